@@ -1,0 +1,31 @@
+# The two commands of the README, and a few helpers.  Each target sets up
+# what is missing first (scripts/setup.sh), so a fresh clone needs nothing else.
+PY := .venv/bin/python
+TTT := .venv/bin/ttt-sm
+
+.PHONY: setup play test soak lint bench tune clean
+
+setup:
+	@sh scripts/setup.sh
+
+play: setup
+	$(TTT) play
+
+test: setup
+	$(PY) -m pytest -q
+
+soak: setup
+	$(PY) -m pytest -q -m soak
+
+lint: setup
+	.venv/bin/ruff check src tests
+	.venv/bin/mypy
+
+bench: setup
+	$(TTT) bench
+
+tune: setup
+	$(TTT) tune
+
+clean:
+	rm -rf .venv out .pytest_cache

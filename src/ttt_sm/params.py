@@ -4,7 +4,7 @@ The thesis gives no dimensions or motor data, so `data/arm.toml` holds
 plausible values for a desk-sized arm (docs/parameters.md says which are
 assumed and why).  :func:`load_params` reads that file, or another of the same
 shape, into frozen dataclasses in SI units; angles given in degrees in the
-file (keys ending in ``_deg``) are converted to radians here.
+file (keys with ``_deg`` in their name) are converted to radians here.
 """
 
 from __future__ import annotations
@@ -225,10 +225,10 @@ def _section(raw: dict[str, Any], cls: type, name: str, where: str) -> Any:
     wanted = {f.name: f for f in fields(cls) if f.name != "source"}
     given = dict(raw)
     for key, value in list(given.items()):
-        if key.endswith("_deg") and key[:-4] + "_rad" in wanted:
+        if "_deg" in key and key.replace("_deg", "_rad") in wanted:
             if not isinstance(value, (int, float)) or isinstance(value, bool):
                 raise ParameterError(f"{where}: [{name}] {key} must be a number, got {value!r}")
-            values[key[:-4] + "_rad"] = math.radians(value)
+            values[key.replace("_deg", "_rad")] = math.radians(value)
             del given[key]
     for key, value in given.items():
         if key not in wanted:

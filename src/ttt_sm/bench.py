@@ -1,0 +1,133 @@
+"""`ttt-sm bench`: the project's speed and quality targets, measured.
+
+Tests never assert on wall-clock time; this command measures it and the
+notes on each issue report what it printed.  Sections can be chosen with
+`--only`; every section returns flat JSON-ready numbers.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .params import ArmParams
+from .sched.clock import WallClock
+from .sched.scheduler import PathStage, Scheduler
+from .sched.trajectory import Waypoint, sample_polyline, square_path
+from .twin.kinematics import IKSolver
+from .twin.plant import ArmSim
+
+
+def _drawing_samples(params: ArmParams, seconds: float, speed: float = 0.03) -> np.ndarray:
+    """Chart-rate poses of squares drawn over and over for about `seconds`."""
+    one = sample_polyline(square_path(params.board, side=0.06), speed, params.control.chart_dt)
+    reps = int(np.ceil(seconds / (len(one) * params.control.chart_dt))) + 1
+    return np.vstack([one] * reps)
+
+
+def _ready_sim(params: ArmParams, samples: np.ndarray, seed: int) -> tuple[ArmSim, Scheduler, PathStage]:
+    """A twin standing at the path's first pose, drives homed, path loaded."""
+    ik = IKSolver(params)
+    q0 = ik.solve(samples[0], q0=np.radians([0.0, 80.0, -70.0, -10.0])).q
+    sim = ArmSim(params, seed=seed, q0=q0)
+    sched = Scheduler(params, sim, ik=ik)
+    sched.assume_homed()
+    path = PathStage(samples)
+    sched.task_stages = [path]
+    return sim, sched, path
+
+
+def bench_loop(params: ArmParams, seconds: float = 20.0, seed: int = 0) -> dict[str, float]:
+    """Closed loop on virtual time: plant + controllers + IK at the chart rate, no charts."""
+    samples = _drawing_samples(params, seconds)
+    sim, sched, _ = _ready_sim(params, samples, seed)
+    sched.run_for(0.2)  # JIT warm-up and settling, not timed
+    t_sim0 = sim.t
+    wall0 = time.perf_counter()
+    sched.run_for(seconds)
+    wall = time.perf_counter() - wall0
+    sim_s = sim.t - t_sim0
+    steps = sim_s * params.control.rate_hz
+    return {
+        "loop_realtime_factor": round(sim_s / wall, 1),
+        "loop_us_per_control_step": round(wall / steps * 1e6, 3),
+        "loop_sim_seconds": round(sim_s, 3),
+        "loop_ik_failures": sched.ik_failures,
+    }
+
+
+def bench_pacing(params: ArmParams, seconds: float = 10.0, seed: int = 0) -> dict[str, float]:
+    """The same loop paced to the wall clock at the control rate."""
+    samples = _drawing_samples(params, seconds)
+    sim, sched, _ = _ready_sim(params, samples, seed)
+    sched.run_for(0.1)  # warm-up on virtual time
+    clock = WallClock(period_s=params.control.dt)
+    sched.set_clock(clock)
+    sched.run_for(seconds)
+    st = clock.stats()
+    return {
+        "pacing_rate_hz": params.control.rate_hz,
+        "pacing_seconds": seconds,
+        "pacing_periods": st.periods,
+        "pacing_deadline_misses": st.deadline_misses,
+        "pacing_lateness_p50_us": round(st.lateness_p50_us, 1),
+        "pacing_lateness_p99_us": round(st.lateness_p99_us, 1),
+        "pacing_lateness_max_us": round(st.lateness_max_us, 1),
+    }
+
+
+def bench_ik_section(params: ArmParams, seed: int = 0) -> dict[str, Any]:
+    """IK speed and robustness (see twin/kinematics_bench.py)."""
+    from .twin.kinematics_bench import bench_ik
+
+    return bench_ik(params, seed=seed)
+
+
+def bench_steps(params: ArmParams, out_dir: Path) -> dict[str, Any]:
+    """Step responses of the three drives on the nonlinear plant (as `ttt-sm tune`)."""
+    from .twin.tuning import tune_report
+
+    rows = tune_report(params, out_dir)
+    return {"step_responses": rows}
+
+
+SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
+    "steps": lambda p, a: bench_steps(p, a["out"]),
+    "ik": lambda p, a: bench_ik_section(p, a["seed"]),
+    "loop": lambda p, a: bench_loop(p, a["loop_seconds"], a["seed"]),
+    "pacing": lambda p, a: bench_pacing(p, a["pacing_seconds"], a["seed"]),
+}
+
+
+def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, quick: bool = False,
+              out: Path = Path("out/bench"), progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Run the chosen sections (all by default) and return one flat result dict.
+
+    `quick` shortens the timed runs (for tests of the command, not for the
+    numbers reported on issues).
+    """
+    names = only or list(SECTIONS)
+    unknown = [n for n in names if n not in SECTIONS]
+    if unknown:
+        raise ValueError(f"unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
+    args = {"seed": seed, "out": out, "loop_seconds": 2.0 if quick else 20.0,
+            "pacing_seconds": 1.0 if quick else 10.0}
+    result: dict[str, Any] = {
+        "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
+                    "numba_jit": os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"},
+        "quick": quick,
+    }
+    for name in names:
+        if progress:
+            progress(f"bench: {name} ...")
+        result.update(SECTIONS[name](params, args))
+    return result
+
+
+__all__ = ["Waypoint", "run_bench", "bench_loop", "bench_pacing"]

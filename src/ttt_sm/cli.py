@@ -1,0 +1,165 @@
+"""`ttt-sm`: the command line.  A thin layer: parse, call the app, print.
+
+Every result-producing subcommand has `--json` (one JSON document on
+standard output, progress on standard error).  Errors are one readable line
+on standard error and exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .params import ParameterError, load_params
+
+
+class CliError(Exception):
+    """A user error the CLI reports as one line."""
+
+
+def _progress(enabled: bool):
+    def say(msg: str) -> None:
+        if enabled:
+            print(msg, file=sys.stderr, flush=True)
+    return say
+
+
+def _emit(data: Any, as_json: bool, text: str | None = None) -> None:
+    if as_json:
+        print(json.dumps(data, indent=2, default=_jsonable))
+    else:
+        print(text if text is not None else json.dumps(data, indent=2, default=_jsonable))
+
+
+def _jsonable(obj: Any) -> Any:
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return dataclasses.asdict(obj)
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, (np.floating, np.integer, np.bool_)):
+        return obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+
+
+def cmd_play(args: argparse.Namespace) -> int:
+    from .app.draw_demo import run_draw_demo
+
+    params = load_params(args.params)
+    result = run_draw_demo(params, seed=args.seed, speed=args.speed / 1000, side=args.side / 1000,
+                           progress=_progress(True))
+    data = dataclasses.asdict(result)
+    lines = [f"  {k}: {v}" for k, v in data.items()]
+    _emit(data, args.json, "play (drawing demo):\n" + "\n".join(lines))
+    return 0
+
+
+def cmd_tune(args: argparse.Namespace) -> int:
+    from .twin.tuning import tune_report
+
+    params = load_params(args.params)
+    rows = tune_report(params, Path(args.out))
+    header = f"{'drive':>5} {'step':>5} {'rise s':>7} {'settle s':>8} {'overshoot %':>11} " \
+             f"{'e(0.5s)':>9} {'static':>9} {'PM in':>6} {'PM out':>6} {'GM out dB':>9}"
+    body = [f"{r['drive']:>5} {r['step_rad']:>5.2f} {r['rise_time_s']:>7.3f} {r['settling_time_s']:>8.3f} "
+            f"{r['overshoot_pct']:>11.2f} {r['error_at_0_5s_rad']:>9.2e} {r['static_error_rad']:>9.2e} "
+            f"{r['inner_phase_margin_deg']:>6.1f} {r['outer_phase_margin_deg']:>6.1f} "
+            f"{r['outer_gain_margin_db']:>9.1f}" for r in rows]
+    plots = [f"plot: {r['plot']}" for r in rows if r.get("plot")]
+    _emit(rows, args.json, "\n".join([header, *body, *plots]))
+    return 0
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from .bench import run_bench
+
+    params = load_params(args.params)
+    only = [s.strip() for s in args.only.split(",")] if args.only else None
+    try:
+        result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=Path(args.out),
+                           progress=_progress(True))
+    except ValueError as exc:
+        raise CliError(str(exc)) from exc
+    _emit(result, args.json)
+    return 0
+
+
+def cmd_ik(args: argparse.Namespace) -> int:
+    from .twin.kinematics import IKSolver, fk
+
+    params = load_params(args.params)
+    target = np.array([args.x / 1000, args.y / 1000, args.z / 1000, np.radians(args.phi)])
+    solver = IKSolver(params)
+    res = solver.solve(target)
+    reached = fk(res.q, params.geometry)
+    data = {"q_deg": np.degrees(res.q).round(4).tolist(), "iterations": res.iterations,
+            "residual": res.residual, "reached_mm_deg": [*(reached[:3] * 1000).round(4).tolist(),
+                                                         round(float(np.degrees(reached[3])), 4)]}
+    _emit(data, args.json, f"q = {data['q_deg']} deg after {res.iterations} iterations "
+                           f"(residual {res.residual:.2e})")
+    return 0
+
+
+def cmd_params(args: argparse.Namespace) -> int:
+    params = load_params(args.params)
+    _emit(dataclasses.asdict(params), args.json)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of `ttt-sm` and its subcommands."""
+    p = argparse.ArgumentParser(prog="ttt-sm", description=__doc__.splitlines()[0])
+    p.add_argument("--params", metavar="FILE", default=None,
+                   help="parameter file (default: the packaged arm.toml)")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    def add(name: str, func, help_: str) -> argparse.ArgumentParser:
+        sp = sub.add_parser(name, help=help_, description=help_)
+        sp.set_defaults(func=func)
+        sp.add_argument("--json", action="store_true", help="print one JSON document")
+        sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
+        return sp
+
+    sp = add("play", cmd_play, "run the main job: for now the simulated arm draws a square")
+    sp.add_argument("--speed", type=float, default=20.0, help="drawing speed, mm/s (default 20)")
+    sp.add_argument("--side", type=float, default=30.0, help="side of the square, mm (default 30)")
+    sp = add("tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
+    sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
+    sp = add("bench", cmd_bench, "measure the speed and quality targets")
+    sp.add_argument("--only", default=None, help="comma-separated sections: steps,ik,loop,pacing")
+    sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
+    sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
+    sp = add("ik", cmd_ik, "solve inverse kinematics for one tool pose")
+    sp.add_argument("x", type=float, help="mm")
+    sp.add_argument("y", type=float, help="mm")
+    sp.add_argument("z", type=float, help="mm")
+    sp.add_argument("--phi", type=float, default=0.0, help="pen angle phi, degrees (default 0)")
+    add("params", cmd_params, "print the parameters in force (SI units)")
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the `ttt-sm` console script."""
+    from .twin.kinematics import IKError
+
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except (ParameterError, IKError, CliError) as exc:
+        print(f"ttt-sm {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"ttt-sm {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

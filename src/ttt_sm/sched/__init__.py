@@ -1,0 +1,1 @@
+"""Scheduling: clocks and the control-step scheduler that wires twin and charts."""

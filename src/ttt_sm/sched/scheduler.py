@@ -1,0 +1,240 @@
+"""The control step of DESIGN.md, run on a clock.
+
+One control step: read the sensors; every `chart_divider`-th step tick the
+chart stages (task stages produce the tool pose, inverse kinematics turns it
+into joint setpoints, joint stages such as the drive-initialisation charts
+pass or replace them); clamp to the joint limits; then the setpoint filters,
+cascade controllers and plant advance one step (inside :class:`ArmSim`).
+
+Charts plug in as *stages*: objects with ``tick(signals)`` that read and write
+the :class:`Signals` of the current chart step.  A plain path is a task stage
+(:class:`PathStage`); the chart runtime of a later issue supplies chart stages.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from ..params import ArmParams
+from ..twin.kinematics import IKError, IKSolver, fk
+from ..twin.plant import ArmSim, Sensors
+from .clock import VirtualClock, WallClock
+
+
+@dataclass
+class Signals:
+    """The signals of one chart step, as the debugger and a trace see them.
+
+    Stages read and write these fields; the scheduler fills `t`, `sensors`,
+    `q_des` (from IK of `task`) and `q_set` (clamped) around them.
+    """
+
+    t: float = 0.0
+    sensors: Sensors | None = None
+    task: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))  # X, Y, Z, phi
+    fr_sw: bool = False
+    q_des: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))  # IK output
+    q_set: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))  # to the controllers
+    ik_iterations: int = 0
+    ik_error: str | None = None
+
+
+class Stage(Protocol):
+    """Something ticked at the chart rate: a chart, or a plain setpoint source."""
+
+    def tick(self, signals: Signals) -> None:
+        """Read and write the signals of this chart step."""
+
+
+class PathStage:
+    """A task stage that plays precomputed tool poses, one row per chart tick.
+
+    After the last row it holds the last pose; `done` tells when it got there.
+    """
+
+    def __init__(self, samples: np.ndarray, fr_sw: bool = False) -> None:
+        if samples.ndim != 2 or samples.shape[1] != 4 or len(samples) == 0:
+            raise ValueError(f"path samples must have shape (n, 4), got {samples.shape}")
+        self.samples = samples
+        self.fr_sw = fr_sw
+        self.index = 0
+
+    @property
+    def done(self) -> bool:
+        """True once the last pose has been sent."""
+        return self.index >= len(self.samples)
+
+    def tick(self, signals: Signals) -> None:
+        """Send the next pose."""
+        i = min(self.index, len(self.samples) - 1)
+        signals.task = self.samples[i]
+        signals.fr_sw = self.fr_sw
+        self.index += 1
+
+
+@dataclass
+class Record:
+    """Per chart tick history of a run, for plots and precision figures."""
+
+    t: list[float] = field(default_factory=list)
+    task: list[np.ndarray] = field(default_factory=list)
+    q_set: list[np.ndarray] = field(default_factory=list)
+    q_encoder: list[np.ndarray] = field(default_factory=list)
+    q_true: list[np.ndarray] = field(default_factory=list)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The history as arrays, one row per chart tick."""
+        return {"t": np.asarray(self.t), "task": np.asarray(self.task),
+                "q_set": np.asarray(self.q_set), "q_encoder": np.asarray(self.q_encoder),
+                "q_true": np.asarray(self.q_true)}
+
+
+class Scheduler:
+    """Runs the control step of DESIGN.md on a virtual or wall clock.
+
+    Parameters
+    ----------
+    params : ArmParams
+        The arm.
+    sim : ArmSim
+        The simulated arm with its controllers (the plant of one control step).
+    task_stages, joint_stages : sequence of Stage
+        Ticked at the chart rate before and after inverse kinematics.
+    clock : VirtualClock or WallClock, optional
+        Virtual time by default.
+    record : bool
+        Keep a per-chart-tick :class:`Record` (costs time; off for benchmarks).
+    """
+
+    def __init__(self, params: ArmParams, sim: ArmSim, task_stages: Sequence[Stage] = (),
+                 joint_stages: Sequence[Stage] = (), clock: VirtualClock | WallClock | None = None,
+                 ik: IKSolver | None = None, record: bool = False) -> None:
+        self.params = params
+        self.sim = sim
+        self.task_stages = list(task_stages)
+        self.joint_stages = list(joint_stages)
+        self.clock = clock if clock is not None else VirtualClock()
+        self.ik = ik if ik is not None else IKSolver(params)
+        self.divider = params.control.chart_divider
+        self.q_min = np.asarray(params.joint_min)
+        self.q_max = np.asarray(params.joint_max)
+        # Joint limits apply in encoder coordinates only once a drive's offset
+        # is known; the servo is absolute, so its limits always apply.
+        self.homed = np.array([False, False, False, True])
+        self.signals = Signals()
+        self.steps = 0
+        self.chart_ticks = 0
+        self.ik_failures = 0
+        self.limit_clamps = 0
+        self.record = Record() if record else None
+        self._hold = np.asarray(sim.q_encoder.tolist() + [sim.q_true[3]], dtype=float)
+        self._clock_started = False
+        self._period0 = 0
+
+    @property
+    def t(self) -> float:
+        """Simulated time, s."""
+        return self.sim.t
+
+    def assume_homed(self) -> None:
+        """Treat every drive as initialised: the twin's true offsets, no init charts."""
+        self.sim.assume_initialised()
+        self.homed[:] = True
+        self._hold = np.asarray(self.sim.q_encoder.tolist() + [self.sim.q_true[3]], dtype=float)
+
+    def set_clock(self, clock: VirtualClock | WallClock) -> None:
+        """Switch clocks; the new clock's period 0 is the next control step."""
+        self.clock = clock
+        self._clock_started = False
+        self._period0 = self.steps
+
+    def tick_charts(self) -> Signals:
+        """One chart step: sensors, task stages, IK, joint stages, clamp, setpoints."""
+        s = self.signals
+        s.t = self.sim.t
+        s.sensors = self.sim.sensors()
+        s.ik_error = None
+        for stage in self.task_stages:
+            stage.tick(s)
+        task = s.task
+        if np.all(np.isfinite(task)):
+            try:
+                result = self.ik.solve(task)
+            except IKError as exc:
+                # Unreachable pose: hold the last good joint setpoints (a safe
+                # state) and report; never pass a wrong answer to the drives.
+                self.ik_failures += 1
+                s.ik_error = str(exc)
+                s.q_des = self._hold.copy()
+            else:
+                s.q_des = result.q
+                s.ik_iterations = result.iterations
+        else:
+            s.q_des = self._hold.copy()
+        s.q_set = s.q_des.copy()
+        for stage in self.joint_stages:
+            stage.tick(s)
+        q = np.asarray(s.q_set, dtype=float)
+        clipped = np.where(self.homed, np.clip(q, self.q_min, self.q_max), q)
+        if not np.array_equal(clipped, q):
+            self.limit_clamps += 1
+        s.q_set = clipped
+        self._hold = clipped
+        self.sim.set_setpoints(clipped, s.fr_sw)
+        self.chart_ticks += 1
+        if self.record is not None:
+            r = self.record
+            r.t.append(s.t)
+            r.task.append(np.array(task, dtype=float))
+            r.q_set.append(clipped.copy())
+            r.q_encoder.append(self.sim.q_encoder.copy())
+            r.q_true.append(self.sim.q_true.copy())
+        return s
+
+    def control_step(self) -> None:
+        """One control step (charts first when this step is a chart step)."""
+        self._start_clock()
+        if self.steps % self.divider == 0:
+            self.tick_charts()
+        self.clock.wait_period(self.steps - self._period0)
+        self.sim.step(1)
+        self.steps += 1
+
+    def run_for(self, seconds: float) -> None:
+        """Run whole chart steps for `seconds` of simulated time."""
+        self.run_until(lambda: False, seconds)
+
+    def run_until(self, predicate: Callable[[], bool], timeout_s: float) -> bool:
+        """Run chart steps until `predicate()` holds (checked after each); False on timeout."""
+        self._start_clock()
+        n_ticks = int(round(timeout_s * self.params.control.rate_hz / self.divider))
+        paced = self.clock.paced
+        for _ in range(n_ticks):
+            while self.steps % self.divider:
+                self.control_step()
+            self.tick_charts()
+            if paced:
+                for _ in range(self.divider):
+                    self.clock.wait_period(self.steps - self._period0)
+                    self.sim.step(1)
+                    self.steps += 1
+            else:
+                self.sim.step(self.divider)
+                self.steps += self.divider
+            if predicate():
+                return True
+        return False
+
+    def _start_clock(self) -> None:
+        if not self._clock_started:
+            self.clock.start()
+            self._clock_started = True
+
+
+def tool_path(params: ArmParams, q: np.ndarray) -> np.ndarray:
+    """Tool poses [x, y, z, phi] by forward kinematics of joint angles, one row per row of `q`."""
+    return np.array([fk(row, params.geometry) for row in np.atleast_2d(q)])

@@ -1,0 +1,79 @@
+"""Task-space paths sampled at the chart rate: plain setpoint sources.
+
+Until the Control chart exists (a later issue), a path is what feeds the
+loop: the tool moves along straight segments at a set speed, one increment
+per chart tick, the way eq. 3.36 draws a line (``X_out = X_out_p + inc``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..params import Board
+
+
+@dataclass(frozen=True)
+class Waypoint:
+    """A tool pose to reach: position (m), pen angle phi (rad), and whether the pen draws."""
+
+    x: float
+    y: float
+    z: float
+    phi: float = 0.0
+    speed: float | None = None  # m/s on the segment that ends here; None: the path default
+
+
+def sample_polyline(waypoints: Sequence[Waypoint], speed: float, dt: float) -> np.ndarray:
+    """Sample straight segments between waypoints at constant speed.
+
+    Parameters
+    ----------
+    waypoints : sequence of Waypoint
+        The first is the start; each later one ends a segment.
+    speed : float
+        Default tool speed along a segment, m/s.
+    dt : float
+        Chart step, s.
+
+    Returns
+    -------
+    np.ndarray, shape (n, 4)
+        One row [x, y, z, phi] per chart tick; phi moves with the position,
+        at most ``speed / 0.05`` rad/s so pure turns take time too.
+    """
+    if len(waypoints) < 1:
+        raise ValueError("a path needs at least one waypoint")
+    if speed <= 0 or dt <= 0:
+        raise ValueError(f"speed and dt must be positive (speed={speed}, dt={dt})")
+    rows = [np.array([waypoints[0].x, waypoints[0].y, waypoints[0].z, waypoints[0].phi])]
+    for wp in waypoints[1:]:
+        a = rows[-1]
+        b = np.array([wp.x, wp.y, wp.z, wp.phi])
+        v = wp.speed if wp.speed is not None else speed
+        length = float(np.linalg.norm(b[:3] - a[:3]))
+        turn = abs(b[3] - a[3]) * 0.05
+        n = max(1, int(np.ceil(max(length, turn) / (v * dt))))
+        s = np.arange(1, n + 1)[:, None] / n
+        rows.extend(a + s * (b - a))
+    return np.vstack(rows)
+
+
+def square_path(board: Board, side: float = 0.03, lift: float = 0.02,
+                press: float = 0.001) -> list[Waypoint]:
+    """A square of `side` drawn around the field's centre, pen lowered and lifted.
+
+    `press` pushes the spring-loaded pen that far into its holder while it
+    draws, so small height errors do not lift it off the board.
+    """
+    cx, cy, z0 = board.field_center_x, board.field_center_y, board.surface_z
+    h = side / 2
+    corners = [(cx + h, cy + h), (cx - h, cy + h), (cx - h, cy - h), (cx + h, cy - h), (cx + h, cy + h)]
+    down, up = z0 - press, z0 + lift
+    path = [Waypoint(cx, cy, up + 0.03), Waypoint(corners[0][0], corners[0][1], up)]
+    path.append(Waypoint(corners[0][0], corners[0][1], down))
+    path.extend(Waypoint(x, y, down) for x, y in corners[1:])
+    path.append(Waypoint(corners[-1][0], corners[-1][1], up))
+    return path

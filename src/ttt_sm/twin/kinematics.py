@@ -324,10 +324,14 @@ def _dls_kernel(target: np.ndarray, q0: np.ndarray, geom: np.ndarray, damping: f
     lambda^2 grows (2x, 4x, 8x, ...).  Near a singular pose a fixed small
     lambda overshoots; a small lambda where the model is good converges fast.
 
-    Returns ``(q, iterations, residual)``; ``residual = |e|`` at `q`.
+    Returns ``(q, iterations, residual)``; ``residual = |e|`` at `q`, NaN
+    when `target` or `q0` is not finite.
     """
     L1, L2, L3, L4, l_f = geom[0], geom[1], geom[2], geom[3], geom[4]
     q = q0.copy()
+    for i in range(4):
+        if not (math.isfinite(target[i]) and math.isfinite(q0[i])):
+            return q, 0, math.nan  # the caller names what was not finite
     e = np.empty(4)
     pose = _fk_floats(q[0], q[1], q[2], q[3], L1, L2, L3, L4, l_f)
     for i in range(4):

@@ -65,7 +65,7 @@ def _drawing_paths(params: ArmParams, rng: np.random.Generator) -> list[np.ndarr
     return paths
 
 
-def _cold_targets(params: ArmParams, rng: np.random.Generator, count: int) -> list[np.ndarray]:
+def cold_targets(params: ArmParams, rng: np.random.Generator, count: int) -> list[np.ndarray]:
     """Reachable targets on the board volume, a fifth of them at or next to full reach."""
     g, b = params.geometry, params.board
     bx0, bx1, by0, by1 = b.board_bounds()
@@ -127,7 +127,7 @@ def bench_ik(params: ArmParams, seed: int = 0, cold_count: int = 1000) -> dict[s
     """
     rng = np.random.default_rng(seed)
     solver = IKSolver(params)
-    cold = _cold_targets(params, rng, cold_count)
+    cold = cold_targets(params, rng, cold_count)
     for target in cold[:20]:  # compile and warm the caches
         solver.reset()
         solver.solve(target)

@@ -6,7 +6,9 @@ code with the iterative solver the arm runs.
 
 from __future__ import annotations
 
+import doctest
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -426,3 +428,9 @@ def test_bench_reports_the_agreed_keys_and_solves_every_cold_target() -> None:
                            "ik_cold_median_iterations", "ik_cold_median_us", "ik_cold_targets"}
     assert result["ik_cold_targets"] == 60 and result["ik_cold_success_rate"] == 1.0
     assert result["ik_warm_median_iterations"] <= 2
+
+
+def test_the_example_in_docs_kinematics_md_runs() -> None:
+    doc = Path(__file__).resolve().parents[2] / "docs" / "kinematics.md"
+    result = doctest.testfile(str(doc), module_relative=False)
+    assert result.attempted >= 5 and result.failed == 0

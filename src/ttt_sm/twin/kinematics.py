@@ -321,8 +321,11 @@ def _dls_kernel(target: np.ndarray, q0: np.ndarray, geom: np.ndarray, damping: f
     gain ratio rho = (actual drop of |e|^2) / (drop the linearised model
     promised), as in Nielsen's Levenberg-Marquardt: a step that lowers |e| is
     kept and lambda^2 shrinks (by up to 3x); one that does not is undone and
-    lambda^2 grows (2x, 4x, 8x, ...).  Near a singular pose a fixed small
-    lambda overshoots; a small lambda where the model is good converges fast.
+    lambda^2 grows (2x, 4x, 8x, ...).  No joint moves more than
+    ``_MAX_STEP_RAD`` in one step.  Why: next to a singular pose the fixed
+    step ``sigma e / (sigma^2 + lambda^2)`` is either huge (sigma ~ lambda:
+    about e / (2 lambda), hundreds of radians) or tiny (sigma << lambda: the
+    error then falls only like 1/k); docs/kinematics.md has the numbers.
 
     Returns ``(q, iterations, residual)``; ``residual = |e|`` at `q`, NaN
     when `target` or `q0` is not finite.
@@ -357,7 +360,9 @@ def _dls_kernel(target: np.ndarray, q0: np.ndarray, geom: np.ndarray, damping: f
             for j in range(4):
                 A[i, j] = J[i, 0] * J[j, 0] + J[i, 1] * J[j, 1] + J[i, 2] * J[j, 2] + J[i, 3] * J[j, 3]
             A[i, i] += mu
-        if not _solve_spd4(A, e, w):
+        if not _solve_spd4(A, e, w):  # round-off made A indefinite: damp harder
+            if not adaptive:
+                break
             mu *= nu
             nu *= 2.0
             need_jacobian = False
@@ -543,8 +548,8 @@ class IKSolver:
                 q, residual, violation = q_h, res_h, _unwind(q_h, self._q_min, self._q_max)
         # A finite residual implies finite q: fk of NaN or inf is NaN.
         if not residual <= ik.tolerance:
-            raise UnreachableTargetError(t, residual, f"no convergence within {ik.max_iterations} "
-                                         "iterations")
+            raise UnreachableTargetError(t, residual, f"eq. 3.35 did not converge within "
+                                         f"{ik.max_iterations} iterations")
         if violation:
             joint = violation - 1
             raise JointLimitError(t, violation, q[joint], self._q_min[joint], self._q_max[joint])

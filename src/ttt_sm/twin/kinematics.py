@@ -12,7 +12,8 @@ down.  docs/kinematics.md derives the equations and lists the thesis' typos.
 * :func:`ik_closed_form` solves the inverse problem geometrically; it is the
   test oracle, not what the arm runs.
 * :func:`damped_least_squares` is the thesis' iterative solver (eq. 3.35),
-  with an adaptive damping that keeps it converging at singular poses.
+  with adaptive damping and a step limit that keep it converging from and
+  near singular poses.
 * :class:`IKSolver` wraps it for a control loop: warm start from the last
   solution, joint limits, and specific errors instead of wrong answers.
 """
@@ -94,7 +95,7 @@ class JointLimitError(IKError):
             f"[{math.degrees(lo):.1f}, {math.degrees(hi):.1f}] deg")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # eq on arrays is ambiguous; compare .q with numpy
 class IKResult:
     """Outcome of one inverse kinematics solve.
 
@@ -517,7 +518,7 @@ class IKSolver:
         Returns
         -------
         IKResult
-            Converged, finite and within the joint limits; q1 in (-pi, pi].
+            Converged, finite and within the joint limits; q1, q2, q3 in [-pi, pi].
 
         Raises
         ------

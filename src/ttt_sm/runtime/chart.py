@@ -1,0 +1,365 @@
+"""TickChart: a python-statemachine ``StateChart`` with Stateflow's clock.
+
+A chart is written like any python-statemachine chart — states as attributes,
+``source.to(target, cond=..., on=...)``, callbacks by name — and reads like its
+diagram.  Two kinds of transition:
+
+* **tick transitions**: written without an event (``off.to(on, cond="switch")``).
+  Stateflow's eventless transitions: tried on every chart tick, guard only.
+* **event transitions**: assigned to an event name (``button = off.to(on)``),
+  taken when that event, posted from outside with :meth:`TickChart.post`, is
+  handled at the next tick.
+
+One :meth:`TickChart.tick`:
+
+1. outputs are copied to ``<name>_p`` (their value one chart tick earlier);
+2. the events posted since the last tick are sent to the library, in order;
+3. the tick transitions of the active states are tried in Stateflow order
+   (outermost state first; within a state, outer transitions then inner ones,
+   each in declaration order).  The first whose guard holds is taken through the
+   library — exit actions, transition action, entry actions, listeners — and the
+   tick ends: at most one tick transition per tick;
+4. if none was taken, the during actions (``during_<state>`` methods) of the
+   active states run, outermost first.
+
+A quiet tick (step 4) never calls ``send()``: guards are compiled to plain calls
+and cached per active configuration (see :mod:`.guards`).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Callable, Mapping, MutableSet
+from typing import Any, ClassVar
+
+from statemachine import StateChart
+from statemachine.factory import StateMachineMetaclass
+from statemachine.state import State
+from statemachine.transition import Transition
+
+from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, check_values, collect_declarations
+from .errors import ChartDefinitionError, GuardMismatchError, UnknownEventError
+from .guards import Guard, compile_guard
+from .structure import (
+    DURING_PREFIX,
+    ChartStructure,
+    build_structure,
+    states_entered_by,
+    tag_tick_transitions,
+)
+from .temporal import temporal_of
+
+_NO_PLAN = object()
+_Plan = tuple[tuple[tuple[Guard | None, str, Transition], ...], tuple[Callable[[], Any], ...]]
+
+
+class TickChartMeta(StateMachineMetaclass):
+    """Builds the library's chart, then tags tick transitions and reads data and structure."""
+
+    def __init__(cls, name: str, bases: tuple[type], attrs: dict[str, Any]) -> None:
+        super().__init__(name, bases, attrs)
+        if not cls.states:  # the abstract TickChart itself
+            return
+        tag_tick_transitions(cls)  # type: ignore[arg-type]
+        structure = build_structure(cls)  # type: ignore[arg-type]
+        decls = collect_declarations(cls)
+        _check_during_names(cls, structure)
+        _check_temporal_guards(cls, structure)
+        cls._structure = structure
+        cls._state_names = frozenset(s.id for s in structure.states)
+        cls._data_decls = decls
+        cls._prev_pairs = tuple(
+            (d.name, d.name + PREVIOUS_SUFFIX) for d in decls if d.kind == "output"
+        )
+
+
+def _check_during_names(cls: type, structure: ChartStructure) -> None:
+    state_ids = {s.id for s in structure.states}
+    for attr in dir(cls):
+        if attr.startswith(DURING_PREFIX) and callable(getattr(cls, attr, None)):
+            if attr[len(DURING_PREFIX):] not in state_ids:
+                raise ChartDefinitionError(
+                    f"{cls.__name__}.{attr}: no state {attr[len(DURING_PREFIX):]!r} to run it in;"
+                    f" states: {', '.join(sorted(state_ids))}"
+                )
+
+
+def _check_temporal_guards(cls: type, structure: ChartStructure) -> None:
+    for info in structure.transitions:
+        if info.kind == "event":
+            for spec in info.transition.cond:
+                if temporal_of(spec.func) is not None:
+                    raise ChartDefinitionError(
+                        f"{cls.__name__}: {info.label}: temporal guards belong on tick transitions"
+                        " (written without an event); an event transition is only tried when"
+                        " its event arrives"
+                    )
+
+
+class _Clock:
+    """Internal listener: records when states are (re-)entered and which transitions ran.
+
+    It uses ``after_transition`` rather than ``on_enter_state`` so that the
+    library's own instance diagrams do not list a hook on every state.
+    """
+
+    def __init__(self, chart: TickChart) -> None:
+        self.chart = chart
+
+    def after_transition(self, transition: Transition) -> None:
+        chart = self.chart
+        now = chart._ticks
+        entered_at = chart._entered_at
+        for state in states_entered_by(chart, transition):
+            entered_at[state.id] = now
+        if chart._recording:
+            chart._taken.append(transition)
+
+
+class TickChart(StateChart, metaclass=TickChartMeta):
+    """Base class of a Stateflow-style chart: subclass it and declare states and data.
+
+    Parameters
+    ----------
+    tick_period_s : float, optional
+        Chart time per tick in seconds (needed by ``after_s``); defaults to the
+        class attribute ``tick_period_s``.
+    chart_name : str, optional
+        Name of this instance in traces and coverage; defaults to the class name.
+    data : mapping, optional
+        Initial values overriding the declared defaults.
+    listeners : list, optional
+        python-statemachine listeners (e.g. :class:`~.listeners.Trace`).
+    **kwargs
+        Passed to ``StateChart`` (``start_value=...`` starts the chart mid-way).
+    """
+
+    catch_errors_as_events = False  # a bug in an action raises, as in Stateflow
+    tick_period_s: float | None = None
+    inputs: ClassVar[tuple[Data, ...]] = ()
+    outputs: ClassVar[tuple[Data, ...]] = ()
+    local: ClassVar[tuple[Data, ...]] = ()
+
+    chart_name: str
+    _ticks: int
+    _entered_at: dict[str, int]
+    _queue: deque[tuple[str, dict[str, Any]]]
+    _plans: dict[Any, _Plan]
+    _plan_key: Any
+    _plan: _Plan | None
+    _guards: dict[int, Guard | None]
+    _taken: list[Transition]
+    _recording: bool
+
+    _structure: ClassVar[ChartStructure]
+    _data_decls: ClassVar[tuple[Data, ...]] = ()
+    _prev_pairs: ClassVar[tuple[tuple[str, str], ...]] = ()
+    _state_names: ClassVar[frozenset[str]] = frozenset()
+
+    def __init__(
+        self,
+        *,
+        tick_period_s: float | None = None,
+        chart_name: str | None = None,
+        data: Mapping[str, Any] | None = None,
+        listeners: list[object] | None = None,
+        **kwargs: Any,
+    ) -> None:
+        d = self.__dict__
+        d["_ticks"] = 0
+        d["_entered_at"] = {}
+        d["_queue"] = deque()
+        d["_plans"] = {}
+        d["_plan_key"] = _NO_PLAN
+        d["_plan"] = None
+        d["_guards"] = {}
+        d["_taken"] = []
+        d["_recording"] = False
+        if tick_period_s is not None:
+            if not tick_period_s > 0:
+                raise ValueError(f"tick_period_s must be > 0 s, got {tick_period_s!r}")
+            d["tick_period_s"] = float(tick_period_s)
+        d["chart_name"] = chart_name or type(self).__name__
+        # Data must exist before the library resolves guards that name it.
+        self.reset_data()
+        if data:
+            check_values(type(self).__name__, self._data_decls, data, set(KIND_ATTRS))
+            d.update(data)
+            for name, prev in self._prev_pairs:
+                d[prev] = d[name]
+        super().__init__(listeners=[_Clock(self), *(listeners or [])], **kwargs)
+        for state in self.configuration:
+            self._entered_at[state.id] = 0
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # Same protection as StateChart.__setattr__ (a state cannot be overwritten),
+        # at a third of its cost: during actions assign outputs on every quiet tick.
+        if name in self._state_names:
+            super().__setattr__(name, value)  # raises the library's error
+        object.__setattr__(self, name, value)
+
+    # -- the clock ---------------------------------------------------------
+
+    def tick(self) -> Transition | None:
+        """Advance the chart by one chart tick; return the tick transition taken, if any."""
+        d = self.__dict__
+        d["_ticks"] += 1
+        for name, prev in self._prev_pairs:
+            d[prev] = d[name]
+        if d["_queue"]:
+            self._handle_posted_events()
+        raw = getattr(d["model"], d["state_field"])
+        if raw is d["_plan_key"]:
+            candidates, durings = d["_plan"]
+        else:
+            candidates, durings = self._load_plan(raw)
+        for guard, event, transition in candidates:
+            if guard is None or guard():
+                self._take(event, transition)
+                return transition
+        for during in durings:
+            during()
+        return None
+
+    def run_ticks(self, n: int) -> int:
+        """Tick ``n`` times; return how many tick transitions were taken."""
+        return sum(self.tick() is not None for _ in range(n))
+
+    def post(self, event: str, **data: Any) -> None:
+        """Queue an event from outside, with its data; it is handled at the next tick.
+
+        The data are passed as keyword arguments to the transition's guards and actions.
+        """
+        if event not in self._structure.user_events:
+            raise UnknownEventError(
+                f"{self.chart_name}: no transition handles event {event!r};"
+                f" events: {', '.join(self._structure.user_events) or '(none)'}"
+            )
+        self._queue.append((event, data))
+
+    def handles(self, event: str) -> bool:
+        """Whether some transition of this chart is triggered by ``event``."""
+        return event in self._structure.user_events
+
+    @property
+    def pending_events(self) -> list[tuple[str, dict[str, Any]]]:
+        """Events posted and not yet handled, oldest first."""
+        return [(e, dict(data)) for e, data in self._queue]
+
+    @property
+    def tick_count(self) -> int:
+        """Chart ticks since construction."""
+        return self._ticks
+
+    @property
+    def time_s(self) -> float | None:
+        """Chart time: ticks times the tick period (``None`` without a period)."""
+        period = self.tick_period_s
+        return None if period is None else self._ticks * period
+
+    def ticks_in(self, state: State | str) -> int:
+        """Ticks since ``state`` was last entered (0 during the tick that entered it)."""
+        state_id = state if isinstance(state, str) else state.id
+        return self._ticks - self._entered_at[state_id]
+
+    def _handle_posted_events(self) -> None:
+        queue = self._queue
+        # Only those posted before this tick: an action that posts waits for the next one.
+        for _ in range(len(queue)):
+            event, data = queue.popleft()
+            self.send(event, **data)
+
+    def _take(self, event: str, transition: Transition) -> None:
+        d = self.__dict__
+        taken = d["_taken"]
+        taken.clear()
+        d["_recording"] = True
+        try:
+            self.send(event)
+        finally:
+            d["_recording"] = False
+        if transition not in taken:
+            info = self._structure.info(transition)
+            raise GuardMismatchError(
+                f"{self.chart_name}: the guard of '{info.label}' held on the fast path but"
+                " python-statemachine did not take the transition; guards must be pure"
+                " functions of the chart's inputs and data (no side effects, no event data)"
+            )
+
+    def _load_plan(self, raw: Any) -> _Plan:
+        d = self.__dict__
+        key = frozenset(raw) if isinstance(raw, MutableSet) else raw
+        plan = d["_plans"].get(key)
+        if plan is None:
+            plan = self._build_plan()
+            d["_plans"][key] = plan
+        d["_plan_key"] = raw
+        d["_plan"] = plan
+        return plan
+
+    def _build_plan(self) -> _Plan:
+        active = set(self.configuration_values)
+        guards = self._guards
+        candidates: list[tuple[Guard | None, str, Transition]] = []
+        durings: list[Callable[[], Any]] = []
+        for state in self._structure.states:
+            if state.id not in active:
+                continue
+            for info in self._structure.tick_by_state[state.id]:
+                t = info.transition
+                if id(t) not in guards:
+                    guards[id(t)] = compile_guard(self, t)[0]
+                assert info.tick_event is not None
+                candidates.append((guards[id(t)], info.tick_event, t))
+            for name in state.during:
+                durings.append(getattr(self, name))
+        return tuple(candidates), tuple(durings)
+
+    def guard_paths(self) -> dict[str, str]:
+        """For each tick transition, whether its guard runs as a plain call (``fast``) or
+        through the library (``library``): a chart author checks the fast path is used."""
+        return {
+            info.label: "fast" if compile_guard(self, info.transition)[1] else "library"
+            for info in self._structure.transitions if info.kind == "tick"
+        }
+
+    # -- data ----------------------------------------------------------------
+
+    @classmethod
+    def declarations(cls) -> tuple[Data, ...]:
+        """The chart's inputs, outputs and local data, in declaration order."""
+        return cls._data_decls
+
+    @classmethod
+    def structure(cls) -> ChartStructure:
+        """States and transitions of the chart, as diagrams and coverage read them."""
+        return cls._structure
+
+    def snapshot(self, kinds: tuple[str, ...] = ("input", "output", "local")) -> dict[str, Any]:
+        """Current values of the declared data of the given kinds, by name."""
+        d = self.__dict__
+        return {decl.name: d[decl.name] for decl in self._data_decls if decl.kind in kinds}
+
+    def previous_outputs(self) -> dict[str, Any]:
+        """Each output's value one chart tick earlier, by output name."""
+        d = self.__dict__
+        return {name: d[prev] for name, prev in self._prev_pairs}
+
+    def set_inputs(self, **values: Any) -> None:
+        """Set inputs by name; an unknown name raises :class:`UnknownDataError`."""
+        check_values(type(self).__name__, self._data_decls, values, {"input"})
+        self.__dict__.update(values)
+
+    def reset_data(self, kinds: tuple[str, ...] = ("input", "output", "local")) -> None:
+        """Put the declared data of the given kinds back to their defaults."""
+        d = self.__dict__
+        for decl in self._data_decls:
+            if decl.kind in kinds:
+                d[decl.name] = decl.fresh_default()
+                if decl.kind == "output":
+                    d[decl.name + PREVIOUS_SUFFIX] = decl.fresh_default()
+
+
+def entered_states(chart: StateChart, transition: Transition) -> list[State]:
+    """Alias of :func:`.structure.states_entered_by`, for listeners written by users."""
+    return states_entered_by(chart, transition)

@@ -1,0 +1,45 @@
+"""Exceptions of the chart runtime: each says what was wrong, where, and what to do."""
+
+from __future__ import annotations
+
+from statemachine.exceptions import InvalidDefinition
+
+
+class ChartDefinitionError(InvalidDefinition):
+    """A chart class is declared wrongly (data names, during actions, temporal guards).
+
+    Raised when the class is created, so a typo shows at import time, not mid-run.
+    It is an ``InvalidDefinition`` of python-statemachine, so code that catches the
+    library's definition errors catches ours too.
+    """
+
+
+class UnknownEventError(KeyError):
+    """An event was posted to a chart that has no transition for it."""
+
+    def __str__(self) -> str:  # KeyError would print the message in quotes
+        return str(self.args[0]) if self.args else ""
+
+
+class UnknownDataError(KeyError):
+    """A data name was given that the chart does not declare."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
+
+
+class TemporalLogicError(RuntimeError):
+    """A temporal guard cannot be evaluated, e.g. ``after_s`` on a chart without a tick period."""
+
+
+class GuardMismatchError(RuntimeError):
+    """A tick transition's guard held on the fast path but the library did not take it.
+
+    Guards must be pure functions of the chart's inputs and data: the runtime
+    evaluates them once itself and the library evaluates them again when it takes
+    the transition.  A guard with side effects, or one that reads the event, breaks this.
+    """
+
+
+class GraphvizMissingError(RuntimeError):
+    """Graphviz ``dot`` is needed for SVG/PNG output and is not installed."""

@@ -1,0 +1,277 @@
+"""What a chart class is made of, read once from its python-statemachine definition.
+
+The clock (:mod:`.chart`), the diagrams (:mod:`.diagram`), the coverage report and a
+future debugger all read the same :class:`ChartStructure`: states in document
+order with their entry/during/exit actions, and every transition with its kind
+(``tick`` or ``event``), guards, actions, Stateflow priority and a stable label.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+from statemachine.event import Event
+from statemachine.state import State
+from statemachine.transition import Transition
+from statemachine.utils import humanize_id
+
+if TYPE_CHECKING:
+    from statemachine import StateChart
+
+#: Prefix of the event generated for each tick transition (one unique event each).
+TICK_EVENT_PREFIX = "_tick_"
+#: Name the generated events show in python-statemachine's own diagrams.
+TICK_EVENT_NAME = "tick"
+#: Prefix of a during action's method name: ``during_<state id>``.
+DURING_PREFIX = "during_"
+
+
+@dataclass(frozen=True)
+class StateInfo:
+    """One state of a chart, with the names of its actions."""
+
+    id: str
+    label: str
+    parent: str | None
+    depth: int
+    children: tuple[str, ...]
+    initial: bool
+    final: bool
+    parallel: bool
+    entry: tuple[str, ...]
+    during: tuple[str, ...]
+    exit: tuple[str, ...]
+
+    @property
+    def is_compound(self) -> bool:
+        return bool(self.children)
+
+
+@dataclass(frozen=True)
+class TransitionInfo:
+    """One transition of a chart, as a diagram, a trace and coverage name it.
+
+    ``kind`` is ``"tick"`` for a guard-only (eventless in Stateflow) transition tried
+    on every chart tick, ``"event"`` for one triggered by an event from outside.
+    ``priority`` is the 1-based Stateflow execution order among the tick transitions
+    of the same source (outer ones first, then inner ones, each in declaration order);
+    0 for event transitions.
+    """
+
+    index: int
+    source: str
+    target: str | None
+    kind: Literal["tick", "event"]
+    events: tuple[str, ...]
+    tick_event: str | None
+    guards: tuple[str, ...]
+    actions: tuple[str, ...]
+    internal: bool
+    inner: bool
+    priority: int
+    label: str
+    transition: Transition = field(compare=False, repr=False)
+
+    @property
+    def trigger(self) -> str:
+        """``"tick"`` for a tick transition, else the event names joined by spaces."""
+        return TICK_EVENT_NAME if self.kind == "tick" else " ".join(self.events)
+
+
+@dataclass(frozen=True)
+class ChartStructure:
+    """States (pre-order: parents before children) and transitions of a chart class."""
+
+    name: str
+    doc: str
+    states: tuple[StateInfo, ...]
+    transitions: tuple[TransitionInfo, ...]
+    tick_by_state: dict[str, tuple[TransitionInfo, ...]] = field(repr=False)
+    by_transition: dict[int, TransitionInfo] = field(repr=False)
+    tick_events: frozenset[str] = field(repr=False)
+    user_events: tuple[str, ...] = ()
+
+    def state(self, state_id: str) -> StateInfo:
+        return next(s for s in self.states if s.id == state_id)
+
+    def info(self, transition: Transition) -> TransitionInfo:
+        """The :class:`TransitionInfo` of a transition object of this chart."""
+        return self.by_transition[id(transition)]
+
+
+def walk_states(states: Iterable[State], depth: int = 0) -> Iterator[tuple[State, int]]:
+    """Yield ``(state, depth)`` in document order, each parent before its children."""
+    for state in states:
+        yield state, depth
+        yield from walk_states(state.states, depth + 1)
+
+
+def is_inner(transition: Transition) -> bool:
+    """Whether a transition stays inside its source (Stateflow's inner transition)."""
+    target = transition.target
+    return bool(
+        transition.internal and target is not None
+        and (target is transition.source or target.is_descendant(transition.source))
+    )
+
+
+def tag_tick_transitions(cls: type[StateChart]) -> None:
+    """Give every eventless transition of ``cls`` its own generated event.
+
+    python-statemachine takes eventless transitions by itself after every event
+    (SCXML), which is not Stateflow's clock.  Each one gets a unique event
+    ``_tick_<source>_<k>`` instead, named ``tick`` in diagrams; the runtime sends
+    exactly that event when the transition's guard holds on a tick.
+    """
+    for state, _depth in walk_states(cls.states):
+        k = 0
+        for transition in state.transitions:
+            if transition.initial or not transition.is_eventless:
+                continue
+            event = Event(id=f"{TICK_EVENT_PREFIX}{state.id}_{k}", name=TICK_EVENT_NAME)
+            transition.add_event(event)
+            cls.add_event(event)  # type: ignore[attr-defined]
+            k += 1
+
+
+def _display_name(state: State) -> str:
+    # States show by their id (the thesis' names: start_stop, wait_1), unless the
+    # chart gave an explicit name.
+    return state.id if state.name == humanize_id(state.id) else str(state.name)
+
+
+def action_names(cls: type, grouper: Any) -> tuple[str, ...]:
+    """Names of the callbacks of a spec group that the class defines or was given."""
+    names = set(dir(cls))
+    return tuple(
+        str(spec) for spec in grouper
+        if not spec.is_convention or spec.func in names
+    )
+
+
+def _guard_names(transition: Transition) -> tuple[str, ...]:
+    return tuple(str(spec) for spec in transition.cond)
+
+
+def build_structure(cls: type[StateChart]) -> ChartStructure:
+    """Read the structure of a chart class (after :func:`tag_tick_transitions`)."""
+    names = set(dir(cls))
+    states: list[StateInfo] = []
+    transitions: list[TransitionInfo] = []
+    tick_by_state: dict[str, tuple[TransitionInfo, ...]] = {}
+    labels: dict[str, int] = {}
+    index = 0
+    for state, depth in walk_states(cls.states):
+        during_name = f"{DURING_PREFIX}{state.id}"
+        states.append(StateInfo(
+            id=state.id,
+            label=_display_name(state),
+            parent=state.parent.id if state.parent else None,
+            depth=depth,
+            children=tuple(c.id for c in state.states),
+            initial=bool(state.initial),
+            final=bool(state.final),
+            parallel=bool(state.parallel),
+            entry=action_names(cls, state.enter),
+            during=(during_name,) if during_name in names else (),
+            exit=action_names(cls, state.exit),
+        ))
+        own = [t for t in state.transitions if not t.initial]
+        tick = [t for t in own if any(str(e).startswith(TICK_EVENT_PREFIX) for e in t.events)]
+        # Stateflow order: outer transitions before inner ones, each in declaration order.
+        ordered_tick = [t for t in tick if not is_inner(t)] + [t for t in tick if is_inner(t)]
+        priority = {id(t): i + 1 for i, t in enumerate(ordered_tick)}
+        infos: dict[int, TransitionInfo] = {}
+        for t in own:
+            tick_event = next((str(e) for e in t.events if str(e).startswith(TICK_EVENT_PREFIX)), None)
+            events = tuple(str(e) for e in t.events if not str(e).startswith(TICK_EVENT_PREFIX))
+            guards = _guard_names(t)
+            kind: Literal["tick", "event"] = "tick" if tick_event else "event"
+            target = t.target.id if t.target is not None else None
+            trigger = TICK_EVENT_NAME if kind == "tick" else " ".join(events)
+            guard_text = f" [{' && '.join(guards)}]" if guards else ""
+            label = f"{state.id} -> {target or '(none)'}: {trigger}{guard_text}"
+            labels[label] = labels.get(label, 0) + 1
+            if labels[label] > 1:
+                label = f"{label} #{labels[label]}"
+            actions = (
+                action_names(cls, t.before) + action_names(cls, t.on) + action_names(cls, t.after)
+            )
+            info = TransitionInfo(
+                index=index, source=state.id, target=target, kind=kind, events=events,
+                tick_event=tick_event, guards=guards, actions=actions,
+                internal=bool(t.internal), inner=is_inner(t), priority=priority.get(id(t), 0),
+                label=label, transition=t,
+            )
+            index += 1
+            infos[id(t)] = info
+            transitions.append(info)
+        tick_by_state[state.id] = tuple(infos[id(t)] for t in ordered_tick)
+    tick_events = frozenset(t.tick_event for t in transitions if t.tick_event)
+    user_events: list[str] = []
+    for t in transitions:
+        for e in t.events:
+            if e not in user_events:
+                user_events.append(e)
+    return ChartStructure(
+        name=cls.__name__,
+        doc=(cls.__doc__ or "").strip(),
+        states=tuple(states),
+        transitions=tuple(transitions),
+        tick_by_state=tick_by_state,
+        by_transition={id(t.transition): t for t in transitions},
+        tick_events=tick_events,
+        user_events=tuple(user_events),
+    )
+
+
+def priority_conflicts(structure: ChartStructure) -> list[str]:
+    """Events handled both by a state and by one of its ancestors.
+
+    Where this happens python-statemachine (SCXML) lets the inner state win, while
+    Stateflow would take the ancestor's transition.  Returns one sentence per
+    conflict; an empty list means both semantics agree for every event of the chart.
+    """
+    parents = {s.id: s.parent for s in structure.states}
+    handlers: dict[str, set[str]] = {}
+    for t in structure.transitions:
+        for e in t.events:
+            handlers.setdefault(e, set()).add(t.source)
+    out: list[str] = []
+    for event, sources in handlers.items():
+        for src in sorted(sources):
+            anc = parents.get(src)
+            while anc is not None:
+                if anc in sources:
+                    out.append(
+                        f"event {event!r}: handled by {anc!r} and its descendant {src!r};"
+                        f" the library takes {src!r}'s transition (SCXML), Stateflow would take {anc!r}'s"
+                    )
+                anc = parents.get(anc)
+    return out
+
+
+def states_entered_by(chart: StateChart, transition: Transition) -> list[State]:
+    """The active states that ``transition`` (just taken) entered or re-entered.
+
+    Uses the library's own transition domain, so a self-transition or a transition
+    to a parent counts its re-entered states, as python-statemachine ran their
+    entry actions.  Call it after the transition (e.g. from ``after_transition``).
+    """
+    if not transition.targets:
+        return []
+    domain = chart._engine.get_transition_domain(transition)
+    config = list(chart.configuration)
+    if domain is None:
+        entered = config
+    else:
+        entered = [s for s in config if s.is_descendant(domain)]
+    target = transition.target
+    if (
+        transition.internal and transition.is_self and target is not None and target.is_atomic
+        and chart.enable_self_transition_entries
+    ):
+        entered.extend(s for s in config if s == target and s not in entered)
+    return entered

@@ -135,6 +135,9 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     """
 
     catch_errors_as_events = False  # a bug in an action raises, as in Stateflow
+    # A state with only a during action and no way out (DriveInit's pass-through) is
+    # normal in Stateflow; python-statemachine calls it a trap state by default.
+    validate_trap_states = False
     tick_period_s: float | None = None
     inputs: ClassVar[tuple[Data, ...]] = ()
     outputs: ClassVar[tuple[Data, ...]] = ()

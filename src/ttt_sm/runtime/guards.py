@@ -27,6 +27,7 @@ from functools import partial
 from typing import TYPE_CHECKING, Any
 
 from statemachine.callbacks import SpecReference
+from statemachine.event_data import EventData, TriggerData
 from statemachine.spec_parser import operator_mapping, parse_boolean_expr, replace_operators
 from statemachine.transition import Transition
 
@@ -232,10 +233,10 @@ def _bind_known(chart: TickChart, transition: Transition, func: Callable[..., An
 def _library_guard(chart: TickChart, transition: Transition) -> Guard:
     key = transition.cond.key
     evaluate = chart._callbacks.all
-    kwargs = {
-        "machine": chart, "model": chart.model, "event": None, "transition": transition,
-        "state": transition.source, "source": transition.source, "target": transition.target,
-    }
+    # The arguments the library gives a guard when the transition's own event is sent.
+    event = next(iter(transition.events), None)
+    trigger = TriggerData(machine=chart, event=event)
+    kwargs = EventData(trigger_data=trigger, transition=transition).extended_kwargs
 
     def library_guard() -> bool:
         return bool(evaluate(key, **kwargs))

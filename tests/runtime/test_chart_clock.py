@@ -1,0 +1,263 @@
+"""The Stateflow clock of TickChart: quiet ticks, one transition per tick, priority, events."""
+
+from __future__ import annotations
+
+import pytest
+from statemachine import State
+
+from ttt_sm.runtime import (
+    Data,
+    GuardMismatchError,
+    TickChart,
+    UnknownEventError,
+    priority_conflicts,
+)
+
+
+class Lamp(TickChart):
+    """A lamp with a dimmer: ``on`` nests ``dim`` and ``bright``."""
+
+    inputs = (
+        Data("switch", "bool", False, "wall switch"),
+        Data("bright_req", "bool", False, "dimmer turned up"),
+    )
+    outputs = (Data("level", "1", 0.0, "light level"),)
+    local = (Data("presses", "1", 0, "button presses seen"),)
+
+    off = State(initial=True)
+
+    class on(State.Compound):
+        dim = State(initial=True)
+        bright = State()
+        dim.to(bright, cond="bright_req")
+        bright.to(dim, cond="not bright_req")
+
+        def during_dim(self) -> None:
+            self.level = self.level_p + 1
+            self.calls.append("during dim")
+
+        def during_bright(self) -> None:
+            self.level = self.level_p + 10
+
+    off.to(on, cond="switch", on="count_on")
+    on.to(off, cond="not switch")
+    button = off.to(on) | on.to(off)
+
+    def __init__(self, **kwargs):
+        self.calls: list[str] = []
+        super().__init__(**kwargs)
+
+    def count_on(self) -> None:
+        self.calls.append("count_on")
+
+    def on_enter_on(self) -> None:
+        self.calls.append("enter on")
+
+    def on_exit_off(self) -> None:
+        self.calls.append("exit off")
+
+    def on_button(self, presses: int = 1) -> None:
+        self.presses += presses
+
+    def during_on(self) -> None:
+        self.calls.append("during on")
+
+
+class SendSpy:
+    """Counts the chart's calls to ``send`` without changing them."""
+
+    def __init__(self, chart: TickChart) -> None:
+        self.events: list[str] = []
+        original = chart.send
+
+        def send(event, *args, **kwargs):
+            self.events.append(event)
+            return original(event, *args, **kwargs)
+
+        chart.send = send  # instance attribute shadows the method
+
+
+class TransitionSpy:
+    """A python-statemachine listener recording the transitions taken."""
+
+    def __init__(self) -> None:
+        self.taken: list[tuple[str, str]] = []
+
+    def after_transition(self, source, target) -> None:
+        self.taken.append((source.id, target.id))
+
+
+def test_quiet_tick_runs_during_actions_and_never_calls_send():
+    lamp = Lamp(start_value="dim")
+    lamp.switch = True  # no guard holds: on stays on, dim stays dim
+    lamp.calls.clear()
+    spy = SendSpy(lamp)
+    for _ in range(5):
+        assert lamp.tick() is None
+    assert spy.events == []
+    assert lamp.level == 5
+    # outermost first: during_on of the parent before during_dim of the child
+    assert lamp.calls == ["during on", "during dim"] * 5
+
+
+def test_a_guard_that_holds_takes_one_transition_through_the_library():
+    listener = TransitionSpy()
+    lamp = Lamp(listeners=[listener])
+    spy = SendSpy(lamp)
+    lamp.switch = True
+    lamp.bright_req = True  # dim -> bright would also hold, but only next tick
+    taken = lamp.tick()
+    assert taken is not None and (taken.source.id, taken.target.id) == ("off", "on")
+    assert listener.taken == [("off", "on")]
+    assert lamp.configuration_values == {"on", "dim"}
+    assert lamp.calls == ["exit off", "count_on", "enter on"]  # exit, transition, entry
+    assert len(spy.events) == 1 and spy.events[0].startswith("_tick_off_")
+    assert lamp.level == 0  # no during action in a tick that took a transition
+    lamp.tick()
+    assert listener.taken == [("off", "on"), ("dim", "bright")]
+    assert lamp.configuration_values == {"on", "bright"}
+
+
+def test_parent_outer_transition_beats_the_childs():
+    lamp = Lamp(start_value="dim")
+    lamp.switch = False  # on -> off holds
+    lamp.bright_req = True  # dim -> bright holds too
+    taken = lamp.tick()
+    assert (taken.source.id, taken.target.id) == ("on", "off")
+    assert lamp.configuration_values == {"off"}
+
+
+class Order(TickChart):
+    """Transitions of one state tried in declaration order; outer before inner."""
+
+    inputs = (Data("go", "bool", False, "enable"),)
+
+    class box(State.Compound):
+        a = State(initial=True)
+        b = State()
+        c = State()
+        a.to(b, cond="go")
+        a.to(c, cond="go")
+
+    done = State()
+    box.to(box.c, cond="go", internal=True)  # inner: declared first, tried after the outer one
+    box.to(done, cond="go")
+    done.to(box)
+
+
+def test_within_a_state_outer_transitions_first_then_declaration_order():
+    chart = Order()
+    structure = Order.structure()
+    order = [(t.target, t.priority) for t in structure.tick_by_state["box"]]
+    assert order == [("done", 1), ("c", 2)]
+    chart.go = True
+    assert chart.tick().target.id == "done"
+    chart.tick()  # done -> box (unguarded)
+    chart.go = False
+    chart.tick()
+    chart.go = True
+    # box's own outer transition wins over its inner one and over a's
+    assert chart.tick().target.id == "done"
+
+
+def test_within_a_leaf_the_first_declared_transition_wins():
+    chart = Order(start_value="a")
+    chart.__dict__["go"] = True
+    candidates = [t.target.id for _g, _e, t in chart._build_plan()[0]]
+    assert candidates == ["done", "c", "b", "c"]  # box: outer, inner; then a: in order
+
+
+def test_events_posted_between_ticks_are_handled_at_the_next_tick_in_order_with_data():
+    lamp = Lamp()
+    lamp.post("button", presses=2)
+    lamp.post("button", presses=3)
+    assert lamp.configuration_values == {"off"}  # nothing until the tick
+    assert [e for e, _ in lamp.pending_events] == ["button", "button"]
+    lamp.tick()
+    assert lamp.pending_events == []
+    assert lamp.presses == 5  # both, in order: off -> on (2), on -> off (3)
+    assert lamp.configuration_values == {"off"}
+
+
+def test_event_transition_then_tick_transitions_in_the_same_tick():
+    lamp = Lamp()
+    lamp.bright_req = True
+    lamp.switch = True
+    lamp.post("button")
+    taken = lamp.tick()  # button: off -> on; then the tick: dim -> bright
+    assert (taken.source.id, taken.target.id) == ("dim", "bright")
+
+
+def test_an_event_posted_by_an_action_waits_for_the_next_tick():
+    class Relay(TickChart):
+        a = State(initial=True)
+        b = State()
+        c = State()
+        go = a.to(b)
+        more = b.to(c)
+
+        def on_go(self) -> None:
+            self.post("more")
+
+    relay = Relay()
+    relay.post("go")
+    relay.tick()
+    assert relay.configuration_values == {"b"}
+    relay.tick()
+    assert relay.configuration_values == {"c"}
+
+
+def test_unknown_event_is_refused_when_posted():
+    lamp = Lamp()
+    with pytest.raises(UnknownEventError, match="no transition handles event 'buton'"):
+        lamp.post("buton")
+    assert lamp.handles("button") and not lamp.handles("tick")
+
+
+def test_an_impure_guard_is_reported():
+    class Flaky(TickChart):
+        a = State(initial=True)
+        b = State()
+        a.to(b, cond="flip")
+
+        def __init__(self):
+            self.n = 0
+            super().__init__()
+
+        def flip(self) -> bool:
+            self.n += 1
+            return self.n == 1  # holds once: on the fast path, not again in the library
+
+    with pytest.raises(GuardMismatchError, match="a -> b"):
+        Flaky().tick()
+
+
+def test_start_mid_way_and_ticks_count():
+    lamp = Lamp(start_value="bright", tick_period_s=0.002)
+    assert lamp.configuration_values == {"on", "bright"}
+    lamp.bright_req = True
+    lamp.switch = True
+    assert lamp.run_ticks(3) == 0
+    assert lamp.tick_count == 3 and lamp.time_s == pytest.approx(0.006)
+    assert lamp.level == 30
+
+
+def test_priority_conflicts_name_where_scxml_and_stateflow_differ():
+    class Nested(TickChart):
+        class outer(State.Compound):
+            inner = State(initial=True)
+            done = State()
+            stop = inner.to(done)
+
+        idle = State()
+        stop = outer.to(idle)
+        idle.to(outer)
+
+    conflicts = priority_conflicts(Nested.structure())
+    assert len(conflicts) == 1 and "'stop'" in conflicts[0] and "'inner'" in conflicts[0]
+    # the library's order: the child wins the event
+    chart = Nested()
+    chart.post("stop")
+    chart.tick()
+    assert chart.configuration_values == {"outer", "done"}
+    assert priority_conflicts(Lamp.structure()) == []

@@ -81,7 +81,8 @@ def _is_within(structure: ChartStructure, state: str, ancestor: str) -> bool:
 
 
 def _q(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+    return '"' + escaped + '"'
 
 
 def _html(text: str) -> str:

@@ -121,6 +121,12 @@ def to_dot(chart: StateChart | type[StateChart], active: set[str] | None = None)
         f'  edge [fontname={_q(FONT)}, fontsize="9"];',
     ]
 
+    def head(state_id: str) -> str:
+        # An edge into a compound from outside ends at its initial dot, clipped at the
+        # cluster border: the arrow then meets the cluster where its story starts.
+        state = by_id[state_id]
+        return f"{state_id}__start" if state.is_compound and not state.parallel else state_id
+
     def emit(states: list[StateInfo], indent: str, parent: StateInfo | None) -> None:
         if parent is None or not parent.parallel:
             initial = next((s for s in states if s.initial), None)
@@ -128,7 +134,7 @@ def to_dot(chart: StateChart | type[StateChart], active: set[str] | None = None)
                 start = f"{parent.id}__start" if parent else "__start__"
                 out.append(f'{indent}{_q(start)} [shape="point", width="0.12", fillcolor="black", label=""];')
                 lhead = f', lhead={_q("cluster_" + initial.id)}' if initial.is_compound else ""
-                out.append(f"{indent}{_q(start)} -> {_q(initial.id)} [weight=\"10\"{lhead}];")
+                out.append(f"{indent}{_q(start)} -> {_q(head(initial.id))} [weight=\"10\"{lhead}];")
         for state in states:
             is_active = state.id in active
             if state.is_compound:
@@ -158,17 +164,19 @@ def to_dot(chart: StateChart | type[StateChart], active: set[str] | None = None)
         label = "\n".join(p for p in (first, action) if p)
         target = t.target or t.source
         attrs = [f"label={_q(label)}"] if label else []
+        head_node = target
         if by_id[t.source].is_compound and not _is_within(structure, target, t.source):
             attrs.append(f"ltail={_q('cluster_' + t.source)}")
         if by_id[target].is_compound and not _is_within(structure, t.source, target):
             attrs.append(f"lhead={_q('cluster_' + target)}")
+            head_node = head(target)
         if t.kind == "tick":
             attrs.append('style="solid"')
         else:
             attrs.append('color="#1f4e9c", fontcolor="#1f4e9c"')
         if t.target is None:
             attrs.append('arrowhead="none"')
-        out.append(f"  {_q(t.source)} -> {_q(target)} [{', '.join(attrs)}];")
+        out.append(f"  {_q(t.source)} -> {_q(head_node)} [{', '.join(attrs)}];")
     out.append("}")
     return "\n".join(out) + "\n"
 

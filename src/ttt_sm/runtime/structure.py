@@ -151,6 +151,13 @@ def action_names(cls: type, grouper: Any) -> tuple[str, ...]:
     )
 
 
+def _display_events(transition: Transition) -> tuple[str, ...]:
+    """Event ids of a transition, without the generated tick event and without the
+    SCXML dotted alias (``done.state.x``) the library adds beside ``done_state_x``."""
+    ids = [str(e) for e in transition.events if not str(e).startswith(TICK_EVENT_PREFIX)]
+    return tuple(e for e in ids if not ("." in e and e.replace(".", "_") in ids))
+
+
 def _guard_names(transition: Transition) -> tuple[str, ...]:
     return tuple(str(spec) for spec in transition.cond)
 
@@ -186,7 +193,7 @@ def build_structure(cls: type[StateChart]) -> ChartStructure:
         infos: dict[int, TransitionInfo] = {}
         for t in own:
             tick_event = next((str(e) for e in t.events if str(e).startswith(TICK_EVENT_PREFIX)), None)
-            events = tuple(str(e) for e in t.events if not str(e).startswith(TICK_EVENT_PREFIX))
+            events = _display_events(t)
             guards = _guard_names(t)
             kind: Literal["tick", "event"] = "tick" if tick_event else "event"
             target = t.target.id if t.target is not None else None
@@ -212,9 +219,9 @@ def build_structure(cls: type[StateChart]) -> ChartStructure:
     tick_events = frozenset(t.tick_event for t in transitions if t.tick_event)
     user_events: list[str] = []
     for t in transitions:
-        for e in t.events:
-            if e not in user_events:
-                user_events.append(e)
+        for e in t.transition.events:
+            if str(e) not in user_events and not str(e).startswith(TICK_EVENT_PREFIX):
+                user_events.append(str(e))
     return ChartStructure(
         name=cls.__name__,
         doc=(cls.__doc__ or "").strip(),

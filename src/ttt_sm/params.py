@@ -172,6 +172,7 @@ class DriveParams:
     load_viscous: float
     gear_clearance: float
     gear_stiffness: float
+    gear_damping: float
     encoder_counts: int
     limit_min_rad: float
     limit_max_rad: float
@@ -275,7 +276,7 @@ def _check(params: ArmParams, where: str) -> None:
                     "gear_ratio", "load_inertia", "gear_stiffness", "encoder_counts"):
             if getattr(d, key) <= 0:
                 raise ParameterError(f"{where}: [drive.{i}] {key} must be positive")
-        for key in ("motor_viscous", "motor_coulomb", "load_viscous", "gear_clearance"):
+        for key in ("motor_viscous", "motor_coulomb", "load_viscous", "gear_clearance", "gear_damping"):
             if getattr(d, key) < 0:
                 raise ParameterError(f"{where}: [drive.{i}] {key} must not be negative")
         if not d.limit_min_rad < d.limit_max_rad:

@@ -65,9 +65,9 @@ def test_dot_draws_compound_states_as_nested_clusters_with_guards_and_actions():
     assert "during / during_dim" in body  # during action inside the state
     assert "entry / on_enter_off" in dot
     assert '"dim" -> "bright" [label="[after(3)]\\n/ louder"' in dot
-    assert '"off" -> "on" [label="[switch]", lhead="cluster_on"' in dot
+    assert '"off" -> "on__start" [label="[switch]", lhead="cluster_on"' in dot
     assert '"on" -> "off" [label="[not switch]", ltail="cluster_on"' in dot
-    assert '"off" -> "on" [label="button"' in dot
+    assert '"off" -> "on__start" [label="button"' in dot
 
 
 def test_mermaid_nests_compound_states():

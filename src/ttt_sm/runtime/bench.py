@@ -32,9 +32,6 @@ class BenchMove(TickChart):
         move.to(stalled, cond="timed_out")
         stalled.to(move, cond="stop")
 
-        def during_move(self) -> None:
-            self.x = self.x_p + self.inc
-
     done = State()
     idle.to(run, cond="not stop")
     run.to(idle, cond="stop")
@@ -43,6 +40,9 @@ class BenchMove(TickChart):
 
     def timed_out(self) -> bool:
         return self.x > 2 * self.limit
+
+    def during_move(self) -> None:
+        self.x = self.x_p + self.inc
 
 
 class BenchMoveSend(StateChart):

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Callable, Mapping, MutableSet
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from statemachine import StateChart
 from statemachine.factory import StateMachineMetaclass
@@ -193,6 +193,12 @@ class TickChart(StateChart, metaclass=TickChartMeta):
         super().__init__(listeners=[_Clock(self), *(listeners or [])], **kwargs)
         for state in self.configuration:
             self._entered_at[state.id] = 0
+
+    if TYPE_CHECKING:
+        # Declared data are instance attributes made from ``inputs``/``outputs``/``local``;
+        # a type checker cannot see them.  Annotate them in the chart body
+        # (``X_out: float``) for precise types.
+        def __getattr__(self, name: str) -> Any: ...
 
     def __setattr__(self, name: str, value: Any) -> None:
         # Same protection as StateChart.__setattr__ (a state cannot be overwritten),

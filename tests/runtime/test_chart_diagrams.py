@@ -87,7 +87,7 @@ def test_markdown_page_has_the_mermaid_block_and_data_table():
     assert "```mermaid\nstateDiagram-v2\n" in page
     assert "| input | `switch` | bool | `False` | wall switch |" in page
     assert "| output | `level` | 1 | `0.0` | light level (previous tick: `level_p`) |" in page
-    assert "| `dim` | bright | tick | 1 | after(3) | louder |" in page
+    assert "| `dim` | `bright` | tick | 1 | after(3) | louder |" in page
 
 
 def test_render_active_highlights_the_active_states():

@@ -299,7 +299,8 @@ def to_markdown(chart: StateChart | type[StateChart]) -> str:
             " posted from outside, is handled at the next tick.", "",
             "| source | target | trigger | priority | guard | action |", "|---|---|---|---|---|---|"]
     for t in structure.transitions:
-        out.append(f"| `{t.source}` | {_cell(t.target or '(none)')} | {_cell(t.trigger)} |"
+        target = f"`{t.target}`" if t.target else "(none)"
+        out.append(f"| `{t.source}` | {target} | {_cell(t.trigger)} |"
                    f" {t.priority or '—'} | {_cell(' && '.join(t.guards))} | {_cell(', '.join(t.actions))} |")
     conflicts = priority_conflicts(structure)
     if conflicts:

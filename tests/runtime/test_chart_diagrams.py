@@ -8,11 +8,12 @@ import subprocess
 import sys
 
 import pytest
-from statemachine import State
+from statemachine import HistoryState, State
 
 from ttt_sm.runtime import Data, TickChart, after
 from ttt_sm.runtime.diagram import to_dot, to_markdown, to_mermaid
 from ttt_sm.runtime.export import export_all, export_chart, render_active, stale_files
+from ttt_sm.runtime.listeners import Coverage
 
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz dot not installed")
 
@@ -177,3 +178,38 @@ def test_render_active_svg_and_png():
     assert render_active(lamp, "png").startswith(b"\x89PNG")
     with pytest.raises(ValueError, match="unknown format"):
         render_active(lamp, "gif")
+
+
+class Resumable(TickChart):
+    """Work resumes where it paused: a history state."""
+
+    inputs = (Data("go", "bool", False, "next step"),)
+
+    class work(State.Compound):
+        a = State(initial=True)
+        b = State()
+        h = HistoryState()
+        a.to(b, cond="go")
+
+    pause = State()
+    hold = work.to(pause)
+    resume = pause.to(work.h)
+
+
+def test_history_states_are_drawn_inside_their_compound_and_not_counted_as_states():
+    dot = to_dot(Resumable)
+    assert '"h" [label="H", shape="circle"' in _cluster_body(dot, "work")
+    assert '"pause" -> "h" [label="resume"' in dot
+    assert 'state "H" as h' in to_mermaid(Resumable)
+    assert "| `h` (shallow history) | work |" in to_markdown(Resumable)
+    chart = Resumable()
+    coverage = Coverage().observe(chart)
+    chart.go = True
+    chart.tick()
+    chart.post("hold")
+    chart.tick()
+    chart.post("resume")
+    chart.tick()
+    assert chart.configuration_values == {"work", "b"}
+    report = coverage.report().charts[0]
+    assert "h" not in report.states and report.missing_states == ()

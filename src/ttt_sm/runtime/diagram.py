@@ -150,6 +150,9 @@ def to_dot(chart: StateChart | type[StateChart], active: set[str] | None = None)
                            ' height="0", label=""];')
                 emit([by_id[c] for c in state.children], indent + "  ", state)
                 out.append(f"{indent}}}")
+            elif state.history:
+                out.append(f'{indent}{_q(state.id)} [label={_q(state.label)}, shape="circle",'
+                           ' width="0.3", fixedsize="true"];')
             else:
                 attrs = [f"label={_html_label(state.label, state_actions(state))}"]
                 if state.final:
@@ -234,6 +237,8 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
                 out.append(f"{indent}--")
             if state.label != state.id:
                 out.append(f'{indent}state "{_m(state.label)}" as {state.id}')
+            if state.history:
+                continue
             if state.is_compound:
                 out.append(f"{indent}state {state.id} {{")
                 emit([by_id[c] for c in state.children], indent + "    ", state)
@@ -290,6 +295,9 @@ def to_markdown(chart: StateChart | type[StateChart]) -> str:
         out.append("This chart declares no data.")
     out += ["", "## States", "", "| state | inside | entry | during | exit |", "|---|---|---|---|---|"]
     for s in structure.states:
+        if s.history:
+            out.append(f"| `{s.id}` ({s.history} history) | {_cell(s.parent or '')} | — | — | — |")
+            continue
         out.append(f"| `{s.id}`{' (initial)' if s.initial else ''} | {_cell(s.parent or '')} |"
                    f" {_cell(', '.join(s.entry))} | {_cell(', '.join(s.during))} |"
                    f" {_cell(', '.join(s.exit))} |")

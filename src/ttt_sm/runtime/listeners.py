@@ -232,7 +232,7 @@ class Coverage:
         charts = []
         for name in sorted(self._classes):
             structure = _structure_of(self._classes[name])
-            states = tuple(s.id for s in structure.states)
+            states = tuple(s.id for s in structure.states if not s.history)
             transitions = tuple(t.label for t in structure.transitions)
             charts.append(ChartCoverage(
                 chart=name,

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
 from statemachine.event import Event
-from statemachine.state import State
+from statemachine.state import HistoryState, State
 from statemachine.transition import Transition
 from statemachine.utils import humanize_id
 
@@ -43,6 +43,7 @@ class StateInfo:
     entry: tuple[str, ...]
     during: tuple[str, ...]
     exit: tuple[str, ...]
+    history: Literal["", "shallow", "deep"] = ""
 
     @property
     def is_compound(self) -> bool:
@@ -108,6 +109,15 @@ def walk_states(states: Iterable[State], depth: int = 0) -> Iterator[tuple[State
         yield from walk_states(state.states, depth + 1)
 
 
+def _walk_with_history(states: Iterable[State], depth: int = 0) -> Iterator[tuple[State, int]]:
+    """Like :func:`walk_states`, with each compound's history pseudo-states after its children."""
+    for state in states:
+        yield state, depth
+        yield from _walk_with_history(state.states, depth + 1)
+        for history in state.history:
+            yield history, depth + 1
+
+
 def is_inner(transition: Transition) -> bool:
     """Whether a transition stays inside its source (Stateflow's inner transition)."""
     target = transition.target
@@ -170,14 +180,25 @@ def build_structure(cls: type[StateChart]) -> ChartStructure:
     tick_by_state: dict[str, tuple[TransitionInfo, ...]] = {}
     labels: dict[str, int] = {}
     index = 0
-    for state, depth in walk_states(cls.states):
+    for state, depth in _walk_with_history(cls.states):
+        if isinstance(state, HistoryState):
+            # A history pseudo-state: drawn and targeted, never active itself; its
+            # default transition belongs to the library's entry, not to the clock.
+            history_kind: Literal["shallow", "deep"] = "deep" if state.type.is_deep else "shallow"
+            states.append(StateInfo(
+                id=state.id, label="H*" if history_kind == "deep" else "H",
+                parent=state.parent.id if state.parent else None, depth=depth, children=(),
+                initial=False, final=False, parallel=False, entry=(), during=(), exit=(),
+                history=history_kind,
+            ))
+            continue
         during_name = f"{DURING_PREFIX}{state.id}"
         states.append(StateInfo(
             id=state.id,
             label=_display_name(state),
             parent=state.parent.id if state.parent else None,
             depth=depth,
-            children=tuple(c.id for c in state.states),
+            children=tuple(c.id for c in state.states) + tuple(h.id for h in state.history),
             initial=bool(state.initial),
             final=bool(state.final),
             parallel=bool(state.parallel),

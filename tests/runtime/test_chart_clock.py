@@ -261,3 +261,20 @@ def test_priority_conflicts_name_where_scxml_and_stateflow_differ():
     chart.tick()
     assert chart.configuration_values == {"outer", "done"}
     assert priority_conflicts(Lamp.structure()) == []
+
+
+def test_a_chain_of_guards_that_all_hold_is_walked_one_transition_per_tick():
+    class Chain(TickChart):
+        a = State(initial=True)
+        b = State()
+        c = State()
+        a.to(b)
+        b.to(c)
+
+    listener = TransitionSpy()
+    chain = Chain(listeners=[listener])
+    chain.tick()
+    assert chain.configuration_values == {"b"} and listener.taken == [("a", "b")]
+    chain.tick()
+    assert chain.configuration_values == {"c"} and listener.taken == [("a", "b"), ("b", "c")]
+    assert chain.tick() is None

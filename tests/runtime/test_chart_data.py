@@ -91,6 +91,7 @@ def _define(**attrs):
     ({"inputs": (Data("tick", "1", 0),)}, "clashes with the chart attribute"),
     ({"outputs": (Data("y", "1", 0),), "inputs": (Data("y_p", "1", 0),)}, "already declared"),
     ({"inputs": (Data("2x", "1", 0),)}, "not a Python identifier"),
+    ({"local": (Data("model", "1", 0),)}, "used by the chart itself"),
     ({"inputs": ("x",)}, "is not a Data"),
     ({"during_c": lambda self: None}, "no state 'c'"),
 ])

@@ -32,6 +32,11 @@ KIND_ATTRS: dict[Kind, str] = {"input": "inputs", "output": "outputs", "local": 
 #: Suffix of the attribute holding an output's value one chart tick earlier.
 PREVIOUS_SUFFIX = "_p"
 
+#: Instance attributes of a chart (python-statemachine's and the runtime's): not data names.
+RESERVED_NAMES = frozenset({
+    "model", "state_field", "history_values", "start_configuration_values", "chart_name",
+})
+
 
 @dataclass(frozen=True)
 class Data:
@@ -102,6 +107,8 @@ def _check_name(cls: type, name: str, attr: str, seen: dict[str, str]) -> None:
         raise ChartDefinitionError(f"{where}: data name {name!r} must not start with '_'")
     if name in seen:
         raise ChartDefinitionError(f"{where}: data name {name!r} is already declared in {seen[name]}")
+    if name in RESERVED_NAMES:
+        raise ChartDefinitionError(f"{where}: data name {name!r} is used by the chart itself; rename it")
     states_map = getattr(cls, "states_map", {})
     if any(getattr(s, "id", None) == name for s in states_map.values()):
         raise ChartDefinitionError(f"{where}: data name {name!r} is also a state; rename one")

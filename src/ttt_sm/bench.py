@@ -20,7 +20,7 @@ from .params import ArmParams
 from .sched.clock import WallClock
 from .sched.scheduler import PathStage, Scheduler
 from .sched.trajectory import Waypoint, sample_polyline, square_path
-from .twin.kinematics import IKSolver
+from .twin.kinematics import HOME_Q, IKSolver
 from .twin.plant import ArmSim
 
 
@@ -34,7 +34,7 @@ def _drawing_samples(params: ArmParams, seconds: float, speed: float = 0.03) -> 
 def _ready_sim(params: ArmParams, samples: np.ndarray, seed: int) -> tuple[ArmSim, Scheduler, PathStage]:
     """A twin standing at the path's first pose, drives homed, path loaded."""
     ik = IKSolver(params)
-    q0 = ik.solve(samples[0], q0=np.radians([0.0, 80.0, -70.0, -10.0])).q
+    q0 = ik.solve(samples[0], q0=np.asarray(HOME_Q)).q
     sim = ArmSim(params, seed=seed, q0=q0)
     sched = Scheduler(params, sim, ik=ik)
     sched.assume_homed()

@@ -19,7 +19,7 @@ from ..params import ArmParams
 from ..sched.scheduler import PathStage, Scheduler, tool_path
 from ..sched.stages import JointMoveStage
 from ..sched.trajectory import Waypoint, sample_polyline, square_path
-from ..twin.kinematics import fk
+from ..twin.kinematics import HOME_Q, fk
 from ..twin.plant import ArmSim
 
 
@@ -70,7 +70,7 @@ def run_draw_demo(params: ArmParams, seed: int = 0, speed: float = 0.02, side: f
     waypoints = square_path(params.board, side=side)
     first = waypoints[0]
     q_ready = sched.ik.solve(np.array([first.x, first.y, first.z, first.phi]),
-                             q0=_elbow_up_guess(params)).q
+                             q0=np.asarray(HOME_Q)).q
     q_start = np.array(sim.q_encoder.tolist() + [sim.q_true[3]])
     move = JointMoveStage(q_start, q_ready, chart_dt)
     sched.joint_stages = [move]
@@ -110,11 +110,6 @@ def run_draw_demo(params: ArmParams, seed: int = 0, speed: float = 0.02, side: f
         f"({result.realtime_factor:.0f}x real time); drawing error rms {result.drawing_rms_error_mm:.3f} mm, "
         f"max {result.drawing_max_error_mm:.3f} mm")
     return result
-
-
-def _elbow_up_guess(params: ArmParams) -> np.ndarray:
-    """A start for IK in the elbow-up working configuration above the board."""
-    return np.radians([0.0, 80.0, -70.0, -10.0])
 
 
 __all__ = ["DrawDemoResult", "Waypoint", "run_draw_demo"]

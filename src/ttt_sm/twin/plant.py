@@ -350,6 +350,27 @@ class ArmSim:
         return self._ds[:, K.S_WM].copy()
 
     @property
+    def speed_load(self) -> np.ndarray:
+        """True load (joint) speeds of drives 1..3 (rad/s)."""
+        return self._ds[:, K.S_WQ].copy()
+
+    def mechanical_energy(self) -> float:
+        """Kinetic energy of rotors and loads + gravity and gear-spring potential of drives 1..3, J.
+
+        Gravity's zero is the arm hanging straight down.  With the drives
+        off, friction can only take energy out: a check of the integrator.
+        """
+        ds, dp = self._ds, self._dp
+        kinetic = 0.5 * float(np.sum(dp[:, K.P_JM] * ds[:, K.S_WM] ** 2 + dp[:, K.P_JL] * ds[:, K.S_WQ] ** 2))
+        g2, g23 = float(self._gp[K.G_GRAV2]), float(self._gp[K.G_GRAV23])
+        q2, q3 = float(ds[1, K.S_Q]), float(ds[2, K.S_Q])
+        gravity = g2 * (1.0 - math.cos(q2)) + g23 * (1.0 - math.cos(q2 + q3))
+        delta = ds[:, K.S_TH] / dp[:, K.P_N] - ds[:, K.S_Q]
+        squeeze = np.maximum(np.abs(delta) - 0.5 * dp[:, K.P_CLEAR], 0.0)
+        spring = 0.5 * float(np.sum(dp[:, K.P_K] * squeeze**2))
+        return kinetic + gravity + spring
+
+    @property
     def at_limit(self) -> np.ndarray:
         """True per drive while its load rests on a hard stop."""
         return self._di[:, K.I_AT_LIMIT] != 0

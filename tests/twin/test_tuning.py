@@ -1,0 +1,131 @@
+"""Tuning: margins of the designed loops, the model against the twin, the step-response targets."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import control as ct
+import numpy as np
+import pytest
+
+from ttt_sm.params import load_params
+from ttt_sm.twin.control import setpoint_filter_matrices
+from ttt_sm.twin.plant import ArmSim
+from ttt_sm.twin.tuning import (
+    STATIC_WINDOW_S,
+    STEP_POSES,
+    STEP_RAD,
+    design_gains,
+    drive_plant,
+    loop_margins,
+    loop_models,
+    step_response,
+    tune_report,
+)
+
+REPORT_KEYS = {"drive", "step_rad", "rise_time_s", "settling_time_s", "overshoot_pct", "error_at_0_5s_rad",
+               "static_error_rad", "inner_phase_margin_deg", "outer_phase_margin_deg",
+               "outer_gain_margin_db", "plot"}
+
+
+@pytest.fixture(scope="module")
+def params():
+    return load_params()
+
+
+@pytest.fixture(scope="module")
+def gains(params):
+    return design_gains(params)
+
+
+@pytest.mark.parametrize("drive", [1, 2, 3])
+def test_both_loops_keep_45_degrees_of_phase_margin(params, gains, drive):
+    g = gains.drive(drive)
+    assert g.inner_phase_margin_deg >= 45.0
+    assert g.outer_phase_margin_deg >= 45.0
+    assert g.inner_gain_margin_db >= 6.0
+    assert g.outer_gain_margin_db >= 6.0
+    assert g.inner_crossover_hz <= params.control.inner_crossover_hz * 1.01
+    assert g.outer_crossover_hz == pytest.approx(params.control.outer_crossover_hz, rel=0.02)
+    # the reported numbers are control.margin's on the sampled loops
+    inner, outer = loop_models(params, drive, g)
+    assert loop_margins(inner)[0] == pytest.approx(g.inner_phase_margin_deg)
+    gm, pm, _, _ = ct.margin(ct.frd(outer, np.logspace(-1, np.log10(np.pi / params.control.dt) - 1e-6, 4000)))
+    assert pm == pytest.approx(g.outer_phase_margin_deg, abs=0.5)
+
+
+def test_the_design_model_has_the_gear_resonance(params):
+    rigid = drive_plant(params, 1, compliant=False)
+    soft = drive_plant(params, 1, compliant=True)
+    d = params.drives[0]
+    w_res = np.abs(np.imag(ct.poles(soft))).max()
+    j_motor = d.rotor_inertia * d.gear_ratio**2
+    expect = np.sqrt(d.gear_stiffness * (1 / j_motor + 1 / d.load_inertia))
+    assert w_res == pytest.approx(expect, rel=0.05)
+    # below the resonance the two models agree (same inertia, friction, motor)
+    w = 2 * np.pi * 2.0
+    assert abs(soft(1j * w)) == pytest.approx(abs(rigid(1j * w)), rel=0.01)
+
+
+@pytest.mark.parametrize("drive", [1, 2, 3])
+def test_the_tuning_model_predicts_a_small_step_of_the_twin(params, gains, drive):
+    """Below saturation the nonlinear twin follows the linear closed loop the design used."""
+    g = gains.drive(drive)
+    dt = params.control.dt
+    _, t_q = loop_models(params, drive, dataclasses.replace(g, kp_pos=1.0, ki_pos=0.0))
+    closed = ct.feedback(t_q, g.kp_pos)  # (kp r_f + kff dr_f/dt) -> encoder angle
+    ad, bd = setpoint_filter_matrices(params.control.setpoint_cutoff_hz, dt)
+    c = np.array([[g.kp_pos, g.kff_speed]])
+    # the kernel advances the filter first, then uses it: y[k] = C x[k+1]
+    filt = ct.ss(ad, bd.reshape(2, 1), c @ ad, c @ bd.reshape(2, 1), dt)
+    n, step = 400, 0.02
+    lin = ct.step_response(ct.series(filt, closed), T=np.arange(n + 1) * dt).outputs[1:] * step
+
+    q0 = STEP_POSES[drive]
+    sim = ArmSim(params, gains, q0=q0)
+    sim.assume_initialised()
+    sim.set_setpoints(np.append(sim.q_encoder, q0[3]))
+    sim.run(300)
+    start = np.append(sim.q_encoder, q0[3])
+    target = start.copy()
+    target[drive - 1] += step
+    sim.set_setpoints(target)
+    tr = sim.run(n)
+    y = tr.q_encoder[:, drive - 1] - start[drive - 1]
+    assert np.abs(tr.duty[:, drive - 1]).max() < 0.9  # linear territory
+    assert np.abs(y - lin).max() < 0.03 * step
+
+
+@pytest.mark.parametrize("drive", [1, 2, 3])
+def test_step_response_meets_the_targets_on_the_nonlinear_twin(params, gains, drive):
+    m = step_response(params, gains, drive, STEP_RAD[drive])
+    assert m.settling_time_s <= 0.5
+    assert m.overshoot_pct <= 5.0
+    assert m.static_error_rad <= 1e-4
+    assert m.max_abs_duty == 1.0  # a real step: it saturated, friction and gravity on
+    # the static error is what its definition says, on the quantized encoder
+    err = m.setpoint - m.encoder
+    assert m.static_error_rad == pytest.approx(np.abs(err[m.t > m.t[-1] - STATIC_WINDOW_S]).max())
+    counts = (m.encoder - m.encoder[0]) / m.rad_per_count
+    assert np.allclose(counts, np.round(counts), atol=1e-6)
+    assert 0.0 < m.rise_time_s < m.settling_time_s
+
+
+def test_drive_2_steps_up_from_where_it_hung(params, gains):
+    m = step_response(params, gains, 2, 1.0)
+    start = m.setpoint[0] - m.step_rad
+    assert abs(start) < 0.2  # it hung near zero before the step (in encoder = joint coordinates)
+
+
+def test_tune_report_has_exactly_the_keys_and_writes_plots(params, tmp_path):
+    rows = tune_report(params, tmp_path)
+    assert [r["drive"] for r in rows] == [1, 2, 3]
+    assert [r["step_rad"] for r in rows] == [1.0, 1.0, 0.5]
+    for r in rows:
+        assert set(r) == REPORT_KEYS
+        png = tmp_path / f"step_drive{r['drive']}.png"
+        assert r["plot"] == str(png)
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert png.stat().st_size < 150_000
+        assert r["settling_time_s"] <= 0.5 and r["overshoot_pct"] <= 5.0 and r["static_error_rad"] <= 1e-4
+        assert r["inner_phase_margin_deg"] >= 45.0 and r["outer_phase_margin_deg"] >= 45.0

@@ -69,3 +69,16 @@ def test_square_path_draws_below_the_surface_and_lifts():
     xs = [w.x for w in drawn]
     assert max(xs) - min(xs) == pytest.approx(0.03)
     assert path[-1].z > b.surface_z
+
+
+def test_distance_to_path_is_geometric():
+    from ttt_sm.sched.trajectory import distance_to_path
+
+    path = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    pts = np.array([[0.5, 0.2], [1.3, 0.5], [-0.3, -0.4], [1.0, 1.0]])
+    assert np.allclose(distance_to_path(pts, path), [0.2, 0.3, 0.5, 0.0])
+    # a single vertex is a point
+    assert np.allclose(distance_to_path(pts[:1], path[:1]), [np.hypot(0.5, 0.2)])
+    # chunking does not change the answer
+    many = np.random.default_rng(0).uniform(-1, 2, size=(1500, 2))
+    assert np.allclose(distance_to_path(many, path, chunk=7), distance_to_path(many, path))

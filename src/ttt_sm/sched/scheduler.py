@@ -13,6 +13,7 @@ the :class:`Signals` of the current chart step.  A plain path is a task stage
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -25,22 +26,40 @@ from ..twin.plant import ArmSim, Sensors
 from .clock import VirtualClock, WallClock
 
 
-@dataclass
 class Signals:
     """The signals of one chart step, as the debugger and a trace see them.
 
-    Stages read and write these fields; the scheduler fills `t`, `sensors`,
-    `q_des` (from IK of `task`) and `q_set` (clamped) around them.
+    Stages read and write these fields; the scheduler fills `t`, `q_des` (from
+    IK of `task`) and `q_set` (clamped) around them.  `sensors` is read from
+    the twin on first use in a chart step, so steps that need none pay nothing.
     """
 
-    t: float = 0.0
-    sensors: Sensors | None = None
-    task: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))  # X, Y, Z, phi
-    fr_sw: bool = False
-    q_des: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))  # IK output
-    q_set: np.ndarray = field(default_factory=lambda: np.full(4, np.nan))  # to the controllers
-    ik_iterations: int = 0
-    ik_error: str | None = None
+    __slots__ = ("t", "task", "fr_sw", "q_des", "q_set", "ik_iterations", "ik_error",
+                 "_read_sensors", "_sensors")
+
+    def __init__(self, read_sensors: Callable[[], Sensors] | None = None) -> None:
+        self.t = 0.0
+        self.task: np.ndarray = np.full(4, np.nan)  # X, Y, Z, phi; NaN: no task pose
+        self.fr_sw = False
+        self.q_des: np.ndarray = np.full(4, np.nan)  # IK output
+        self.q_set: np.ndarray = np.full(4, np.nan)  # to the controllers
+        self.ik_iterations = 0
+        self.ik_error: str | None = None
+        self._read_sensors = read_sensors
+        self._sensors: Sensors | None = None
+
+    @property
+    def sensors(self) -> Sensors | None:
+        """Encoder counts, index switches and currents at the start of this chart step."""
+        if self._sensors is None and self._read_sensors is not None:
+            self._sensors = self._read_sensors()
+        return self._sensors
+
+    def new_step(self, t: float) -> None:
+        """Start a chart step at time `t`: sensors are read afresh when asked for."""
+        self.t = t
+        self._sensors = None
+        self.ik_error = None
 
 
 class Stage(Protocol):
@@ -120,12 +139,12 @@ class Scheduler:
         self.clock = clock if clock is not None else VirtualClock()
         self.ik = ik if ik is not None else IKSolver(params)
         self.divider = params.control.chart_divider
-        self.q_min = np.asarray(params.joint_min)
-        self.q_max = np.asarray(params.joint_max)
+        self.q_min = tuple(params.joint_min)
+        self.q_max = tuple(params.joint_max)
         # Joint limits apply in encoder coordinates only once a drive's offset
         # is known; the servo is absolute, so its limits always apply.
-        self.homed = np.array([False, False, False, True])
-        self.signals = Signals()
+        self.homed = [False, False, False, True]
+        self.signals = Signals(sim.sensors)
         self.steps = 0
         self.chart_ticks = 0
         self.ik_failures = 0
@@ -143,7 +162,7 @@ class Scheduler:
     def assume_homed(self) -> None:
         """Treat every drive as initialised: the twin's true offsets, no init charts."""
         self.sim.assume_initialised()
-        self.homed[:] = True
+        self.homed = [True, True, True, True]
         self._hold = np.asarray(self.sim.q_encoder.tolist() + [self.sim.q_true[3]], dtype=float)
 
     def set_clock(self, clock: VirtualClock | WallClock) -> None:
@@ -153,15 +172,13 @@ class Scheduler:
         self._period0 = self.steps
 
     def tick_charts(self) -> Signals:
-        """One chart step: sensors, task stages, IK, joint stages, clamp, setpoints."""
+        """One chart step: task stages, IK, joint stages, clamp, setpoints."""
         s = self.signals
-        s.t = self.sim.t
-        s.sensors = self.sim.sensors()
-        s.ik_error = None
+        s.new_step(self.sim.t)
         for stage in self.task_stages:
             stage.tick(s)
         task = s.task
-        if np.all(np.isfinite(task)):
+        if math.isfinite(task[0] + task[1] + task[2] + task[3]):
             try:
                 result = self.ik.solve(task)
             except IKError as exc:
@@ -175,24 +192,30 @@ class Scheduler:
                 s.ik_iterations = result.iterations
         else:
             s.q_des = self._hold.copy()
-        s.q_set = s.q_des.copy()
+        s.q_set = s.q_des
         for stage in self.joint_stages:
             stage.tick(s)
-        q = np.asarray(s.q_set, dtype=float)
-        clipped = np.where(self.homed, np.clip(q, self.q_min, self.q_max), q)
-        if not np.array_equal(clipped, q):
+        q = [float(v) for v in s.q_set]
+        clamped = False
+        for i in range(4):
+            if self.homed[i]:
+                if q[i] < self.q_min[i]:
+                    q[i], clamped = self.q_min[i], True
+                elif q[i] > self.q_max[i]:
+                    q[i], clamped = self.q_max[i], True
+        if clamped:
             self.limit_clamps += 1
-        s.q_set = clipped
-        self._hold = clipped
-        self.sim.set_setpoints(clipped, s.fr_sw)
+            s.q_set = np.array(q)
+        self._hold = s.q_set
+        self.sim.set_setpoints(q, s.fr_sw)
         self.chart_ticks += 1
         if self.record is not None:
             r = self.record
             r.t.append(s.t)
             r.task.append(np.array(task, dtype=float))
-            r.q_set.append(clipped.copy())
-            r.q_encoder.append(self.sim.q_encoder.copy())
-            r.q_true.append(self.sim.q_true.copy())
+            r.q_set.append(np.array(q))
+            r.q_encoder.append(self.sim.q_encoder)
+            r.q_true.append(self.sim.q_true)
         return s
 
     def control_step(self) -> None:

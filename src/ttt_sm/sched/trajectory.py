@@ -77,3 +77,36 @@ def square_path(board: Board, side: float = 0.03, lift: float = 0.02,
     path.extend(Waypoint(x, y, down) for x, y in corners[1:])
     path.append(Waypoint(corners[-1][0], corners[-1][1], up))
     return path
+
+
+def distance_to_path(points: np.ndarray, path: np.ndarray, chunk: int = 512) -> np.ndarray:
+    """Distance from each point to the nearest point of a polyline, metres.
+
+    Parameters
+    ----------
+    points : np.ndarray, shape (n, d)
+        Positions to measure (e.g. the true tool path), d = 2 or 3.
+    path : np.ndarray, shape (m, d)
+        Vertices of the desired polyline, m >= 1.
+
+    Returns
+    -------
+    np.ndarray, shape (n,)
+        The geometric deviation: unlike a difference at equal times, it does
+        not count a tool that is on the path but late as an error.
+    """
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    poly = np.atleast_2d(np.asarray(path, dtype=float))
+    if len(poly) == 1:
+        return np.linalg.norm(pts - poly[0], axis=1)
+    a, b = poly[:-1], poly[1:]
+    ab = b - a
+    denom = np.einsum("ij,ij->i", ab, ab)
+    denom[denom == 0] = 1.0
+    out = np.empty(len(pts))
+    for i in range(0, len(pts), chunk):
+        p = pts[i:i + chunk, None, :]
+        s = np.clip(np.einsum("nij,ij->ni", p - a, ab) / denom, 0.0, 1.0)
+        nearest = a + s[..., None] * ab
+        out[i:i + chunk] = np.sqrt(np.min(np.sum((p - nearest) ** 2, axis=2), axis=1))
+    return out

@@ -371,6 +371,49 @@ def plot_step(m: StepMetrics, path: Path) -> Path:
     return path
 
 
+def plot_loops(params: ArmParams, gains: Gains, path: Path) -> Path:
+    """Bode plots of every drive's inner and outer open loop (compliant gear; inner also rigid)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    omega = _freq_grid(params.control.dt)[1000:]
+    f = omega / (2 * math.pi)
+    fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.4), dpi=80, sharex=True)
+    for drive in (1, 2, 3):
+        g = gains.drive(drive)
+        inner, outer = loop_models(params, drive, g)
+        rigid, _ = loop_models(params, drive, g, compliant=False)
+        for col, (loop, name) in enumerate(((inner, "inner (speed)"), (outer, "outer (position)"))):
+            r = _response(loop, omega)
+            ph = np.degrees(np.unwrap(np.angle(r)))
+            ph -= 360.0 * np.round((ph[0] + 90.0) / 360.0)  # start near -90 deg (an integrator)
+            color = f"C{drive - 1}"
+            axes[0, col].semilogx(f, 20 * np.log10(np.abs(r)), color, lw=1.0, label=f"drive {drive}")
+            axes[1, col].semilogx(f, ph, color, lw=1.0)
+            axes[0, col].set_title(f"{name} open loop")
+            if col == 0:
+                rr = _response(rigid, omega)
+                axes[0, 0].semilogx(f, 20 * np.log10(np.abs(rr)), f"C{drive - 1}", lw=0.6, ls=":")
+    for col in (0, 1):
+        axes[0, col].axhline(0.0, color="k", lw=0.6)
+        axes[1, col].axhline(-180.0, color="k", lw=0.6)
+        axes[0, col].set_ylim(-40, 40)
+        axes[1, col].set_ylim(-360, 0)
+        axes[1, col].set_xlabel("frequency (Hz)")
+        for ax in axes[:, col]:
+            ax.grid(alpha=0.3, which="both")
+    axes[0, 0].set_ylabel("|L| (dB)")
+    axes[1, 0].set_ylabel("phase (deg)")
+    axes[0, 0].legend(fontsize=8, title="dotted: rigid gear", title_fontsize=7)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
 def tune_report(params: ArmParams, out_dir: Path | str) -> list[dict[str, Any]]:
     """Design the gains, step every drive on the twin, write one PNG per drive.
 

@@ -234,6 +234,8 @@ def test_bad_requests_are_specific_errors(params, gains):
     sim = ArmSim(params, gains)
     with pytest.raises(DriveNumberError, match="drive must be 1, 2 or 3"):
         sim.set_enabled(0, False)
+    with pytest.raises(SimError, match="4 finite angles"):
+        sim.set_setpoints([0.0, float("nan"), 0.0, 0.0])
 
 
 def test_numba_disabled_runs_the_same_kernel(params, gains, tmp_path):

@@ -267,6 +267,9 @@ class ArmSim:
         `fr_sw` selects the slow setpoint filters (thesis' slow moves).  The
         servo angle is turned into its PWM duty here, as the I/O card would.
         """
+        if not (math.isfinite(q_des[0]) and math.isfinite(q_des[1]) and math.isfinite(q_des[2])
+                and math.isfinite(q_des[3])):
+            raise SimError(f"setpoints must be 4 finite angles (rad), got {list(q_des)!r}")
         ds = self._ds
         ds[0, K.S_R_RAW] = q_des[0]
         ds[1, K.S_R_RAW] = q_des[1]

@@ -28,6 +28,11 @@ import numpy as np
 from ..params import ArmParams
 from .control import DriveGains, Gains, check_drive, max_joint_speed, speed_filter_alpha
 
+
+class TuningError(RuntimeError):
+    """No controller meets the margin limits for a drive's model (see the message)."""
+
+
 # ---- design rules ------------------------------------------------------------
 
 #: Minimum phase margin (deg) and gain margin (dB) the design accepts for
@@ -190,7 +195,9 @@ def _design_inner(params: ArmParams, drive: int) -> tuple[float, float]:
             if pm >= MIN_PHASE_MARGIN_DEG and gm >= MIN_GAIN_MARGIN_DB:
                 return float(kp), float(kp * wi)
         f *= CROSSOVER_STEP
-    raise RuntimeError(f"drive {drive}: no speed loop with the required margins")
+    raise TuningError(f"drive {drive}: no speed PI keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
+                      f"{MIN_GAIN_MARGIN_DB:g} dB down to 5 % of inner_crossover_hz; check [drive.{drive}] "
+                      "(gear stiffness and damping, inertias) and [control] speed_filter_hz")
 
 
 def _design_outer(params: ArmParams, drive: int, kp_w: float, ki_w: float) -> tuple[float, float]:
@@ -210,7 +217,9 @@ def _design_outer(params: ArmParams, drive: int, kp_w: float, ki_w: float) -> tu
         if pm >= MIN_PHASE_MARGIN_DEG and gm >= MIN_GAIN_MARGIN_DB:
             return float(kp), float(kp * wi)
         f *= CROSSOVER_STEP
-    raise RuntimeError(f"drive {drive}: no position loop with the required margins")
+    raise TuningError(f"drive {drive}: no position gain keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
+                      f"{MIN_GAIN_MARGIN_DB:g} dB down to 5 % of outer_crossover_hz; lower "
+                      "[control] outer_crossover_hz below the speed loop's crossover")
 
 
 @lru_cache(maxsize=8)
@@ -335,16 +344,14 @@ def step_response(params: ArmParams, gains: Gains, drive: int, step_rad: float, 
 
 def plot_step(m: StepMetrics, path: Path) -> Path:
     """Draw a step response like thesis figs. 3.7-3.9: response left, error zoomed right."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure  # no pyplot: no global backend state
 
     t = np.concatenate([[-0.05, 0.0], m.t])
     start = m.setpoint[0] - m.step_rad
     sp = np.concatenate([[start, m.setpoint[0]], m.setpoint])
     enc = np.concatenate([[start, start], m.encoder])
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9.0, 3.4), dpi=80)
+    fig = Figure(figsize=(9.0, 3.4), dpi=80)
+    a1, a2 = fig.subplots(1, 2)
     a1.plot(t, sp, "k--", lw=1.0, label="desired (raw step)")
     a1.plot(t, enc, "C0", lw=1.2, label="actual (encoder)")
     a1.set_xlabel("time (s)")
@@ -367,20 +374,17 @@ def plot_step(m: StepMetrics, path: Path) -> Path:
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path)
-    plt.close(fig)
     return path
 
 
 def plot_loops(params: ArmParams, gains: Gains, path: Path) -> Path:
     """Bode plots of every drive's inner and outer open loop (compliant gear; inner also rigid)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     omega = _freq_grid(params.control.dt)[1000:]
     f = omega / (2 * math.pi)
-    fig, axes = plt.subplots(2, 2, figsize=(9.0, 5.4), dpi=80, sharex=True)
+    fig = Figure(figsize=(9.0, 5.4), dpi=80)
+    axes = fig.subplots(2, 2, sharex=True)
     for drive in (1, 2, 3):
         g = gains.drive(drive)
         inner, outer = loop_models(params, drive, g)
@@ -410,7 +414,6 @@ def plot_loops(params: ArmParams, gains: Gains, path: Path) -> Path:
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path)
-    plt.close(fig)
     return path
 
 
@@ -441,6 +444,6 @@ def tune_report(params: ArmParams, out_dir: Path | str) -> list[dict[str, Any]]:
 
 
 __all__ = [
-    "drive_plant", "speed_estimator", "loop_models", "loop_margins", "design_gains", "StepMetrics",
-    "step_response", "plot_step", "tune_report", "STEP_POSES", "STEP_RAD",
+    "TuningError", "drive_plant", "speed_estimator", "loop_models", "loop_margins", "design_gains",
+    "StepMetrics", "step_response", "plot_step", "plot_loops", "tune_report", "STEP_POSES", "STEP_RAD",
 ]

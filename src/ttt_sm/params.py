@@ -46,6 +46,7 @@ class Board:
     width: float
     depth: float
     zone_clearance: float
+    zone_depth: float
 
     @property
     def cell_size(self) -> float:
@@ -64,9 +65,10 @@ class Board:
                 self.field_center_y - self.depth / 2, self.field_center_y + self.depth / 2)
 
     def in_zone(self, x: float, y: float, z: float) -> bool:
-        """True where a point is inside the board zone (over the board, low)."""
+        """True where a point is inside the board zone: the board, its stand, and the air just above."""
         x0, x1, y0, y1 = self.board_bounds()
-        return x0 <= x <= x1 and y0 <= y <= y1 and z <= self.surface_z + self.zone_clearance
+        return (x0 <= x <= x1 and y0 <= y <= y1
+                and self.surface_z - self.zone_depth <= z <= self.surface_z + self.zone_clearance)
 
 
 @dataclass(frozen=True)

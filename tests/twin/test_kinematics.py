@@ -434,3 +434,18 @@ def test_the_example_in_docs_kinematics_md_runs() -> None:
     doc = Path(__file__).resolve().parents[2] / "docs" / "kinematics.md"
     result = doctest.testfile(str(doc), module_relative=False)
     assert result.attempted >= 5 and result.failed == 0
+
+
+def test_link_points_end_at_the_tool_and_keep_link_lengths():
+    from ttt_sm.twin.kinematics import link_points
+
+    g = load_params().geometry
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        q = rng.uniform(-3, 3, size=4)
+        pts = link_points(q, g)
+        assert np.allclose(pts[2], fk(q, g)[:3])
+        # the shoulder is on the base axis at height L1; the elbow is L2 from it
+        assert np.linalg.norm(pts[0] - np.array([-g.l_f, 0.0, g.L1])) == pytest.approx(g.L2)
+        assert np.linalg.norm(pts[1] - pts[0]) == pytest.approx(g.L3)
+        assert np.linalg.norm(pts[2] - pts[1]) == pytest.approx(np.hypot(g.L4, g.l_f))

@@ -190,6 +190,35 @@ def fk(q: Any, geometry: Geometry) -> np.ndarray:
     return np.array(_fk_floats(q1, q2, q3, q4, g.L1, g.L2, g.L3, g.L4, g.l_f))
 
 
+def link_points(q: Any, geometry: Geometry) -> np.ndarray:
+    """Positions of the elbow (joint 3), the wrist (servo axis) and the pen tip.
+
+    Parameters
+    ----------
+    q : array_like, shape (4,)
+        Joint angles q1..q4, rad.
+    geometry : Geometry
+        Link lengths, m.
+
+    Returns
+    -------
+    np.ndarray, shape (3, 3)
+        Rows elbow, wrist, tip; columns x, y, z (m).  The tip row equals
+        ``fk(q)[:3]``.  Used to keep the whole arm, not only the pen, out of
+        a zone.
+    """
+    q1, q2, q3, q4 = (float(v) for v in q)
+    g = geometry
+    c1, s1 = math.cos(q1), math.sin(q1)
+    # points in frame 1 (x1 across the arm plane, y1 out along it, z1 up), eqs. 3.18-3.19
+    y_e, z_e = g.L2 * math.sin(q2), -g.L2 * math.cos(q2)
+    y_w, z_w = y_e + g.L3 * math.sin(q2 + q3), z_e - g.L3 * math.cos(q2 + q3)
+    y_t, z_t = y_w + g.L4 * math.sin(q2 + q3 + q4), z_w - g.L4 * math.cos(q2 + q3 + q4)
+    frame1 = ((0.0, y_e, z_e), (0.0, y_w, z_w), (g.l_f, y_t, z_t))
+    # frame 1 to the global frame: eq. 3.20 (rotation q1 about Z, origin at (-l_f, 0, L1))
+    return np.array([(c1 * x - s1 * y - g.l_f, s1 * x + c1 * y, g.L1 + z) for x, y, z in frame1])
+
+
 def jacobian(q: Any, geometry: Geometry) -> np.ndarray:
     """Analytic Jacobian d[x, y, z, phi]/dq of :func:`fk` (eq. 3.30).
 

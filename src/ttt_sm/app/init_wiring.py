@@ -1,0 +1,229 @@
+"""Wiring of the drive-initialisation charts into the twin (thesis fig. 3.2).
+
+:class:`DriveInitStage` is a joint stage of the scheduler: every chart step it
+plays the thesis' Encoder block (index level, the encoder angle latched at the
+index edge, the encoder angle itself), feeds the three charts, ticks them, and
+passes their `pos_out` to the controllers.  When a chart moves its `offset`
+output, the Encoder block applies it, so the drive's encoder angle becomes its
+true joint angle from then on.
+
+:func:`run_init` initialises the twin from one power-on pose, and
+:func:`init_report` from many, measuring what `ttt-sm init` reports.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..charts.drive_init import DriveInit1, DriveInit2, DriveInit3
+from ..params import ArmParams
+from ..sched.scheduler import Scheduler, Signals
+from ..twin.kinematics import link_points
+from ..twin.plant import ArmSim
+
+#: Servo angle during initialisation: the pen in line with the forearm.
+SERVO_INIT_RAD = 0.0
+
+
+def make_init_charts(params: ArmParams, listeners: Sequence[object] = ()) -> tuple[
+        DriveInit1, DriveInit2, DriveInit3]:
+    """The three init charts with the switch and parking angles of `params`."""
+    d1, d2, d3 = params.drives
+    period = params.control.chart_dt
+    lst = list(listeners)
+    c1 = DriveInit1(tick_period_s=period, listeners=lst,
+                    data={"index_angle": d1.index_rad, "park": d1.park_rad})
+    c2 = DriveInit2(tick_period_s=period, listeners=lst, data={"index_angle": d2.index_rad})
+    c3 = DriveInit3(tick_period_s=period, listeners=lst,
+                    data={"index_angle": d3.index_rad, "park": d3.park_rad})
+    return c1, c2, c3
+
+
+class DriveInitStage:
+    """Joint stage: the Encoder blocks and the three init charts between IK and the drives."""
+
+    def __init__(self, params: ArmParams, sim: ArmSim, sched: Scheduler,
+                 charts: tuple[DriveInit1, DriveInit2, DriveInit3]) -> None:
+        self.sim = sim
+        self.sched = sched
+        self.charts = charts
+        self.rad_per_count = [d.rad_per_count for d in params.drives]
+        self.applied = [0.0, 0.0, 0.0]
+        #: Inputs forced by a test or scenario, applied after the Encoder blocks: (chart index, name) -> value.
+        self.overrides: dict[tuple[int, str], object] = {}
+        self.done = False  # every drive passes its commanded position through
+        self.failed = False  # a chart gave up (a switch not found)
+
+    def _update_status(self) -> None:
+        # Reading the configuration costs microseconds: only after a transition.
+        self.done = all("pass_pos" in c.configuration_values for c in self.charts)
+        self.failed = any("failed" in c.configuration_values for c in self.charts)
+
+    def tick(self, signals: Signals) -> None:
+        """Encoder blocks in, charts ticked, offsets applied, pos_out out."""
+        c1, c2, c3 = self.charts
+        sensors = signals.sensors
+        assert sensors is not None
+        sim = self.sim
+        enc = sim.q_encoder
+        pos_in = signals.q_set
+        offsets = sim.offset_estimate
+        latched = [sensors.index_count[d] * self.rad_per_count[d] + offsets[d] for d in range(3)]
+        # Each chart reads the others' flags as they were at the end of the last step.
+        ini_23, ini2, ini3 = c1.ini_23, c2.ini2, c3.ini3
+        c1.pos_in, c1.index, c1.pos_Encoder, c1.index_pos = pos_in[0], sensors.index[0], enc[0], latched[0]
+        c1.ini2, c1.ini3 = ini2, ini3
+        c2.pos_in, c2.index, c2.index_pos, c2.ini1, c2.ini3 = (pos_in[1], sensors.index[1], latched[1],
+                                                               ini_23, ini3)
+        c3.pos_in, c3.index, c3.index_pos, c3.ini1, c3.ini2 = (pos_in[2], sensors.index[2], latched[2],
+                                                               ini_23, ini2)
+        for (d, name), value in self.overrides.items():
+            setattr(self.charts[d], name, value)
+        # Posted events may move a chart without a tick transition.
+        moved = any(c.pending_events for c in self.charts)
+        for d, chart in enumerate(self.charts):
+            if chart.tick() is not None:
+                moved = True
+            if chart.offset != self.applied[d]:
+                sim.set_offset_estimate(d + 1, chart.offset)
+                self.applied[d] = chart.offset
+                self.sched.homed[d] = True
+        if moved:
+            self._update_status()
+        servo = pos_in[3] if self.done else SERVO_INIT_RAD
+        signals.q_set = np.array([c1.pos_out, c2.pos_out, c3.pos_out, servo])
+
+
+class InitMonitor:
+    """Joint stage run last: counts board-zone entries and commands past a joint limit.
+
+    A board-zone entry is a chart step in which the elbow, the wrist or the pen
+    tip is inside the zone (:meth:`Board.in_zone`).
+
+    A command past a limit is a setpoint, in true joint coordinates, beyond a
+    hard stop; for drive 1, beyond it by more than `allowance_rad`: drive 1
+    finds a stop by pushing its setpoint a little past it (that is how the
+    thesis detects a stall without a limit-switch signal), and no more.
+    Drives 2 and 3 get no allowance.
+    """
+
+    def __init__(self, params: ArmParams, sim: ArmSim, allowance_rad: float) -> None:
+        self.params = params
+        self.sim = sim
+        allowance = np.array([allowance_rad, 0.0, 0.0])
+        self.lo = np.array([d.limit_min_rad for d in params.drives]) - allowance
+        self.hi = np.array([d.limit_max_rad for d in params.drives]) + allowance
+        self.limit_violations = 0
+        self.zone_ticks = 0
+        self.max_overtravel_rad = 0.0
+
+    def tick(self, signals: Signals) -> None:
+        """Check this chart step's setpoints and the true tool position."""
+        sim = self.sim
+        q_true_cmd = np.asarray(signals.q_set[:3]) - sim.offset_estimate + sim.true_offset
+        over = np.maximum(q_true_cmd - self.hi, self.lo - q_true_cmd)
+        self.max_overtravel_rad = max(self.max_overtravel_rad, float(over.max()))
+        if np.any(over > 0):
+            self.limit_violations += 1
+        board = self.params.board
+        if any(board.in_zone(x, y, z) for x, y, z in link_points(sim.q_true, self.params.geometry)):
+            self.zone_ticks += 1
+
+
+def stall_allowance(params: ArmParams, inc: float, detect_ticks: int = 5) -> float:
+    """How far drive 1's setpoint may pass a hard stop before the stall shows.
+
+    The setpoint filter (critically damped, second order) makes the drive
+    trail a ramp of speed v by 2 v / omega; the chart needs a few more ticks to
+    see the encoder stand still.
+    """
+    v = inc / params.control.chart_dt
+    omega = 2 * math.pi * params.control.setpoint_cutoff_hz
+    return 2 * v / omega + detect_ticks * inc
+
+
+@dataclass(frozen=True)
+class InitRun:
+    """One initialisation from one power-on pose."""
+
+    q_power_on: tuple[float, float, float, float]
+    success: bool
+    time_s: float
+    limit_violations: int
+    board_zone_ticks: int
+    offset_error_rad: tuple[float, float, float]
+    max_overtravel_rad: float
+
+
+def random_power_on(params: ArmParams, rng: np.random.Generator) -> np.ndarray:
+    """A pose anywhere between the hard stops (drives 1-3), servo at its init angle."""
+    lo = np.array([d.limit_min_rad for d in params.drives])
+    hi = np.array([d.limit_max_rad for d in params.drives])
+    return np.append(rng.uniform(lo, hi), SERVO_INIT_RAD)
+
+
+def settled_pose(params: ArmParams, q_start: np.ndarray | None, seconds: float, seed: int) -> np.ndarray:
+    """Where the unpowered arm comes to rest from `q_start` under gravity and friction."""
+    sim = ArmSim(params, seed=seed, q0=q_start)
+    sim.settle_unpowered(seconds)
+    return sim.q_true
+
+
+def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None,
+             settle_s: float = 2.0, timeout_s: float = 40.0) -> InitRun:
+    """Initialise the twin once.
+
+    The arm is placed at `q_start` (default: its rest pose) and left unpowered
+    for `settle_s`, so gravity brings the pitch joints down as it would before
+    anyone switches the arm on (drive 2 "near zero", section 3.1.2).  Then the
+    arm is powered: the encoders start counting from zero there, the
+    controllers hold where the arm stands, and the init charts take over.
+    """
+    q_power_on = settled_pose(params, q_start, settle_s, seed) if settle_s > 0 else q_start
+    sim = ArmSim(params, seed=seed, q0=q_power_on)
+    q0_true = sim.q_true
+    sched = Scheduler(params, sim)
+    charts = make_init_charts(params)
+    stage = DriveInitStage(params, sim, sched, charts)
+    monitor = InitMonitor(params, sim, allowance_rad=stall_allowance(params, charts[0].inc))
+    sched.joint_stages = [stage, monitor]
+    t0 = sim.t
+    sched.run_until(lambda: stage.done or stage.failed, timeout_s)
+    return InitRun(
+        q_power_on=tuple(float(v) for v in q0_true),  # type: ignore[arg-type]
+        success=stage.done,
+        time_s=round(sim.t - t0, 4),
+        limit_violations=monitor.limit_violations,
+        board_zone_ticks=monitor.zone_ticks,
+        offset_error_rad=tuple(float(v) for v in sim.offset_estimate - sim.true_offset),  # type: ignore
+        max_overtravel_rad=round(monitor.max_overtravel_rad, 5),
+    )
+
+
+def init_report(params: ArmParams, starts: int, seed: int = 0) -> dict[str, float | int]:
+    """Initialise from `starts` random power-on poses: what `ttt-sm init --json` prints."""
+    rng = np.random.default_rng(seed)
+    wall0 = time.perf_counter()
+    runs = [run_init(params, seed=seed + k, q_start=random_power_on(params, rng)) for k in range(starts)]
+    times = [r.time_s for r in runs]
+    offset_errors = [abs(e) for r in runs if r.success for e in r.offset_error_rad]
+    count = min(d.rad_per_count for d in params.drives)
+    return {
+        "runs": len(runs),
+        "successes": sum(r.success for r in runs),
+        "limit_violations": sum(r.limit_violations for r in runs),
+        "board_zone_entries": sum(r.board_zone_ticks > 0 for r in runs),
+        "max_time_s": round(max(times), 3),
+        "mean_time_s": round(float(np.mean(times)), 3),
+        "max_offset_error_rad": float(max(offset_errors)) if offset_errors else math.nan,
+        "one_count_rad": count,
+        "max_overtravel_rad": max(r.max_overtravel_rad for r in runs),
+        "wall_time_s": round(time.perf_counter() - wall0, 2),
+        "failed_power_on_deg": [[round(math.degrees(v), 1) for v in r.q_power_on] for r in runs
+                                if not r.success],
+    }

@@ -1,0 +1,180 @@
+"""The robot as a whole: the twin, the scheduler and the charts, wired.
+
+:class:`Robot` is the one object the debugger, the scenario runner, the CLI
+and (later) the GUIs drive.  It knows the charts by name, steps the loop by a
+control step or a chart step, runs until a condition holds, and exposes the
+chart data and the signals of the current step without anyone reading code.
+
+Today it holds the three drive-initialisation charts; the Control chart and
+the game charts join it in later issues.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..params import ArmParams
+from ..runtime import TickChart
+from ..sched.scheduler import Scheduler
+from ..twin.kinematics import fk
+from ..twin.plant import ArmSim
+from .init_wiring import DriveInitStage, make_init_charts, settled_pose
+
+
+class RobotError(ValueError):
+    """A request the robot cannot take: unknown chart, datum or event."""
+
+
+class Robot:
+    """The simulated robot with its charts, ready to step.
+
+    Parameters
+    ----------
+    params : ArmParams
+        The arm.
+    seed : int
+        Seeds the twin.
+    q_start : array_like, shape (4,), optional
+        Pose before power-on (default: the twin's rest pose).
+    settle_s : float
+        Seconds the unpowered arm settles under gravity before power-on.
+    listeners : sequence
+        python-statemachine listeners attached to every chart (trace, coverage,
+        the debugger's breakpoints).
+    """
+
+    def __init__(self, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
+                 settle_s: float = 0.0, listeners: Sequence[object] = ()) -> None:
+        self.params = params
+        self.seed = seed
+        q0 = np.asarray(q_start, dtype=float) if q_start is not None else None
+        if settle_s > 0:
+            q0 = settled_pose(params, q0, settle_s, seed)
+        self.sim = ArmSim(params, seed=seed, q0=q0)
+        self.sched = Scheduler(params, self.sim)
+        init = make_init_charts(params, listeners)
+        self.init_stage = DriveInitStage(params, self.sim, self.sched, init)
+        self.sched.joint_stages = [self.init_stage]
+        self.charts: dict[str, TickChart] = {c.chart_name: c for c in init}
+
+    # -- time ------------------------------------------------------------------
+
+    @property
+    def t(self) -> float:
+        """Simulated time since power-on, s."""
+        return self.sim.t
+
+    @property
+    def steps(self) -> int:
+        """Control steps run so far."""
+        return self.sched.steps
+
+    @property
+    def chart_ticks(self) -> int:
+        """Chart steps run so far."""
+        return self.sched.chart_ticks
+
+    def control_step(self) -> None:
+        """One control step (a chart step too, every `chart_divider`-th)."""
+        self.sched.control_step()
+
+    def chart_step(self) -> None:
+        """Run control steps up to and through the next chart step."""
+        self.sched.run_until(lambda: True, timeout_s=self.params.control.chart_dt)
+
+    def run_for(self, seconds: float) -> None:
+        """Run whole chart steps for `seconds` of simulated time."""
+        self.sched.run_for(seconds)
+
+    def run_until(self, predicate: Callable[[], bool], timeout_s: float) -> bool:
+        """Run chart steps until `predicate()` holds; False if `timeout_s` passed first."""
+        return self.sched.run_until(predicate, timeout_s)
+
+    # -- charts ------------------------------------------------------------------
+
+    def chart(self, name: str) -> TickChart:
+        """A chart by name (``DriveInit1`` ...); a clear error names the charts there are."""
+        try:
+            return self.charts[name]
+        except KeyError:
+            raise RobotError(f"no chart {name!r}; charts: {', '.join(self.charts)}") from None
+
+    def active(self, chart: str) -> set[str]:
+        """The active configuration (state ids) of a chart."""
+        return set(self.chart(chart).configuration_values)
+
+    def set_input(self, chart: str, name: str, value: Any, force: bool = False) -> None:
+        """Set a chart input.
+
+        Inputs that the wiring feeds every chart step (the Encoder block's
+        `index`, ...) would be overwritten at the next step: `force` keeps the
+        value there until :meth:`release`, as a test of a broken switch needs.
+        """
+        c = self.chart(chart)
+        names = {d.name for d in c.declarations() if d.kind == "input"}
+        if name not in names:
+            raise RobotError(f"{chart} has no input {name!r}; inputs: {', '.join(sorted(names))}")
+        setattr(c, name, value)
+        if force:
+            self.init_stage.overrides[(self._init_index(chart), name)] = value
+
+    def release(self, chart: str, name: str) -> None:
+        """Stop forcing an input (see :meth:`set_input`)."""
+        self.init_stage.overrides.pop((self._init_index(chart), name), None)
+
+    def post(self, chart: str, event: str, **data: Any) -> None:
+        """Send an event to a chart; it is handled at the chart's next tick."""
+        self.chart(chart).post(event, **data)
+
+    def value(self, chart: str, name: str) -> Any:
+        """A chart datum (input, output or local) by name."""
+        c = self.chart(chart)
+        names = {d.name for d in c.declarations()}
+        if name not in names:
+            raise RobotError(f"{chart} has no datum {name!r}; data: {', '.join(sorted(names))}")
+        return getattr(c, name)
+
+    def _init_index(self, chart: str) -> int:
+        names = [c.chart_name for c in self.init_stage.charts]
+        if chart not in names:
+            raise RobotError(f"only the init charts' inputs can be forced, not {chart!r}")
+        return names.index(chart)
+
+    # -- signals -------------------------------------------------------------------
+
+    def signal_values(self) -> dict[str, Any]:
+        """The signals of the current step, as plain numbers (SI units)."""
+        s = self.sched.signals
+        sim = self.sim
+        tool = fk(sim.q_true, self.params.geometry)
+        sensors = sim.sensors()
+        return {
+            "t": round(sim.t, 6),
+            "q_set": [float(v) for v in s.q_set],
+            "q_encoder": [float(v) for v in sim.q_encoder],
+            "q_true": [float(v) for v in sim.q_true],
+            "offset_estimate": [float(v) for v in sim.offset_estimate],
+            "index": list(sensors.index),
+            "counts": list(sensors.counts),
+            "current_a": [round(float(v), 4) for v in sensors.current_a],
+            "tool_true": [float(v) for v in tool],
+            "fr_sw": bool(s.fr_sw),
+            "ik_error": s.ik_error,
+        }
+
+    def snapshot(self) -> dict[str, Any]:
+        """Every chart's configuration and data, and the signals: what a debugger shows."""
+        return {
+            "t": round(self.sim.t, 6),
+            "charts": {name: {"active": sorted(c.configuration_values), "data": c.snapshot()}
+                       for name, c in self.charts.items()},
+            "signals": self.signal_values(),
+        }
+
+    @property
+    def initialised(self) -> bool:
+        """True once every drive passes its commanded position through."""
+        return self.init_stage.done

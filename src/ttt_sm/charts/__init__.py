@@ -1,0 +1,12 @@
+"""The thesis' Stateflow charts, written on :mod:`ttt_sm.runtime`.
+
+Charts import the runtime only; the application (`ttt_sm.app`) wires them to
+the twin, the scheduler and the game.
+"""
+
+from .drive_init import INIT_CHARTS, DriveInit1, DriveInit2, DriveInit3
+
+#: Every chart of the project, in the order the diagrams list them.
+ALL_CHARTS = (*INIT_CHARTS,)
+
+__all__ = ["ALL_CHARTS", "INIT_CHARTS", "DriveInit1", "DriveInit2", "DriveInit3"]

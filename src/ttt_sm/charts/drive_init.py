@@ -1,0 +1,297 @@
+"""The three drive-initialisation charts of thesis section 3.1.2 (figs. 3.2-3.4).
+
+The encoders are relative: at power-on they count from zero wherever the arm
+happens to be.  Each chart moves its drive until the drive's index switch
+changes, which tells the Encoder block where the drive really is (the
+`offset` output), and only then passes the position commanded from above
+(`pos_in`, the IK output) through to its controller (`pos_out`).
+
+- DriveInit1 (base yaw) turns one way until its index passes, or until a
+  stall shows it hit a hard stop (the setpoint runs ahead of the encoder:
+  "If the output position of the encoder is not changing, while the output
+  position of the initialization block still is ..."), then turns back until
+  the index passes; it parks where drives 2 and 3 can initialise away from the
+  board, tells them (`ini_23`), and waits for them.
+- DriveInit2 (shoulder) hangs near zero at power-on, so it turns by a set
+  angle one way and, if the index did not pass, turns back until it does.
+- DriveInit3 (elbow): its index switch is also its limit switch, so it turns
+  towards it with an increment that starts big and shrinks, to touch it
+  slowly.
+
+Every angle here is in the drive's encoder coordinates, which become the true
+joint angle once `offset` is applied.  The charts import only the runtime;
+`ttt_sm.app.init_wiring` connects them to the twin.
+"""
+
+from __future__ import annotations
+
+from statemachine import HistoryState, State
+
+from ..runtime import Data, TickChart, after
+
+CHART_PERIOD_S = 0.002
+
+
+def _step_towards(value: float, target: float, inc: float) -> float:
+    """`value` moved towards `target` by at most `inc`."""
+    return value + max(-inc, min(inc, target - value))
+
+
+class DriveInit1(TickChart):
+    """Drive 1: find the index (or a hard stop, then the index), park, wait, pass pos_in."""
+
+    tick_period_s = CHART_PERIOD_S
+
+    inputs = (
+        Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
+        Data("stop", "bool", False, "a non-zero value stops the drive where it is"),
+        Data("index", "bool", False, "index switch level, from the Encoder block"),
+        Data("pos_Encoder", "rad", 0.0, "drive angle from the encoder (relative until initialised)"),
+        Data("index_pos", "rad", 0.0, "encoder angle latched at the index switch's last edge"),
+        Data("ini2", "bool", False, "drive 2 is initialised"),
+        Data("ini3", "bool", False, "drive 3 is initialised"),
+    )
+    outputs = (
+        Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
+        Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
+        Data("ini_23", "bool", False, "drive 1 initialised and parked: drives 2 and 3 may start"),
+    )
+    local = (
+        Data("inc", "rad", 0.002, "search step per chart tick (1 rad/s at 500 Hz)"),
+        Data("index_angle", "rad", 0.0, "true angle of the index switch"),
+        Data("park", "rad", 0.0, "angle to wait at while drives 2 and 3 initialise"),
+        Data("still_band", "rad", 0.0005, "encoder moving less than this per tick (a quarter of inc): stalled"),
+        Data("park_tol", "rad", 0.002, "how close the encoder must be to the parking angle"),
+        Data("enc_prev", "rad", 0.0, "encoder angle one chart tick earlier"),
+        Data("index_start", "bool", False, "index level when the current search began"),
+    )
+
+    class run(State.Compound):
+        class initialise(State.Compound):
+            power_on = State(initial=True)
+            turn_fwd = State()
+            turn_back = State()
+            go_park = State()
+            wait_23 = State()
+
+            power_on.to(turn_fwd)  # on the first tick, once the inputs are read
+            turn_fwd.to(go_park, cond="index_passed", on="set_home")
+            turn_fwd.to(turn_back, cond=[after(50), "stalled"], on="reverse")
+            turn_back.to(go_park, cond="index_passed", on="set_home")
+            go_park.to(wait_23, cond="parked")
+
+        pass_pos = State()
+        h = HistoryState()
+        initialise.wait_23.to(pass_pos, cond="ini2 and ini3")
+
+    stopped = State()
+    failed = State()
+
+    run.to(stopped, cond="stop")
+    stopped.to(run.h, cond="not stop")
+    run.initialise.turn_back.to(failed, cond=[after(50), "stalled"])
+
+    # -- guards: pure functions of inputs and data -----------------------------
+
+    def index_passed(self) -> bool:
+        """The index switch changed since the search began."""
+        return self.index != self.index_start
+
+    def stalled(self) -> bool:
+        """The encoder stands still while the setpoint moves on: a hard stop.
+
+        Checked only after 50 ticks in the turning state, once the drive is
+        under way (the setpoint filters delay its start).
+        """
+        return abs(self.pos_Encoder - self.enc_prev) < self.still_band
+
+    def parked(self) -> bool:
+        """Setpoint at the parking angle and the drive there too."""
+        return self.pos_out == self.park and abs(self.pos_Encoder - self.park) < self.park_tol
+
+    # -- actions ------------------------------------------------------------------
+
+    def on_enter_turn_fwd(self) -> None:
+        self.index_start = self.index
+        self.pos_out = self.pos_Encoder
+
+    def during_turn_fwd(self) -> None:
+        self.pos_out = self.pos_out_p + self.inc
+        self.enc_prev = self.pos_Encoder
+
+    def reverse(self) -> None:
+        """Turn back from where the drive stands, not from where the setpoint ran to."""
+        self.pos_out = self.pos_Encoder
+        self.index_start = self.index
+        self.enc_prev = self.pos_Encoder
+
+    def during_turn_back(self) -> None:
+        self.pos_out = self.pos_out_p - self.inc
+        self.enc_prev = self.pos_Encoder
+
+    def set_home(self) -> None:
+        """The index passed: its latched encoder angle is `index_angle` really."""
+        correction = self.index_angle - self.index_pos
+        self.offset = self.offset + correction
+        self.pos_out = self.pos_out + correction
+
+    def during_go_park(self) -> None:
+        self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc)
+
+    def on_enter_wait_23(self) -> None:
+        self.ini_23 = True
+
+    def during_pass_pos(self) -> None:
+        self.pos_out = self.pos_in
+
+    def on_enter_stopped(self) -> None:
+        self.pos_out = self.pos_Encoder
+
+    def on_enter_failed(self) -> None:
+        self.pos_out = self.pos_Encoder
+
+
+class DriveInit2(TickChart):
+    """Drive 2: wait for drive 1, turn a set angle, turn back if the index did not pass."""
+
+    tick_period_s = CHART_PERIOD_S
+
+    inputs = (
+        Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
+        Data("index", "bool", False, "index switch level, from the Encoder block"),
+        Data("index_pos", "rad", 0.0, "encoder angle latched at the index switch's last edge"),
+        Data("ini1", "bool", False, "drive 1 is initialised and parked (its ini_23)"),
+        Data("ini3", "bool", False, "drive 3 is initialised"),
+    )
+    outputs = (
+        Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
+        Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
+        Data("ini2", "bool", False, "drive 2 is initialised"),
+    )
+    local = (
+        Data("inc", "rad", 0.0015, "search step per chart tick (0.75 rad/s at 500 Hz)"),
+        Data("index_angle", "rad", 0.0, "true angle of the index switch"),
+        Data("turn_angle", "rad", 0.6, "how far to turn one way before turning back"),
+        Data("max_back", "rad", 2.0, "how far to turn back before giving up"),
+        Data("travel", "rad", 0.0, "turned so far in the current direction"),
+        Data("index_start", "bool", False, "index level when the current search began"),
+    )
+
+    wait_ini1 = State(initial=True)
+    turn_one_way = State()
+    turn_back = State()
+    wait_ini3 = State()
+    pass_pos = State()
+    failed = State()
+
+    wait_ini1.to(turn_one_way, cond="ini1", on="start_search")
+    turn_one_way.to(wait_ini3, cond="index_passed", on="set_home")
+    turn_one_way.to(turn_back, cond="travel >= turn_angle", on="start_search")
+    turn_back.to(wait_ini3, cond="index_passed", on="set_home")
+    turn_back.to(failed, cond="travel >= max_back")
+    wait_ini3.to(pass_pos, cond="ini3")
+
+    def index_passed(self) -> bool:
+        """The index switch changed since the search began."""
+        return self.index != self.index_start
+
+    def start_search(self) -> None:
+        self.index_start = self.index
+        self.travel = 0.0
+
+    def during_turn_one_way(self) -> None:
+        self.pos_out = self.pos_out_p + self.inc
+        self.travel = self.travel + self.inc
+
+    def during_turn_back(self) -> None:
+        self.pos_out = self.pos_out_p - self.inc
+        self.travel = self.travel + self.inc
+
+    def set_home(self) -> None:
+        """The index passed: its latched encoder angle is `index_angle` really."""
+        correction = self.index_angle - self.index_pos
+        self.offset = self.offset + correction
+        self.pos_out = self.pos_out + correction
+
+    def on_enter_wait_ini3(self) -> None:
+        self.ini2 = True
+
+    def during_pass_pos(self) -> None:
+        self.pos_out = self.pos_in
+
+
+class DriveInit3(TickChart):
+    """Drive 3: turn towards the index-and-limit switch with a shrinking increment."""
+
+    tick_period_s = CHART_PERIOD_S
+
+    inputs = (
+        Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
+        Data("index", "bool", False, "index-and-limit switch level, from the Encoder block"),
+        Data("index_pos", "rad", 0.0, "encoder angle latched at the switch's last edge"),
+        Data("ini1", "bool", False, "drive 1 is initialised and parked (its ini_23)"),
+        Data("ini2", "bool", False, "drive 2 is initialised"),
+    )
+    outputs = (
+        Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
+        Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
+        Data("ini3", "bool", False, "drive 3 is initialised and parked"),
+    )
+    local = (
+        Data("inc", "rad", 0.0, "current step per chart tick"),
+        Data("inc_max", "rad", 0.002, "first step (1 rad/s at 500 Hz)"),
+        Data("inc_min", "rad", 0.0004, "smallest step (0.2 rad/s): how fast the switch is touched"),
+        Data("shrink", "1", 0.997, "the step is multiplied by this every tick"),
+        Data("index_angle", "rad", 0.0, "true angle of the index-and-limit switch"),
+        Data("park", "rad", 0.0, "angle to wait at once initialised"),
+        Data("max_travel", "rad", 3.5, "how far to turn before giving up"),
+        Data("travel", "rad", 0.0, "turned so far"),
+    )
+
+    wait_ini1 = State(initial=True)
+    leave_switch = State()
+    approach = State()
+    back_off = State()
+    wait_ini2 = State()
+    pass_pos = State()
+    failed = State()
+
+    wait_ini1.to(leave_switch, cond="ini1 and index", on="start_search")
+    wait_ini1.to(approach, cond="ini1", on="start_search")
+    leave_switch.to(back_off, cond="not index", on="set_home")
+    approach.to(back_off, cond="index", on="set_home")
+    approach.to(failed, cond="travel >= max_travel")
+    leave_switch.to(failed, cond="travel >= max_travel")
+    back_off.to(wait_ini2, cond="pos_out == park")
+    wait_ini2.to(pass_pos, cond="ini2")
+
+    def start_search(self) -> None:
+        self.inc = self.inc_max
+        self.travel = 0.0
+
+    def during_approach(self) -> None:
+        self.pos_out = self.pos_out_p + self.inc
+        self.travel = self.travel + self.inc
+        self.inc = max(self.inc_min, self.inc * self.shrink)
+
+    def during_leave_switch(self) -> None:
+        self.pos_out = self.pos_out_p - self.inc_min
+        self.travel = self.travel + self.inc_min
+
+    def set_home(self) -> None:
+        """The switch changed: its latched encoder angle is `index_angle` really."""
+        correction = self.index_angle - self.index_pos
+        self.offset = self.offset + correction
+        self.pos_out = self.pos_out + correction
+
+    def during_back_off(self) -> None:
+        self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc_max / 2)
+
+    def on_enter_wait_ini2(self) -> None:
+        self.ini3 = True
+
+    def during_pass_pos(self) -> None:
+        self.pos_out = self.pos_in
+
+
+INIT_CHARTS = (DriveInit1, DriveInit2, DriveInit3)

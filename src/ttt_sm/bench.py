@@ -97,11 +97,31 @@ def bench_steps(params: ArmParams, out_dir: Path) -> dict[str, Any]:
     return {"step_responses": rows}
 
 
+def bench_charts(params: ArmParams) -> dict[str, float]:
+    """Cost of a quiet chart tick against the same tick through send() (runtime)."""
+    from .runtime.bench import bench_quiet_tick
+
+    result = dict(bench_quiet_tick())
+    if "speedup" in result:
+        result["chart_quiet_tick_speedup"] = result.pop("speedup")
+    return result
+
+
+def bench_init(params: ArmParams, starts: int, seed: int = 0) -> dict[str, Any]:
+    """`ttt-sm init --starts N`: the init charts from random power-on poses."""
+    from .app.init_wiring import init_report
+
+    report = init_report(params, starts, seed=seed)
+    return {f"init_{k}": v for k, v in report.items()}
+
+
 SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "steps": lambda p, a: bench_steps(p, a["out"]),
     "ik": lambda p, a: bench_ik_section(p, a["seed"]),
     "loop": lambda p, a: bench_loop(p, a["loop_seconds"], a["seed"]),
     "pacing": lambda p, a: bench_pacing(p, a["pacing_seconds"], a["seed"]),
+    "charts": lambda p, a: bench_charts(p),
+    "init": lambda p, a: bench_init(p, a["init_starts"], a["seed"]),
 }
 
 
@@ -117,7 +137,7 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
     if unknown:
         raise ValueError(f"unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
     args = {"seed": seed, "out": out, "loop_seconds": 2.0 if quick else 20.0,
-            "pacing_seconds": 1.0 if quick else 10.0}
+            "pacing_seconds": 1.0 if quick else 10.0, "init_starts": 5 if quick else 200}
     result: dict[str, Any] = {
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
                     "numba_jit": os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"},

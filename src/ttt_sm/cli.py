@@ -108,6 +108,42 @@ def cmd_ik(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_init(args: argparse.Namespace) -> int:
+    from .app.init_wiring import init_report
+
+    if args.starts < 1:
+        raise CliError(f"--starts must be at least 1, got {args.starts}")
+    params = load_params(args.params)
+    report = init_report(params, args.starts, seed=args.seed)
+    text = "\n".join(f"  {k}: {v}" for k, v in report.items())
+    _emit(report, args.json, f"init from {args.starts} random power-on poses:\n{text}")
+    ok = report["successes"] == report["runs"] and not report["limit_violations"] \
+        and not report["board_zone_entries"]
+    return 0 if ok else 1
+
+
+#: What `charts export` writes by default: what charts/ in the repository holds.
+REPO_CHART_FORMATS = ("svg", "mermaid")
+
+
+def cmd_charts(args: argparse.Namespace) -> int:
+    from .charts import ALL_CHARTS
+    from .runtime.export import FORMATS, export_command
+
+    formats = tuple(f.strip() for f in args.format.split(",")) if args.format else REPO_CHART_FORMATS
+    unknown = [f for f in formats if f not in FORMATS]
+    if unknown:
+        raise CliError(f"unknown format(s) {', '.join(unknown)}; choose from {', '.join(FORMATS)}")
+    result = export_command(ALL_CHARTS, args.out, check=args.action == "check", formats=formats)
+    if args.action == "check":
+        text = "charts are up to date" if result["ok"] else \
+            "stale (run `ttt-sm charts export`):\n" + "\n".join(f"  {f}" for f in result["stale"])  # type: ignore
+    else:
+        text = "wrote:\n" + "\n".join(f"  {f}" for f in result["written"])  # type: ignore[attr-defined]
+    _emit(result, args.json, text)
+    return 0 if result.get("ok", True) else 1
+
+
 def cmd_params(args: argparse.Namespace) -> int:
     params = load_params(args.params)
     _emit(dataclasses.asdict(params), args.json)
@@ -134,7 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
     sp = add("bench", cmd_bench, "measure the speed and quality targets")
-    sp.add_argument("--only", default=None, help="comma-separated sections: steps,ik,loop,pacing")
+    sp.add_argument("--only", default=None, help="comma-separated sections: steps,ik,loop,pacing,charts,init")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
     sp = add("ik", cmd_ik, "solve inverse kinematics for one tool pose")
@@ -142,6 +178,13 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("y", type=float, help="mm")
     sp.add_argument("z", type=float, help="mm")
     sp.add_argument("--phi", type=float, default=0.0, help="pen angle phi, degrees (default 0)")
+    sp = add("init", cmd_init, "initialise the drives with the init charts from random power-on poses")
+    sp.add_argument("--starts", type=int, default=20, help="number of random power-on poses (default 20)")
+    sp = add("charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
+    sp.add_argument("action", choices=["export", "check"])
+    sp.add_argument("--format", default=None,
+                    help="comma-separated: svg,png,mermaid,dot (default svg,mermaid: what charts/ holds)")
+    sp.add_argument("--out", default="charts", help="folder (default charts/)")
     add("params", cmd_params, "print the parameters in force (SI units)")
     return p
 

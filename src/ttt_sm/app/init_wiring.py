@@ -26,8 +26,9 @@ from ..sched.scheduler import Scheduler, Signals
 from ..twin.kinematics import link_points
 from ..twin.plant import ArmSim
 
-#: Servo angle during initialisation: the pen in line with the forearm.
-SERVO_INIT_RAD = 0.0
+def servo_init_angle(params: ArmParams) -> float:
+    """Servo angle during initialisation: the pen vertical (phi = 0) once drives 2 and 3 park."""
+    return -(params.drives[1].park_rad + params.drives[2].park_rad)
 
 
 def make_init_charts(params: ArmParams, listeners: Sequence[object] = ()) -> tuple[
@@ -38,7 +39,8 @@ def make_init_charts(params: ArmParams, listeners: Sequence[object] = ()) -> tup
     lst = list(listeners)
     c1 = DriveInit1(tick_period_s=period, listeners=lst,
                     data={"index_angle": d1.index_rad, "park": d1.park_rad})
-    c2 = DriveInit2(tick_period_s=period, listeners=lst, data={"index_angle": d2.index_rad})
+    c2 = DriveInit2(tick_period_s=period, listeners=lst,
+                    data={"index_angle": d2.index_rad, "park": d2.park_rad})
     c3 = DriveInit3(tick_period_s=period, listeners=lst,
                     data={"index_angle": d3.index_rad, "park": d3.park_rad})
     return c1, c2, c3
@@ -53,6 +55,7 @@ class DriveInitStage:
         self.sched = sched
         self.charts = charts
         self.rad_per_count = [d.rad_per_count for d in params.drives]
+        self.servo_init = servo_init_angle(params)
         self.applied = [0.0, 0.0, 0.0]
         #: Inputs forced by a test or scenario, applied after the Encoder blocks: (chart index, name) -> value.
         self.overrides: dict[tuple[int, str], object] = {}
@@ -95,7 +98,7 @@ class DriveInitStage:
                 self.sched.homed[d] = True
         if moved:
             self._update_status()
-        servo = pos_in[3] if self.done else SERVO_INIT_RAD
+        servo = pos_in[3] if self.done else self.servo_init
         signals.q_set = np.array([c1.pos_out, c2.pos_out, c3.pos_out, servo])
 
 
@@ -135,18 +138,6 @@ class InitMonitor:
             self.zone_ticks += 1
 
 
-def stall_allowance(params: ArmParams, inc: float, detect_ticks: int = 5) -> float:
-    """How far drive 1's setpoint may pass a hard stop before the stall shows.
-
-    The setpoint filter (critically damped, second order) makes the drive
-    trail a ramp of speed v by 2 v / omega; the chart needs a few more ticks to
-    see the encoder stand still.
-    """
-    v = inc / params.control.chart_dt
-    omega = 2 * math.pi * params.control.setpoint_cutoff_hz
-    return 2 * v / omega + detect_ticks * inc
-
-
 @dataclass(frozen=True)
 class InitRun:
     """One initialisation from one power-on pose."""
@@ -164,7 +155,7 @@ def random_power_on(params: ArmParams, rng: np.random.Generator) -> np.ndarray:
     """A pose anywhere between the hard stops (drives 1-3), servo at its init angle."""
     lo = np.array([d.limit_min_rad for d in params.drives])
     hi = np.array([d.limit_max_rad for d in params.drives])
-    return np.append(rng.uniform(lo, hi), SERVO_INIT_RAD)
+    return np.append(rng.uniform(lo, hi), servo_init_angle(params))
 
 
 def settled_pose(params: ArmParams, q_start: np.ndarray | None, seconds: float, seed: int) -> np.ndarray:
@@ -190,7 +181,8 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
     sched = Scheduler(params, sim)
     charts = make_init_charts(params)
     stage = DriveInitStage(params, sim, sched, charts)
-    monitor = InitMonitor(params, sim, allowance_rad=stall_allowance(params, charts[0].inc))
+    # Drive 1 may push its setpoint past a stop by its stall band (and one more step) to find it.
+    monitor = InitMonitor(params, sim, allowance_rad=charts[0].stall_lag + charts[0].inc)
     sched.joint_stages = [stage, monitor]
     t0 = sim.t
     sched.run_until(lambda: stage.done or stage.failed, timeout_s)

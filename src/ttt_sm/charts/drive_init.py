@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from statemachine import HistoryState, State
 
-from ..runtime import Data, TickChart, after
+from ..runtime import Data, TickChart
 
 CHART_PERIOD_S = 0.002
 
@@ -61,6 +61,9 @@ class DriveInit1(TickChart):
         Data("index_angle", "rad", 0.0, "true angle of the index switch"),
         Data("park", "rad", 0.0, "angle to wait at while drives 2 and 3 initialise"),
         Data("still_band", "rad", 0.0005, "encoder moving less than this per tick (a quarter of inc): stalled"),
+        Data("stall_lag", "rad", 0.06, "setpoint this far ahead of a still encoder: stalled (a start at a stop)"),
+        Data("direction", "1", 1.0, "+1 while turning forward, -1 while turning back"),
+        Data("moving", "bool", False, "the encoder has moved since the current turn began"),
         Data("park_tol", "rad", 0.002, "how close the encoder must be to the parking angle"),
         Data("enc_prev", "rad", 0.0, "encoder angle one chart tick earlier"),
         Data("index_start", "bool", False, "index level when the current search began"),
@@ -76,7 +79,7 @@ class DriveInit1(TickChart):
 
             power_on.to(turn_fwd)  # on the first tick, once the inputs are read
             turn_fwd.to(go_park, cond="index_passed", on="set_home")
-            turn_fwd.to(turn_back, cond=[after(50), "stalled"], on="reverse")
+            turn_fwd.to(turn_back, cond="stalled", on="reverse")
             turn_back.to(go_park, cond="index_passed", on="set_home")
             go_park.to(wait_23, cond="parked")
 
@@ -89,7 +92,7 @@ class DriveInit1(TickChart):
 
     run.to(stopped, cond="stop")
     stopped.to(run.h, cond="not stop")
-    run.initialise.turn_back.to(failed, cond=[after(50), "stalled"])
+    run.initialise.turn_back.to(failed, cond="stalled")
 
     # -- guards: pure functions of inputs and data -----------------------------
 
@@ -100,10 +103,14 @@ class DriveInit1(TickChart):
     def stalled(self) -> bool:
         """The encoder stands still while the setpoint moves on: a hard stop.
 
-        Checked only after 50 ticks in the turning state, once the drive is
-        under way (the setpoint filters delay its start).
+        Either the drive was moving and its encoder stopped, or (a start
+        right at a stop, where it never moved) the setpoint ran `stall_lag`
+        ahead of it.  Before the drive gets under way the setpoint filter
+        delays it, which is why a still encoder alone does not count.
         """
-        return abs(self.pos_Encoder - self.enc_prev) < self.still_band
+        if (self.pos_out - self.pos_Encoder) * self.direction > self.stall_lag:
+            return True
+        return self.moving and abs(self.pos_Encoder - self.enc_prev) < self.still_band
 
     def parked(self) -> bool:
         """Setpoint at the parking angle and the drive there too."""
@@ -114,9 +121,18 @@ class DriveInit1(TickChart):
     def on_enter_turn_fwd(self) -> None:
         self.index_start = self.index
         self.pos_out = self.pos_Encoder
+        self.enc_prev = self.pos_Encoder
+        self.direction = 1.0
+        self.moving = False
 
     def during_turn_fwd(self) -> None:
         self.pos_out = self.pos_out_p + self.inc
+        self._watch_encoder()
+
+    def _watch_encoder(self) -> None:
+        """Remember this tick's encoder angle, and whether the drive got under way."""
+        if abs(self.pos_Encoder - self.enc_prev) >= self.still_band:
+            self.moving = True
         self.enc_prev = self.pos_Encoder
 
     def reverse(self) -> None:
@@ -124,10 +140,12 @@ class DriveInit1(TickChart):
         self.pos_out = self.pos_Encoder
         self.index_start = self.index
         self.enc_prev = self.pos_Encoder
+        self.direction = -1.0
+        self.moving = False
 
     def during_turn_back(self) -> None:
         self.pos_out = self.pos_out_p - self.inc
-        self.enc_prev = self.pos_Encoder
+        self._watch_encoder()
 
     def set_home(self) -> None:
         """The index passed: its latched encoder angle is `index_angle` really."""
@@ -152,7 +170,7 @@ class DriveInit1(TickChart):
 
 
 class DriveInit2(TickChart):
-    """Drive 2: wait for drive 1, turn a set angle, turn back if the index did not pass."""
+    """Drive 2: wait for drive 1, turn a set angle, turn back if the index did not pass, wait, park."""
 
     tick_period_s = CHART_PERIOD_S
 
@@ -175,12 +193,14 @@ class DriveInit2(TickChart):
         Data("max_back", "rad", 2.0, "how far to turn back before giving up"),
         Data("travel", "rad", 0.0, "turned so far in the current direction"),
         Data("index_start", "bool", False, "index level when the current search began"),
+        Data("park", "rad", 0.0, "angle to hold once initialised, until the Control chart takes over"),
     )
 
     wait_ini1 = State(initial=True)
     turn_one_way = State()
     turn_back = State()
     wait_ini3 = State()
+    go_park = State()
     pass_pos = State()
     failed = State()
 
@@ -189,7 +209,8 @@ class DriveInit2(TickChart):
     turn_one_way.to(turn_back, cond="travel >= turn_angle", on="start_search")
     turn_back.to(wait_ini3, cond="index_passed", on="set_home")
     turn_back.to(failed, cond="travel >= max_back")
-    wait_ini3.to(pass_pos, cond="ini3")
+    wait_ini3.to(go_park, cond="ini3")
+    go_park.to(pass_pos, cond="pos_out == park")
 
     def index_passed(self) -> bool:
         """The index switch changed since the search began."""
@@ -215,6 +236,9 @@ class DriveInit2(TickChart):
 
     def on_enter_wait_ini3(self) -> None:
         self.ini2 = True
+
+    def during_go_park(self) -> None:
+        self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc)
 
     def during_pass_pos(self) -> None:
         self.pos_out = self.pos_in
@@ -285,7 +309,7 @@ class DriveInit3(TickChart):
         self.pos_out = self.pos_out + correction
 
     def during_back_off(self) -> None:
-        self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc_max / 2)
+        self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc_max)
 
     def on_enter_wait_ini2(self) -> None:
         self.ini3 = True

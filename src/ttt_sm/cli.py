@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from .params import ParameterError, load_params
+from .scenario.cli import register as register_scenario
 
 
 class CliError(Exception):
@@ -186,6 +187,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="comma-separated: svg,png,mermaid,dot (default svg,mermaid: what charts/ holds)")
     sp.add_argument("--out", default="charts", help="folder (default charts/)")
     add("params", cmd_params, "print the parameters in force (SI units)")
+    register_scenario(sub)
     return p
 
 

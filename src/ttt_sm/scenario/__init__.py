@@ -1,0 +1,41 @@
+"""Scenario tests of event sequences: YAML files that drive the robot and check its charts.
+
+A scenario file says, step by step, what happens to the robot (inputs set or
+forced, events posted, time passing) and what the charts must do (states
+entered in order, conditions on chart data and signals).  It is a test and a
+piece of documentation: ``tests/scenarios/drive_1_turns_back_at_a_hard_stop.yaml``.
+
+- :mod:`.source`: YAML with line numbers (a ``SafeLoader`` subclass);
+- :mod:`.expr`: the condition language (parsed, never ``eval``-ed);
+- :mod:`.model`, :mod:`.loader`: the steps, checked against the charts;
+- :mod:`.runner`: runs scenarios on the simulated robot, with coverage;
+- :mod:`.cli`: ``ttt-sm scenario run``; :mod:`.pytest_plugin`: YAML files as tests.
+
+See ``docs/scenarios.md``.
+"""
+
+from .errors import ScenarioError
+from .expr import Expression, ExprError, Ref, parse
+from .loader import load_scenario, load_scenario_text, scenario_files
+from .model import SIGNALS, Catalog, Scenario
+from .runner import Failure, RunReport, ScenarioResult, coverage_dict, run_scenario, run_scenarios
+
+__all__ = [
+    "SIGNALS",
+    "Catalog",
+    "ExprError",
+    "Expression",
+    "Failure",
+    "Ref",
+    "RunReport",
+    "Scenario",
+    "ScenarioError",
+    "ScenarioResult",
+    "coverage_dict",
+    "load_scenario",
+    "load_scenario_text",
+    "parse",
+    "run_scenario",
+    "run_scenarios",
+    "scenario_files",
+]

@@ -1,0 +1,361 @@
+"""A tiny, safe expression language for scenario conditions (no ``eval``).
+
+Conditions in scenario files read like Python but can only *look*:
+
+    DriveInit1.ini_23 == true and abs(q_true[1] + 100deg) < 0.5deg
+
+Grammar (lowest precedence first)::
+
+    expr    := or
+    or      := and ("or" and)*
+    and     := not ("and" not)*
+    not     := "not" not | compare
+    compare := sum (("==" | "!=" | "<" | "<=" | ">" | ">=") sum)*   # chains: 0 < x < 1
+    sum     := product (("+" | "-") product)*
+    product := unary (("*" | "/") unary)*
+    unary   := "-" unary | atom
+    atom    := NUMBER [UNIT] | "true" | "false" | "(" expr ")"
+             | FUNCTION "(" expr ("," expr)* ")"  # abs, min, max
+             | NAME "." NAME                      # a chart datum or state: DriveInit1.stop
+             | NAME ["[" INTEGER "]"]             # a signal: t, q_true[1]
+
+Values are in SI units, as the charts and signals hold them; a number may
+carry a unit that converts it: ``170deg`` (or ``170 deg``), ``20mm``, ``5ms``
+(``rad``, ``m``, ``s`` change nothing).  Vector signals are numbered from 1,
+as the thesis numbers joints and drives: ``q_true[1]`` is q1.
+
+It is the language of the debugger's ``break when`` conditions
+(:mod:`ttt_sm.debug.expr`: same names, units, numbering and chained
+comparisons), plus arithmetic and ``abs``/``min``/``max``: every ``break
+when`` condition means the same here.
+
+The language knows nothing about robots: names are :class:`Ref` objects that
+the caller resolves (the scenario runner binds them to a robot's charts and
+signals).  :func:`parse` checks the syntax and lists the references, so a
+loader can check every name before anything runs.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["FUNCTIONS", "UNITS", "Expression", "ExprError", "Ref", "parse"]
+
+
+class ExprError(ValueError):
+    """A condition that cannot be parsed or evaluated; ``column`` is 1-based (0: unknown)."""
+
+    def __init__(self, message: str, text: str = "", column: int = 0) -> None:
+        self.message = message
+        self.text = text
+        self.column = column
+        where = f" at column {column}" if column else ""
+        super().__init__(f"{message}{where} in {text!r}" if text else message)
+
+
+@dataclass(frozen=True)
+class Ref:
+    """A name in a condition: ``chart.name`` (chart datum or state) or a signal ``name[index]``.
+
+    ``index`` is as written: 1 for the first element.
+    """
+
+    chart: str | None
+    name: str
+    index: int | None = None
+    column: int = 0
+
+    def __str__(self) -> str:
+        head = f"{self.chart}.{self.name}" if self.chart else self.name
+        return head if self.index is None else f"{head}[{self.index}]"
+
+
+#: Functions a condition may call: name -> (function, number of arguments or None for 1+).
+FUNCTIONS: dict[str, tuple[Callable[..., Any], int | None]] = {
+    "abs": (abs, 1),
+    "min": (min, None),
+    "max": (max, None),
+}
+#: Units a number may carry: factor to SI.
+UNITS: dict[str, float] = {"deg": math.pi / 180, "rad": 1.0, "mm": 1e-3, "m": 1.0, "ms": 1e-3, "s": 1.0}
+
+_COMPARE = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
+            ">": operator.gt, ">=": operator.ge}
+_ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv}
+_KEYWORDS = {"and", "or", "not", "true", "false", "True", "False"}
+_TOKEN = re.compile(r"""
+    (?P<space>\s+)
+  | (?P<number>(?:\d+\.\d*|\.\d+|\d+)(?:[eE][+-]?\d+)?)
+  | (?P<name>[A-Za-z_][A-Za-z_0-9]*)
+  | (?P<op>==|!=|<=|>=|<|>|\+|-|\*|/|\(|\)|\[|\]|\.|,)
+""", re.VERBOSE)
+_HINTS = {"=": "use == to compare", "&": "use 'and'", "|": "use 'or'", "!": "use 'not' (or != to compare)"}
+
+
+@dataclass(frozen=True)
+class _Tok:
+    kind: str  # number, name, op, end
+    text: str
+    column: int  # 1-based
+
+
+def _tokenize(text: str) -> list[_Tok]:
+    tokens: list[_Tok] = []
+    pos = 0
+    while pos < len(text):
+        m = _TOKEN.match(text, pos)
+        if m is None:
+            ch = text[pos]
+            hint = _HINTS.get(ch, "")
+            raise ExprError(f"unexpected character {ch!r}" + (f" ({hint})" if hint else ""),
+                            text, pos + 1)
+        kind = m.lastgroup or ""
+        if kind != "space":
+            tokens.append(_Tok(kind, m.group(), pos + 1))
+        pos = m.end()
+    tokens.append(_Tok("end", "", len(text) + 1))
+    return tokens
+
+
+# -- syntax tree: small frozen nodes, evaluated or compiled to closures ----------------
+
+Node = Any  # one of the tuples below; kept as tuples so a tree is cheap and hashable
+# ("const", value) | ("ref", Ref) | ("neg", node) | ("not", node) | ("and", nodes) | ("or", nodes)
+# ("arith", op, left, right) | ("compare", ops, operands) | ("call", name, args)
+
+
+class _Parser:
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.tokens = _tokenize(text)
+        self.pos = 0
+        self.refs: list[Ref] = []
+
+    @property
+    def tok(self) -> _Tok:
+        return self.tokens[self.pos]
+
+    def error(self, message: str, tok: _Tok | None = None) -> ExprError:
+        return ExprError(message, self.text, (tok or self.tok).column)
+
+    def take(self, text: str) -> bool:
+        if self.tok.text == text and self.tok.kind in ("op", "name"):
+            self.pos += 1
+            return True
+        return False
+
+    def expect(self, text: str, what: str) -> None:
+        if not self.take(text):
+            found = repr(self.tok.text) if self.tok.kind != "end" else "the end"
+            raise self.error(f"expected {what}, found {found}")
+
+    def parse(self) -> Node:
+        if self.tok.kind == "end":
+            raise self.error("empty condition")
+        node = self.parse_or()
+        if self.tok.kind != "end":
+            raise self.error(f"unexpected {self.tok.text!r}")
+        return node
+
+    def parse_or(self) -> Node:
+        items = [self.parse_and()]
+        while self.take("or"):
+            items.append(self.parse_and())
+        return items[0] if len(items) == 1 else ("or", tuple(items))
+
+    def parse_and(self) -> Node:
+        items = [self.parse_not()]
+        while self.take("and"):
+            items.append(self.parse_not())
+        return items[0] if len(items) == 1 else ("and", tuple(items))
+
+    def parse_not(self) -> Node:
+        if self.take("not"):
+            return ("not", self.parse_not())
+        return self.parse_compare()
+
+    def parse_compare(self) -> Node:
+        operands = [self.parse_sum()]
+        ops: list[str] = []
+        while self.tok.kind == "op" and self.tok.text in _COMPARE:
+            ops.append(self.tok.text)
+            self.pos += 1
+            operands.append(self.parse_sum())
+        return operands[0] if not ops else ("compare", tuple(ops), tuple(operands))
+
+    def parse_sum(self) -> Node:
+        node = self.parse_product()
+        while self.tok.kind == "op" and self.tok.text in ("+", "-"):
+            op = self.tok.text
+            self.pos += 1
+            node = ("arith", op, node, self.parse_product())
+        return node
+
+    def parse_product(self) -> Node:
+        node = self.parse_unary()
+        while self.tok.kind == "op" and self.tok.text in ("*", "/"):
+            op = self.tok.text
+            self.pos += 1
+            node = ("arith", op, node, self.parse_unary())
+        return node
+
+    def parse_unary(self) -> Node:
+        if self.take("-"):
+            return ("neg", self.parse_unary())
+        return self.parse_atom()
+
+    def parse_atom(self) -> Node:
+        tok = self.tok
+        if tok.kind == "number":
+            self.pos += 1
+            value: float = float(tok.text) if any(c in tok.text for c in ".eE") else int(tok.text)
+            unit = self.tok
+            if unit.kind == "name" and unit.text in UNITS:
+                self.pos += 1
+                value = value * UNITS[unit.text]
+            elif unit.kind == "name" and unit.text not in _KEYWORDS:
+                raise self.error(f"unknown unit {unit.text!r}; units: {', '.join(UNITS)}", unit)
+            return ("const", value)
+        if self.take("("):
+            node = self.parse_or()
+            self.expect(")", "')'")
+            return node
+        if tok.kind != "name":
+            found = repr(tok.text) if tok.kind != "end" else "the end"
+            raise self.error(f"expected a number, a name or '(', found {found}")
+        self.pos += 1
+        if tok.text in ("true", "True"):
+            return ("const", True)
+        if tok.text in ("false", "False"):
+            return ("const", False)
+        if tok.text in _KEYWORDS:
+            raise self.error(f"{tok.text!r} needs something before it", tok)
+        if self.tok.text == "(" and self.tok.kind == "op":
+            return self.parse_call(tok)
+        chart: str | None = None
+        name = tok.text
+        if self.take("."):
+            if self.tok.kind != "name":
+                raise self.error(f"expected a datum or state name after '{tok.text}.'")
+            chart, name = tok.text, self.tok.text
+            self.pos += 1
+        index: int | None = None
+        if self.take("["):
+            if self.tok.kind != "number" or not self.tok.text.isdigit():
+                raise self.error("expected an element number (1, 2, ...) inside [ ]")
+            index = int(self.tok.text)
+            self.pos += 1
+            self.expect("]", "']'")
+        ref = Ref(chart, name, index, tok.column)
+        self.refs.append(ref)
+        return ("ref", ref)
+
+    def parse_call(self, tok: _Tok) -> Node:
+        if tok.text not in FUNCTIONS:
+            raise self.error(f"unknown function {tok.text!r}; functions: {', '.join(FUNCTIONS)}", tok)
+        self.expect("(", "'('")
+        args = [self.parse_or()]
+        while self.take(","):
+            args.append(self.parse_or())
+        self.expect(")", "')' after the arguments")
+        arity = FUNCTIONS[tok.text][1]
+        if arity is not None and len(args) != arity:
+            raise self.error(f"{tok.text}() takes {arity} argument(s), got {len(args)}", tok)
+        if tok.text in ("min", "max") and len(args) < 2:
+            raise self.error(f"{tok.text}() takes 2 or more arguments", tok)
+        return ("call", tok.text, tuple(args))
+
+
+def _compile(node: Node, get: Callable[[Ref], Callable[[], Any]], text: str) -> Callable[[], Any]:
+    """A closure that evaluates `node`, references read through the getters from `get`."""
+    kind = node[0]
+    if kind == "const":
+        value = node[1]
+        return lambda: value
+    if kind == "ref":
+        return get(node[1])
+    if kind == "neg":
+        f = _compile(node[1], get, text)
+        return lambda: -f()
+    if kind == "not":
+        f = _compile(node[1], get, text)
+        return lambda: not f()
+    if kind in ("and", "or"):
+        fs = tuple(_compile(n, get, text) for n in node[1])
+        if kind == "and":
+            return lambda: all(f() for f in fs)
+        return lambda: any(f() for f in fs)
+    if kind == "arith":
+        op = _ARITH[node[1]]
+        left, right = _compile(node[2], get, text), _compile(node[3], get, text)
+
+        def arith() -> Any:
+            try:
+                return op(left(), right())
+            except (ZeroDivisionError, TypeError) as exc:
+                raise ExprError(f"cannot compute {node[1]!r}: {exc}", text) from None
+        return arith
+    if kind == "compare":
+        ops = tuple(_COMPARE[o] for o in node[1])
+        fs = tuple(_compile(n, get, text) for n in node[2])
+
+        def compare() -> bool:
+            left = fs[0]()
+            for op, f in zip(ops, fs[1:], strict=True):
+                right = f()
+                try:
+                    if not op(left, right):
+                        return False
+                except TypeError as exc:
+                    raise ExprError(f"cannot compare: {exc}", text) from None
+                left = right
+            return True
+        return compare
+    if kind == "call":
+        func = FUNCTIONS[node[1]][0]
+        fs = tuple(_compile(n, get, text) for n in node[2])
+
+        def call() -> Any:
+            try:
+                return func(*(f() for f in fs))
+            except TypeError as exc:
+                raise ExprError(f"{node[1]}(): {exc}", text) from None
+        return call
+    raise AssertionError(f"unknown node {kind!r}")
+
+
+@dataclass(frozen=True)
+class Expression:
+    """A parsed condition: its text, its syntax tree and the names it reads."""
+
+    text: str
+    tree: Node
+    refs: tuple[Ref, ...]
+
+    def bind(self, get: Callable[[Ref], Callable[[], Any]]) -> Callable[[], Any]:
+        """A fast evaluator: ``get(ref)`` returns a getter per name, called once per name here.
+
+        Use it when the same condition is evaluated on every chart step.
+        """
+        return _compile(self.tree, get, self.text)
+
+    def evaluate(self, lookup: Callable[[Ref], Any]) -> Any:
+        """Evaluate once, ``lookup(ref)`` giving each name's value."""
+        return self.bind(lambda ref: lambda: lookup(ref))()
+
+    def __str__(self) -> str:
+        return self.text
+
+
+def parse(text: str) -> Expression:
+    """Parse a condition; raise :class:`ExprError` (with the column) if it is not one."""
+    if not isinstance(text, str):
+        raise ExprError(f"a condition is text, got {type(text).__name__} {text!r}")
+    parser = _Parser(text)
+    tree = parser.parse()
+    return Expression(text, tree, tuple(parser.refs))

@@ -1,0 +1,400 @@
+"""Read a scenario file and check it against the format and the charts it names.
+
+Every mistake is a :class:`~.errors.ScenarioError` naming the file and the line:
+an unknown step kind, chart, state, datum, event or signal (with the names
+there are, and a guess at what was meant), a value of the wrong type, a missing
+``timeout_s``, a condition that does not parse.  Nothing runs before the whole
+file is known to be right.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+from .errors import ScenarioError
+from .expr import Expression, ExprError, parse
+from .model import (
+    Catalog,
+    ChartRef,
+    ExpectStatesStep,
+    ExpectStep,
+    MarkStep,
+    PostStep,
+    ReleaseStep,
+    RunStep,
+    RunUntilStep,
+    Scenario,
+    SetStep,
+    Start,
+    Step,
+    Where,
+    chart_data,
+    chart_states,
+)
+from .source import MarkedDict, MarkedList, load_yaml, load_yaml_file
+
+TOP_KEYS = ("name", "description", "seed", "start", "steps")
+#: Step kinds, and the extra keys each allows beside its own.
+STEP_OPTIONS: dict[str, tuple[str, ...]] = {
+    "set": ("force",),
+    "release": (),
+    "post": (),
+    "run": (),
+    "run_until": (),
+    "expect": (),
+    "expect_states": (),
+    "mark": (),
+}
+MATCH_MODES = ("subsequence", "exact")
+
+
+def _guess(word: object, options: Iterable[str]) -> str:
+    close = difflib.get_close_matches(str(word), list(options), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _type_name(value: Any) -> str:
+    if value is None:
+        return "nothing"
+    if isinstance(value, bool):
+        return f"boolean {str(value).lower()}"
+    if isinstance(value, (int, float)):
+        return f"number {value}"
+    if isinstance(value, str):
+        return f"text {value!r}"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, dict):
+        return "a mapping"
+    return type(value).__name__
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+class _Checker:
+    """Turns the YAML data of one file into a :class:`Scenario`, or raises at the first mistake."""
+
+    def __init__(self, file: str, catalog: Catalog) -> None:
+        self.file = file
+        self.catalog = catalog
+
+    def error(self, line: int, message: str) -> ScenarioError:
+        return ScenarioError(self.file, line, message)
+
+    # -- top level -------------------------------------------------------------------
+
+    def scenario(self, doc: Any) -> Scenario:
+        if not isinstance(doc, MarkedDict):
+            line = getattr(doc, "line", 1)
+            raise self.error(line, "a scenario file is a mapping with name: and steps: (got "
+                                   f"{_type_name(doc)})")
+        self.keys(doc, TOP_KEYS, "scenario")
+        for key in ("name", "steps"):
+            if key not in doc:
+                raise self.error(doc.line, f"missing {key}:")
+        name = self.text(doc, "name")
+        description = self.text(doc, "description") if "description" in doc else ""
+        seed = doc.get("seed", 0)
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise self.error(doc.line_of("seed"), f"seed: expected a whole number >= 0, got {_type_name(seed)}")
+        start = self.start(doc["start"], doc.line_of("start")) if "start" in doc else Start()
+        steps_data = doc["steps"]
+        if not isinstance(steps_data, MarkedList) or not steps_data:
+            raise self.error(doc.line_of("steps"), "steps: expected a list of steps, each starting with '- '")
+        steps = tuple(self.step(item, line) for item, line in zip(steps_data, steps_data.item_lines,
+                                                                      strict=True))
+        return Scenario(name=name, file=self.file, steps=steps, description=description, seed=seed,
+                        start=start, where=Where(self.file, doc.line))
+
+    def keys(self, mapping: MarkedDict, allowed: Iterable[str], what: str) -> None:
+        allowed = tuple(allowed)
+        for key in mapping:
+            if key not in allowed:
+                raise self.error(mapping.key_lines[key], f"{what}: unknown key {key!r}{_guess(key, allowed)};"
+                                                         f" keys: {', '.join(allowed)}")
+
+    def text(self, mapping: MarkedDict, key: str) -> str:
+        value = mapping[key]
+        if not isinstance(value, str) or not value.strip():
+            raise self.error(mapping.line_of(key), f"{key}: expected text, got {_type_name(value)}")
+        return value.strip()
+
+    def number(self, mapping: MarkedDict, key: str, what: str, positive: bool = True) -> float:
+        value = mapping[key]
+        line = mapping.line_of(key)
+        if not _is_number(value):
+            raise self.error(line, f"{what}: {key} expected a number, got {_type_name(value)}")
+        if positive and value <= 0:
+            raise self.error(line, f"{what}: {key} must be > 0, got {value}")
+        if not positive and value < 0:
+            raise self.error(line, f"{what}: {key} must be >= 0, got {value}")
+        return float(value)
+
+    def start(self, data: Any, line: int) -> Start:
+        if not isinstance(data, MarkedDict):
+            raise self.error(line, f"start: expected a mapping with q_deg: and settle_s:, got {_type_name(data)}")
+        self.keys(data, ("q_deg", "settle_s"), "start")
+        q_deg: tuple[float, ...] | None = None
+        if "q_deg" in data:
+            q = data["q_deg"]
+            if not isinstance(q, list) or len(q) not in (3, 4) or not all(_is_number(v) for v in q):
+                raise self.error(data.line_of("q_deg"), "start: q_deg expected a list of 3 or 4 joint angles in"
+                                                        f" degrees (q1, q2, q3[, q4]), got {q!r}")
+            q_deg = tuple(float(v) for v in q) + ((0.0,) if len(q) == 3 else ())
+        settle = self.number(data, "settle_s", "start", positive=False) if "settle_s" in data else 0.0
+        return Start(q_deg=q_deg, settle_s=settle, where=Where(self.file, data.line))
+
+    # -- steps -------------------------------------------------------------------------
+
+    def step(self, item: Any, line: int) -> Step:
+        if not isinstance(item, MarkedDict) or not item:
+            raise self.error(line, f"a step is a mapping like 'run: {{seconds: 1}}', got {_type_name(item)};"
+                                   f" step kinds: {', '.join(STEP_OPTIONS)}")
+        kinds = [k for k in item if k in STEP_OPTIONS]
+        if not kinds:
+            key = next(iter(item))
+            raise self.error(item.key_lines[key], f"unknown step kind {key!r}{_guess(key, STEP_OPTIONS)};"
+                                                  f" step kinds: {', '.join(STEP_OPTIONS)}")
+        if len(kinds) > 1:
+            raise self.error(item.key_lines[kinds[1]], f"one step, two actions ({kinds[0]!r} and {kinds[1]!r}):"
+                                                       " start a new step with '- '")
+        kind = kinds[0]
+        self.keys(item, (kind, *STEP_OPTIONS[kind]), kind)
+        where = Where(self.file, item.key_lines[kind])
+        handler: Callable[[Any, int, Where, MarkedDict], Step] = getattr(self, f"step_{kind}")
+        return handler(item[kind], item.line_of(kind), where, item)
+
+    def step_set(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        if not isinstance(value, MarkedDict) or not value:
+            raise self.error(line, "set: expected a mapping like {DriveInit1.stop: true}, got "
+                                   f"{_type_name(value)}")
+        force = item.get("force", False)
+        if not isinstance(force, bool):
+            raise self.error(item.line_of("force"), f"force: expected true or false, got {_type_name(force)}")
+        values = []
+        for key, v in value.items():
+            ref = self.chart_ref(key, value.key_lines[key], "set", want="input")
+            decl = next(d for d in self.catalog.charts[ref.chart].declarations() if d.name == ref.name)
+            default = decl.default
+            if isinstance(default, bool) and not isinstance(v, bool):
+                raise self.error(value.line_of(key), f"set: {ref} is a flag: expected true or false,"
+                                                     f" got {_type_name(v)}")
+            if _is_number(default) and not isinstance(default, bool) and not _is_number(v):
+                raise self.error(value.line_of(key), f"set: {ref} is a number ({decl.unit}): expected a"
+                                                     f" number, got {_type_name(v)}")
+            values.append((ref, float(v) if _is_number(default) and not isinstance(default, bool) else v))
+        return SetStep(where, tuple(values), force)
+
+    def step_release(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        names = value if isinstance(value, list) else [value]
+        lines = value.item_lines if isinstance(value, MarkedList) else [line]
+        if not names:
+            raise self.error(line, "release: expected Chart.input or a list of them")
+        refs = tuple(self.chart_ref(n, n_line, "release", want="input") for n, n_line in zip(names, lines,
+                                                                                                 strict=True))
+        return ReleaseStep(where, refs)
+
+    def step_post(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        if not isinstance(value, MarkedDict):
+            raise self.error(line, f"post: expected {{chart: ..., event: ..., data: {{...}}}}, got {_type_name(value)}")
+        self.keys(value, ("chart", "event", "data"), "post")
+        for key in ("chart", "event"):
+            if key not in value:
+                raise self.error(value.line, f"post: missing {key}:")
+        chart = self.chart_name(value["chart"], value.line_of("chart"), "post")
+        event = value["event"]
+        events = self.catalog.charts[chart].structure().user_events
+        if event not in events:
+            raise self.error(value.line_of("event"), f"post: {chart} handles no event {event!r}{_guess(event, events)};"
+                                                     f" events: {', '.join(events) or '(none: all its transitions are tick transitions)'}")
+        data = value.get("data", {})
+        if not isinstance(data, dict) or not all(isinstance(k, str) and k.isidentifier() for k in data):
+            raise self.error(value.line_of("data"), "post: data expected a mapping of names to values")
+        return PostStep(where, chart, str(event), dict(data))
+
+    def step_run(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        if not isinstance(value, MarkedDict) or len(value) != 1:
+            raise self.error(line, f"run: expected {{seconds: S}} or {{chart_steps: N}}, got {_type_name(value)}")
+        self.keys(value, ("seconds", "chart_steps"), "run")
+        if "seconds" in value:
+            return RunStep(where, seconds=self.number(value, "seconds", "run"))
+        steps = value["chart_steps"]
+        if isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
+            raise self.error(value.line_of("chart_steps"), f"run: chart_steps expected a whole number >= 1,"
+                                                           f" got {_type_name(steps)}")
+        return RunStep(where, chart_steps=steps)
+
+    def step_run_until(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        goals = ("entered", "active", "condition")
+        if not isinstance(value, MarkedDict):
+            raise self.error(line, "run_until: expected {entered: Chart.state, timeout_s: T}, {active: ...}"
+                                   f" or {{condition: \"...\", timeout_s: T}}, got {_type_name(value)}")
+        self.keys(value, (*goals, "timeout_s"), "run_until")
+        given = [g for g in goals if g in value]
+        if len(given) != 1:
+            raise self.error(value.line, f"run_until: give exactly one of {', '.join(goals)}"
+                                         f" (got {', '.join(given) or 'none'})")
+        if "timeout_s" not in value:
+            raise self.error(value.line, "run_until: missing timeout_s: (seconds of simulated time after"
+                                         " which the step fails)")
+        timeout = self.number(value, "timeout_s", "run_until")
+        goal = given[0]
+        if goal == "condition":
+            cond = self.condition(value["condition"], value.line_of("condition"), "run_until")
+            return RunUntilStep(where, timeout, condition=cond)
+        ref = self.chart_ref(value[goal], value.line_of(goal), "run_until", want="state")
+        return RunUntilStep(where, timeout, **{goal: ref})
+
+    def step_expect(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        if isinstance(value, str):
+            return ExpectStep(where, self.condition(value, line, "expect"))
+        if not isinstance(value, MarkedDict):
+            raise self.error(line, f"expect: expected a condition or {{condition: ..., within_s: T}},"
+                                   f" got {_type_name(value)}")
+        self.keys(value, ("condition", "within_s", "for_s"), "expect")
+        if "condition" not in value:
+            raise self.error(value.line, "expect: missing condition:")
+        if "within_s" in value and "for_s" in value:
+            raise self.error(value.line_of("for_s"), "expect: within_s (holds at some moment) and for_s"
+                                                     " (holds all the time) exclude each other")
+        cond = self.condition(value["condition"], value.line_of("condition"), "expect")
+        within = self.number(value, "within_s", "expect") if "within_s" in value else None
+        for_s = self.number(value, "for_s", "expect") if "for_s" in value else None
+        return ExpectStep(where, cond, within_s=within, for_s=for_s)
+
+    def step_expect_states(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        if not isinstance(value, MarkedDict):
+            raise self.error(line, "expect_states: expected {chart: ..., sequence: [...]}, got "
+                                   f"{_type_name(value)}")
+        self.keys(value, ("chart", "sequence", "match"), "expect_states")
+        for key in ("chart", "sequence"):
+            if key not in value:
+                raise self.error(value.line, f"expect_states: missing {key}:")
+        chart = self.chart_name(value["chart"], value.line_of("chart"), "expect_states")
+        match = value.get("match", "subsequence")
+        if match not in MATCH_MODES:
+            raise self.error(value.line_of("match"), f"expect_states: match expected one of"
+                                                     f" {', '.join(MATCH_MODES)}, got {_type_name(match)}")
+        seq = value["sequence"]
+        if not isinstance(seq, MarkedList) or not seq:
+            raise self.error(value.line_of("sequence"), "expect_states: sequence expected a list of state"
+                                                        f" names, got {_type_name(seq)}")
+        states = chart_states(self.catalog.charts[chart])
+        for name, n_line in zip(seq, seq.item_lines, strict=True):
+            self.state_name(chart, name, n_line, "expect_states", states)
+            if match == "exact" and states[name] == "compound":
+                raise self.error(n_line, f"expect_states: {chart}.{name} is a compound state; an exact"
+                                         " sequence lists the leaf states entered (use match: subsequence"
+                                         " to include compound states)")
+        return ExpectStatesStep(where, chart, tuple(seq), match)
+
+    def step_mark(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        if value is not None and not isinstance(value, str):
+            raise self.error(line, f"mark: expected a label (text) or nothing, got {_type_name(value)}")
+        return MarkStep(where, value or "")
+
+    # -- names -------------------------------------------------------------------------
+
+    def chart_name(self, name: Any, line: int, what: str) -> str:
+        charts = self.catalog.charts
+        if not isinstance(name, str) or name not in charts:
+            raise self.error(line, f"{what}: unknown chart {name!r}{_guess(name, charts)};"
+                                   f" charts: {', '.join(charts)}")
+        return name
+
+    def state_name(self, chart: str, name: Any, line: int, what: str,
+                   states: dict[str, str] | None = None) -> str:
+        states = states if states is not None else chart_states(self.catalog.charts[chart])
+        if not isinstance(name, str) or name not in states:
+            real = [s for s, k in states.items() if k != "history"]
+            raise self.error(line, f"{what}: {chart} has no state {name!r}{_guess(name, real)};"
+                                   f" states: {', '.join(real)}")
+        if states[name] == "history":
+            raise self.error(line, f"{what}: {chart}.{name} is a history pseudo-state: it is never entered"
+                                   " itself; name the state it restores")
+        return name
+
+    def chart_ref(self, text: Any, line: int, what: str, want: str) -> ChartRef:
+        """``Chart.name`` where name must be an ``input`` or a ``state``."""
+        if not isinstance(text, str) or text.count(".") != 1:
+            example = "DriveInit1.stop" if want == "input" else "DriveInit1.turn_back"
+            raise self.error(line, f"{what}: expected Chart.{want} like {example}, got {_type_name(text)}")
+        chart, name = text.split(".")
+        self.chart_name(chart, line, what)
+        cls = self.catalog.charts[chart]
+        if want == "state":
+            self.state_name(chart, name, line, what)
+            return ChartRef(chart, name)
+        data = chart_data(cls)
+        inputs = [n for n, k in data.items() if k == "input"]
+        if name not in inputs:
+            kind = f" is an {data[name]}, not an input" if name in data else f" has no input {name!r}"
+            raise self.error(line, f"{what}: {chart}{kind}{_guess(name, inputs)}; inputs: {', '.join(inputs)}")
+        return ChartRef(chart, name)
+
+    def condition(self, text: Any, line: int, what: str) -> Expression:
+        try:
+            expr = parse(text)
+        except ExprError as exc:
+            raise self.error(line, f"{what}: {exc}") from None
+        for ref in expr.refs:
+            self.expr_ref(ref, expr, line, what)
+        return expr
+
+    def expr_ref(self, ref: Any, expr: Expression, line: int, what: str) -> None:
+        at = f" in {expr.text!r}"
+        if ref.chart is not None:
+            self.chart_name(ref.chart, line, what)
+            cls = self.catalog.charts[ref.chart]
+            data, states = chart_data(cls), chart_states(cls)
+            if ref.name in states and states[ref.name] == "history":
+                raise self.error(line, f"{what}: {ref.chart}.{ref.name} is a history pseudo-state, never"
+                                       f" active{at}")
+            if ref.name not in data and ref.name not in states:
+                names = [*data, *(s for s, k in states.items() if k != "history")]
+                raise self.error(line, f"{what}: {ref.chart} has no datum or state {ref.name!r}"
+                                       f"{_guess(ref.name, names)}{at}; data: {', '.join(data)}")
+            if ref.index is not None:
+                raise self.error(line, f"{what}: {ref.chart}.{ref.name} is not a list: no [{ref.index}]{at}")
+            return
+        signals = self.catalog.signals
+        if ref.name not in signals:
+            raise self.error(line, f"{what}: unknown name {ref.name!r}{_guess(ref.name, signals)}{at};"
+                                   f" a chart datum is Chart.name; signals: {', '.join(signals)}")
+        size = signals[ref.name]
+        if size is None and ref.index is not None:
+            raise self.error(line, f"{what}: signal {ref.name} is a single value: no [{ref.index}]{at}")
+        if size is not None and ref.index is None:
+            raise self.error(line, f"{what}: signal {ref.name} has {size} values: pick one, e.g."
+                                   f" {ref.name}[1]{at}")
+        if size is not None and ref.index is not None and not 1 <= ref.index <= size:
+            raise self.error(line, f"{what}: {ref.name}[{ref.index}] out of range: {ref.name} has {size}"
+                                   f" values, numbered from 1 as the thesis numbers joints: [1] to"
+                                   f" [{size}]{at}")
+
+
+def load_scenario_text(text: str, file: str = "<scenario>", catalog: Catalog | None = None) -> Scenario:
+    """Load a scenario from YAML text (``file`` names it in errors)."""
+    return _Checker(file, catalog or Catalog.default()).scenario(load_yaml(text, file))
+
+
+def load_scenario(path: str | Path, catalog: Catalog | None = None) -> Scenario:
+    """Load and check a scenario file; raise :class:`ScenarioError` naming the file and line."""
+    return _Checker(str(path), catalog or Catalog.default()).scenario(load_yaml_file(path))
+
+
+def scenario_files(paths: Iterable[str | Path]) -> list[Path]:
+    """The scenario files named: files as given, folders as their ``*.yaml``/``*.yml`` files, sorted."""
+    out: list[Path] = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            out += sorted(f for f in p.iterdir() if f.suffix in (".yaml", ".yml") and f.is_file())
+        else:
+            out.append(p)
+    return out

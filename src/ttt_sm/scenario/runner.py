@@ -1,0 +1,485 @@
+"""Run scenarios on the simulated robot and say, with file:line, what did not happen.
+
+One scenario builds one :class:`~ttt_sm.app.robot.Robot` from its ``seed`` and
+``start``, then runs its steps in order.  Steps that only look or set
+(``set``, ``release``, ``post``, ``expect``, ``expect_states``, ``mark``) take
+no simulated time; ``run``, ``run_until`` and ``expect`` with ``within_s`` /
+``for_s`` advance the robot by whole chart steps.
+
+A failed expectation is recorded and the scenario goes on, so one run shows
+every wrong expectation.  A step that leaves the robot somewhere the next steps
+do not expect stops the scenario: a ``run_until`` that times out, an input set
+without ``force`` that the wiring overwrote, an error raised by a chart.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from ..params import ArmParams
+from ..runtime import TickChart, states_entered_by
+from ..runtime.listeners import Coverage, CoverageReport, Trace
+from .expr import Expression, ExprError, Ref
+from .model import (
+    ChartRef,
+    ExpectStatesStep,
+    ExpectStep,
+    MarkStep,
+    PostStep,
+    ReleaseStep,
+    RunStep,
+    RunUntilStep,
+    Scenario,
+    SetStep,
+    Step,
+    Where,
+    chart_states,
+)
+
+
+class RobotLike(Protocol):
+    """What the runner needs from a robot (:class:`~ttt_sm.app.robot.Robot` has it all)."""
+
+    params: ArmParams
+    charts: dict[str, TickChart]
+
+    @property
+    def t(self) -> float: ...
+    def chart(self, name: str) -> TickChart: ...
+    def run_until(self, predicate: Callable[[], bool], timeout_s: float) -> bool: ...
+    def set_input(self, chart: str, name: str, value: Any, force: bool = False) -> None: ...
+    def release(self, chart: str, name: str) -> None: ...
+    def post(self, chart: str, event: str, **data: Any) -> None: ...
+    def value(self, chart: str, name: str) -> Any: ...
+    def active(self, chart: str) -> set[str]: ...
+    def signal_values(self) -> dict[str, Any]: ...
+
+
+#: Builds the robot of a scenario: (scenario, params, listeners) -> robot.
+RobotFactory = Callable[[Scenario, ArmParams, Sequence[object]], RobotLike]
+
+
+def default_robot(scenario: Scenario, params: ArmParams, listeners: Sequence[object]) -> RobotLike:
+    """The simulated robot at the scenario's power-on pose."""
+    from ..app.robot import Robot
+
+    q = np.radians(scenario.start.q_deg) if scenario.start.q_deg is not None else None
+    return Robot(params, seed=scenario.seed, q_start=q, settle_s=scenario.start.settle_s,
+                 listeners=listeners)
+
+
+@dataclass(frozen=True)
+class Failure:
+    """What went wrong, at which step."""
+
+    where: Where
+    message: str
+
+    def __str__(self) -> str:
+        return f"{self.where}: {self.message}"
+
+
+@dataclass(frozen=True)
+class ScenarioResult:
+    """The outcome of one scenario."""
+
+    name: str
+    file: str
+    failures: tuple[Failure, ...]
+    sim_time_s: float
+    wall_time_s: float
+    steps_run: int
+    steps_total: int
+
+    @property
+    def passed(self) -> bool:
+        return not self.failures
+
+    def to_dict(self) -> dict[str, Any]:
+        """What ``ttt-sm scenario run --json`` prints per scenario."""
+        return {
+            "name": self.name,
+            "file": self.file,
+            "passed": self.passed,
+            "failures": [str(f) for f in self.failures],
+            "sim_time_s": round(self.sim_time_s, 4),
+            "wall_time_s": round(self.wall_time_s, 3),
+            "steps_run": self.steps_run,
+            "steps_total": self.steps_total,
+        }
+
+
+@dataclass(frozen=True)
+class Entry:
+    """A state entered by a chart."""
+
+    state: str
+    tick: int
+    t: float
+
+
+class StateLog:
+    """Listener: the states each chart entered, in order (compound states too)."""
+
+    def __init__(self) -> None:
+        self.entries: dict[str, list[Entry]] = {}
+        self.clock: Callable[[], float] = lambda: 0.0
+
+    def record_initial(self, charts: Iterable[TickChart]) -> None:
+        """The states active at construction count as entered then (parents first)."""
+        for chart in charts:
+            active = set(chart.configuration_values)
+            log = self.entries.setdefault(chart.chart_name, [])
+            log += [Entry(s.id, chart.tick_count, self.clock()) for s in chart.structure().states
+                    if s.id in active]
+
+    def after_transition(self, machine: TickChart, transition: Any) -> None:
+        log = self.entries.setdefault(machine.chart_name, [])
+        now = self.clock()
+        log += [Entry(s.id, machine.tick_count, now) for s in states_entered_by(machine, transition)]
+
+
+class _Stop(Exception):
+    """Ends a scenario at a failure the next steps cannot build on."""
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.6g}"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    return repr(value)
+
+
+def _seconds(s: float) -> str:
+    return f"{s:g} s"
+
+
+def _subsequence_gap(expected: Sequence[str], actual: Sequence[str]) -> str | None:
+    """None if `expected` is a subsequence of `actual`, else what is missing."""
+    pos = 0
+    for k, state in enumerate(expected):
+        try:
+            pos = actual.index(state, pos) + 1
+        except ValueError:
+            after = f" after {expected[k - 1]}" if k else ""
+            return f"no {state}{after}"
+    return None
+
+
+class _Run:
+    """The steps of one scenario on one robot."""
+
+    def __init__(self, scenario: Scenario, robot: RobotLike, log: StateLog) -> None:
+        self.scenario = scenario
+        self.robot = robot
+        self.log = log
+        self.chart_dt = robot.params.control.chart_dt
+        self.failures: list[Failure] = []
+        self.mark: dict[str, int] = {name: 0 for name in robot.charts}  # the initial states count
+        self.mark_label = "the start"
+        self.pending_sets: list[tuple[SetStep, ChartRef, Any]] = []
+        self.steps_run = 0
+
+    # -- running -----------------------------------------------------------------------
+
+    def run(self) -> None:
+        for step in self.scenario.steps:
+            self.steps_run += 1
+            try:
+                getattr(self, f"do_{step.kind}")(step)
+            except _Stop:
+                return
+            except ExprError as exc:
+                self.failures.append(Failure(step.where, f"{step.kind}: {exc}"))
+                return
+            except Exception as exc:  # a chart's bug or a robot refusal: report it where it happened
+                self.failures.append(Failure(step.where, f"{step.kind}: {type(exc).__name__}: {exc}"))
+                return
+
+    def fail(self, step: Step, message: str, stop: bool = False) -> None:
+        self.failures.append(Failure(step.where, message))
+        if stop:
+            raise _Stop
+
+    def advance(self, timeout_s: float, until: Callable[[], bool] | None = None) -> bool:
+        """Run chart steps until `until()` holds (checked after each) or `timeout_s` passes."""
+        def predicate() -> bool:
+            if self.pending_sets:
+                self.check_pending_sets()
+            return until() if until is not None else False
+        return self.robot.run_until(predicate, timeout_s)
+
+    def check_pending_sets(self) -> None:
+        pending, self.pending_sets = self.pending_sets, []
+        for step, ref, value in pending:
+            now = self.robot.value(ref.chart, ref.name)
+            if now != value:
+                self.fail(step, f"set: {ref} was overwritten at the next chart step (now {_fmt(now)}):"
+                                " the wiring feeds this input every chart step; add 'force: true' to"
+                                " the step to hold it, and release it later", stop=True)
+
+    # -- conditions ----------------------------------------------------------------------
+
+    def getter(self, ref: Ref) -> Callable[[], Any]:
+        robot = self.robot
+        if ref.chart is not None:
+            chart = robot.chart(ref.chart)
+            name = ref.name
+            if name in {d.name for d in chart.declarations()}:
+                return lambda: getattr(chart, name)
+            return lambda: name in chart.configuration_values
+        if ref.name == "t":
+            return lambda: robot.t
+        sim = getattr(robot, "sim", None)
+        i = ref.index - 1 if ref.index is not None else None  # written 1-based, as the thesis numbers joints
+        if sim is not None and ref.name in ("q_true", "q_encoder", "offset_estimate"):
+            attr = ref.name
+            return lambda: float(getattr(sim, attr)[i])
+        name = ref.name
+        if i is None:
+            return lambda: robot.signal_values()[name]
+        return lambda: robot.signal_values()[name][i]
+
+    def bind(self, expr: Expression) -> Callable[[], Any]:
+        return expr.bind(self.getter)
+
+    def values(self, expr: Expression) -> str:
+        """The names a condition reads, with their values now."""
+        seen: dict[str, str] = {}
+        for ref in expr.refs:
+            if str(ref) not in seen:
+                seen[str(ref)] = _fmt(self.getter(ref)())
+        listed = "; ".join(f"{k} = {v}" for k, v in seen.items())
+        return f"t = {self.robot.t:.3f} s" + (f"; {listed}" if listed else "")
+
+    def where_is(self, chart: str) -> str:
+        cls = type(self.robot.chart(chart))
+        kinds = chart_states(cls)
+        leaves = [s for s in self.robot.chart(chart).configuration_values if kinds.get(s) == "leaf"]
+        return f"{chart} is in {', '.join(sorted(leaves)) or '(no state)'}"
+
+    # -- steps -----------------------------------------------------------------------------
+
+    def do_set(self, step: SetStep) -> None:
+        for ref, value in step.values:
+            self.robot.set_input(ref.chart, ref.name, value, force=step.force)
+            if not step.force:
+                self.pending_sets.append((step, ref, value))
+
+    def do_release(self, step: ReleaseStep) -> None:
+        for ref in step.targets:
+            self.robot.release(ref.chart, ref.name)
+
+    def do_post(self, step: PostStep) -> None:
+        self.robot.post(step.chart, step.event, **step.data)
+
+    def do_run(self, step: RunStep) -> None:
+        self.advance(step.duration_s(self.chart_dt))
+
+    def do_run_until(self, step: RunUntilStep) -> None:
+        robot = self.robot
+        t0 = robot.t
+        target = step.entered or step.active
+        seen = len(self.log.entries.get(target.chart, [])) if target is not None else 0
+        until: Callable[[], bool]
+        if step.entered is not None:
+            ref = step.entered
+            entries = self.log.entries.setdefault(ref.chart, [])
+            start = len(entries)
+            state = ref.name
+
+            def until() -> bool:
+                return len(entries) > start and any(e.state == state for e in entries[start:])
+        elif step.active is not None:
+            chart, state = robot.chart(step.active.chart), step.active.name
+            if state in chart.configuration_values:
+                return
+
+            def until() -> bool:
+                return state in chart.configuration_values
+        else:
+            assert step.condition is not None
+            cond = self.bind(step.condition)
+            if cond():
+                return
+            until = cond
+        if self.advance(step.timeout_s, until):
+            return
+        if step.condition is not None:
+            detail = f"values now: {self.values(step.condition)}"
+        else:
+            assert target is not None
+            since = [e.state for e in self.log.entries.get(target.chart, [])[seen:]]
+            entered = f"; it entered {', '.join(since)} meanwhile" if since else "; it entered no state meanwhile"
+            detail = f"{self.where_is(target.chart)}{entered}"
+        self.fail(step, f"run_until: {step.goal} did not happen within {_seconds(step.timeout_s)}"
+                        f" (from t = {t0:.3f} s to {robot.t:.3f} s); {detail}", stop=True)
+
+    def do_expect(self, step: ExpectStep) -> None:
+        cond = self.bind(step.condition)
+        text = step.condition.text
+        if step.within_s is not None:
+            if cond() or self.advance(step.within_s, cond):
+                return
+            self.fail(step, f"expect: {text!r} did not hold within {_seconds(step.within_s)};"
+                            f" {self.values(step.condition)}")
+        elif step.for_s is not None:
+            t0 = self.robot.t
+            if not cond():
+                self.fail(step, f"expect: {text!r} for {_seconds(step.for_s)}: false at once;"
+                                f" {self.values(step.condition)}")
+                return
+            if self.advance(step.for_s, lambda: not cond()):
+                self.fail(step, f"expect: {text!r} for {_seconds(step.for_s)}: false after"
+                                f" {self.robot.t - t0:.3f} s; {self.values(step.condition)}")
+        elif not cond():
+            self.fail(step, f"expect: {text!r} is false; {self.values(step.condition)}")
+
+    def do_expect_states(self, step: ExpectStatesStep) -> None:
+        entries = self.log.entries.get(step.chart, [])[self.mark.get(step.chart, 0):]
+        actual = [e.state for e in entries]
+        expected = list(step.sequence)
+        if step.match == "exact":
+            kinds = chart_states(type(self.robot.chart(step.chart)))
+            actual = [s for s in actual if kinds.get(s) == "leaf"]
+            if actual == expected:
+                return
+            problem = "not exactly those"
+        else:
+            gap = _subsequence_gap(expected, actual)
+            if gap is None:
+                return
+            problem = gap
+        order = "exactly these leaf states" if step.match == "exact" else "these states in this order"
+        self.fail(step, f"expect_states: expected {step.chart} to enter {order} since {self.mark_label}:"
+                        f" {', '.join(expected)}; it entered {', '.join(actual) or 'nothing'}"
+                        f" ({problem}); {self.where_is(step.chart)}")
+
+    def do_mark(self, step: MarkStep) -> None:
+        self.mark = {name: len(self.log.entries.get(name, [])) for name in self.robot.charts}
+        self.mark_label = f"mark {step.label!r} (line {step.where.line})" if step.label else \
+            f"the mark on line {step.where.line}"
+
+
+def _check_start(scenario: Scenario, params: ArmParams) -> str | None:
+    """Why the power-on pose is impossible, or None."""
+    q = scenario.start.q_deg
+    if q is None:
+        return None
+    for k, (angle, drive) in enumerate(zip(q[:3], params.drives, strict=False)):
+        lo, hi = math.degrees(drive.limit_min_rad), math.degrees(drive.limit_max_rad)
+        if not lo <= angle <= hi:
+            return f"start: q{k + 1} = {angle:g} deg is beyond the joint's hard stops ({lo:g} .. {hi:g} deg)"
+    return None
+
+
+def run_scenario(scenario: Scenario, params: ArmParams, *, coverage: Coverage | None = None,
+                 listeners: Sequence[object] = (), robot_factory: RobotFactory | None = None) -> ScenarioResult:
+    """Run one loaded scenario on a new robot.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        From :func:`~.loader.load_scenario`.
+    params : ArmParams
+        The arm (``load_params()`` for the packaged one).
+    coverage : Coverage, optional
+        Observes the charts from construction (their initial states count), so
+        that several scenarios add up into one report.
+    listeners : sequence
+        More python-statemachine listeners for the charts (a :class:`Trace` ...).
+    robot_factory : callable, optional
+        Builds the robot (tests use a stand-in); the simulated arm by default.
+    """
+    wall0 = time.perf_counter()
+    start_where = scenario.start.where or scenario.where or Where(scenario.file, 0)
+    problem = _check_start(scenario, params)
+    if problem is not None:
+        return ScenarioResult(scenario.name, scenario.file, (Failure(start_where, problem),), 0.0,
+                              time.perf_counter() - wall0, 0, len(scenario.steps))
+    log = StateLog()
+    robot = (robot_factory or default_robot)(scenario, params, [log, *listeners])
+    log.clock = lambda: robot.t
+    log.record_initial(robot.charts.values())
+    if coverage is not None:
+        coverage.observe(*robot.charts.values())
+    run = _Run(scenario, robot, log)
+    run.run()
+    return ScenarioResult(scenario.name, scenario.file, tuple(run.failures), float(robot.t),
+                          time.perf_counter() - wall0, run.steps_run, len(scenario.steps))
+
+
+@dataclass(frozen=True)
+class RunReport:
+    """Several scenarios run together, with their joint coverage if asked for."""
+
+    results: tuple[ScenarioResult, ...]
+    coverage: CoverageReport | None = None
+    wall_time_s: float = 0.0
+
+    @property
+    def passed(self) -> bool:
+        return all(r.passed for r in self.results)
+
+    def to_dict(self) -> dict[str, Any]:
+        """What ``ttt-sm scenario run --json`` prints."""
+        out: dict[str, Any] = {
+            "passed": self.passed,
+            "scenarios": [r.to_dict() for r in self.results],
+            "counts": {"passed": sum(r.passed for r in self.results),
+                       "failed": sum(not r.passed for r in self.results)},
+            "sim_time_s": round(sum(r.sim_time_s for r in self.results), 3),
+            "wall_time_s": round(self.wall_time_s, 3),
+        }
+        if self.coverage is not None:
+            out["coverage"] = coverage_dict(self.coverage)
+        return out
+
+
+def coverage_dict(report: CoverageReport) -> dict[str, Any]:
+    """Per chart: states entered, transitions taken, and the missing ones."""
+    return {
+        c.chart: {
+            "states": f"{len(c.entered)}/{len(c.states)}",
+            "transitions": f"{len(c.taken)}/{len(c.transitions)}",
+            "complete": c.complete,
+            "entered": list(c.entered),
+            "taken": list(c.taken),
+            "missing_states": list(c.missing_states),
+            "missing_transitions": list(c.missing_transitions),
+        }
+        for c in report.charts
+    }
+
+
+def run_scenarios(scenarios: Iterable[Scenario], params: ArmParams, *, coverage: bool = False,
+                  trace_dir: str | Path | None = None,
+                  progress: Callable[[ScenarioResult], None] | None = None) -> RunReport:
+    """Run scenarios one after another; with ``coverage``, one report for them all.
+
+    ``trace_dir`` writes each scenario's transitions as JSON Lines,
+    ``<file stem>.jsonl``, to see what the charts did.
+    """
+    wall0 = time.perf_counter()
+    cov = Coverage() if coverage else None
+    results = []
+    for scenario in scenarios:
+        trace = Trace() if trace_dir is not None else None
+        result = run_scenario(scenario, params, coverage=cov, listeners=[trace] if trace else [])
+        if trace is not None and trace_dir is not None:
+            trace.write_jsonl(Path(trace_dir) / f"{Path(scenario.file).stem}.jsonl")
+        results.append(result)
+        if progress is not None:
+            progress(result)
+    return RunReport(tuple(results), cov.report() if cov is not None else None,
+                     time.perf_counter() - wall0)

@@ -1,0 +1,101 @@
+"""YAML with line numbers: a ``SafeLoader`` whose mappings and lists remember where they were.
+
+Scenario errors must name ``FILE:LINE``.  :class:`MarkedLoader` is PyYAML's
+``SafeLoader`` (no Python objects, only plain data) that builds
+:class:`MarkedDict` and :class:`MarkedList` instead of ``dict`` and ``list``:
+the same values, plus the line of every key, value and list item.  It also
+refuses a key given twice in one mapping, which plain YAML silently accepts
+(the second ``set:`` of a step would hide the first).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .errors import ScenarioError
+
+
+class MarkedDict(dict[Any, Any]):
+    """A YAML mapping; ``line`` is where it starts, ``key_lines``/``value_lines`` where each entry is."""
+
+    line: int
+    key_lines: dict[Any, int]
+    value_lines: dict[Any, int]
+
+    def line_of(self, key: Any) -> int:
+        """The line of ``key``'s value (the mapping's line if the key is absent)."""
+        return self.value_lines.get(key, self.line)
+
+
+class MarkedList(list[Any]):
+    """A YAML sequence; ``line`` is where it starts, ``item_lines[i]`` where item ``i`` is."""
+
+    line: int
+    item_lines: list[int]
+
+
+def _line(node: yaml.Node) -> int:
+    return node.start_mark.line + 1
+
+
+class MarkedLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that keeps line numbers and refuses duplicate keys."""
+
+    def construct_marked_map(self, node: yaml.MappingNode) -> Any:
+        data = MarkedDict()
+        data.line, data.key_lines, data.value_lines = _line(node), {}, {}
+        yield data
+        self.flatten_mapping(node)
+        for key_node, value_node in node.value:
+            key = self.construct_object(key_node, deep=True)
+            try:
+                hash(key)
+            except TypeError:
+                raise ScenarioError(self.name, _line(key_node), "a mapping key must be a plain value") from None
+            if key in data:
+                raise ScenarioError(self.name, _line(key_node),
+                                    f"key {key!r} given twice (first on line {data.key_lines[key]});"
+                                    " a step holds one action: start a new step with '- '")
+            data[key] = self.construct_object(value_node, deep=True)
+            data.key_lines[key] = _line(key_node)
+            data.value_lines[key] = _line(value_node)
+
+    def construct_marked_seq(self, node: yaml.SequenceNode) -> Any:
+        data = MarkedList()
+        data.line, data.item_lines = _line(node), [_line(n) for n in node.value]
+        yield data
+        data.extend(self.construct_object(n, deep=True) for n in node.value)
+
+
+MarkedLoader.add_constructor("tag:yaml.org,2002:map", MarkedLoader.construct_marked_map)
+MarkedLoader.add_constructor("tag:yaml.org,2002:seq", MarkedLoader.construct_marked_seq)
+
+
+def load_yaml(text: str, file: str) -> Any:
+    """Parse YAML text safely; a syntax error becomes a :class:`ScenarioError` at its line."""
+    loader = MarkedLoader(text)
+    loader.name = file
+    try:
+        return loader.get_single_data()
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else 0
+        problem = exc.problem or exc.context or "not valid YAML"
+        raise ScenarioError(file, line, f"not valid YAML: {problem}") from None
+    except yaml.YAMLError as exc:
+        raise ScenarioError(file, 0, f"not valid YAML: {exc}") from None
+    finally:
+        loader.dispose()
+
+
+def load_yaml_file(path: str | Path) -> Any:
+    """Read and parse a YAML file (see :func:`load_yaml`)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ScenarioError(str(path), 0, f"cannot read the file: {exc.strerror or exc}") from None
+    return load_yaml(text, str(path))

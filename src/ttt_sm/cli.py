@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .debug.cli import register as register_debug
 from .params import ParameterError, load_params
 from .scenario.cli import register as register_scenario
 
@@ -188,6 +189,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--out", default="charts", help="folder (default charts/)")
     add("params", cmd_params, "print the parameters in force (SI units)")
     register_scenario(sub)
+    register_debug(sub)
     return p
 
 

@@ -1,0 +1,77 @@
+"""``ttt-sm debug``: the subcommand that starts the debugger's REPL.
+
+:func:`register` adds it to the ``ttt-sm`` parser; the robot and the
+debugger are imported only when the command runs, so the CLI starts fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import Any
+
+
+def register(sub: Any) -> argparse.ArgumentParser:
+    """Add the ``debug`` subcommand to the subparsers of ``ttt-sm``."""
+    help_ = "step through the robot's charts: breakpoints, data, signals, trace, replay"
+    sp: argparse.ArgumentParser = sub.add_parser("debug", help=help_, description=help_)
+    sp.set_defaults(func=cmd_debug)
+    sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
+    sp.add_argument("--start", metavar="Q1,Q2,Q3[,Q4]", default=None,
+                    help="joint angles before power-on, degrees (default: the twin's rest pose)")
+    sp.add_argument("--settle", metavar="SECONDS", type=float, default=0.0,
+                    help="let the unpowered arm settle under gravity first (default 0)")
+    sp.add_argument("--commands", metavar="FILE", default=None,
+                    help="run the commands in FILE ('-': standard input) and quit;"
+                         " standard input is read the same way when it is not a terminal")
+    return sp
+
+
+def parse_start(text: str) -> tuple[float, ...]:
+    """``"0,10,-20"`` (degrees, 3 or 4 joints) -> radians, servo 0 if not given."""
+    try:
+        values = [float(v) for v in text.replace(" ", "").split(",") if v]
+    except ValueError:
+        raise ValueError(f"--start: expected 3 or 4 angles in degrees like 0,10,-20,0,"
+                         f" got {text!r}") from None
+    if len(values) not in (3, 4) or not all(math.isfinite(v) for v in values):
+        raise ValueError(f"--start: expected 3 or 4 finite angles in degrees, got {text!r}")
+    if len(values) == 3:
+        values.append(0.0)
+    return tuple(math.radians(v) for v in values)
+
+
+def cmd_debug(args: argparse.Namespace) -> int:
+    """Build the robot, then run the REPL: scripted (file or pipe) or interactive."""
+    from ..cli import CliError
+    from ..params import load_params
+    from .debugger import Debugger
+    from .shell import DebugShell
+
+    params = load_params(getattr(args, "params", None))
+    try:
+        q_start = parse_start(args.start) if args.start else None
+        if args.settle < 0 or not math.isfinite(args.settle):
+            raise ValueError(f"--settle must be >= 0 seconds, got {args.settle}")
+        dbg = Debugger.build(params, seed=args.seed, q_start=q_start, settle_s=args.settle)
+    except ValueError as exc:  # a bad pose (SimError), a bad option
+        raise CliError(str(exc)) from exc
+    shell = DebugShell(dbg)
+    start = "rest pose" if q_start is None else \
+        "(" + ", ".join(f"{math.degrees(v):.1f}" for v in q_start) + ") deg"
+    shell.say(f"ttt-sm debugger: seed {args.seed}, start {start}"
+              + (f", settled {args.settle:g} s" if args.settle else "")
+              + f"; charts {', '.join(dbg.chart_names)}. Type help.")
+    if args.commands and args.commands != "-":
+        try:
+            with open(args.commands, encoding="utf-8") as f:
+                shell.run_script(f)
+        except OSError as exc:
+            raise CliError(f"--commands: cannot read {args.commands}: {exc.strerror}") from exc
+    elif args.commands == "-" or not sys.stdin.isatty():
+        shell.run_script(sys.stdin)
+    else:
+        shell.interact()
+        return 0
+    return 1 if shell.errors else 0

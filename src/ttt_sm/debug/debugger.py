@@ -1,0 +1,411 @@
+"""The step-through debugger's engine: run, pause, step, breakpoints, inputs, replay.
+
+:class:`Debugger` drives a :class:`~ttt_sm.app.robot.Robot` one control step
+at a time and stops *between control steps*.  A chart tick is the first part
+of the control step it starts (every ``chart_divider``-th step), so when a
+breakpoint hits at chart tick *k* the debugger stops right after the control
+step holding tick *k*: the charts show the configuration and data that tick
+produced, and the twin has moved one control step (1 ms) since.
+
+It watches the charts through python-statemachine listeners only (a
+:class:`~ttt_sm.runtime.listeners.Trace` and a
+:class:`~.breakpoints.BreakListener`), so it sees exactly what the library did.
+
+Everything the user changes (inputs set or forced, events posted) is recorded
+with the control step it was applied at; :meth:`Debugger.replay` rebuilds the
+robot from its recipe (parameters, seed, power-on pose), re-applies them at the
+same steps and runs to a chart tick, and tells whether it arrived in exactly the
+state recorded when the session was there before.
+"""
+
+from __future__ import annotations
+
+import math
+import signal
+import threading
+from collections import deque
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from ..app.robot import Robot, RobotError
+from ..params import ArmParams
+from ..runtime import Data, TickChart, UnknownEventError
+from ..runtime.errors import GraphvizMissingError
+from ..runtime.export import render_active
+from ..runtime.listeners import Trace
+from .breakpoints import BreakListener, Breakpoint, ChartIndex, Hit, parse_breakpoint
+from .errors import DebugError
+from .names import RobotNames, datum_decl, parse_input_value
+from .records import Action, StopKind, StopReason
+from .replay import Recipe, ReplayResult, RobotRecipe, differences, fingerprint
+
+
+class Debugger:
+    """Step through a :class:`Robot`'s charts: the API under ``ttt-sm debug`` (and a GUI).
+
+    Parameters
+    ----------
+    robot : Robot
+        The robot to debug.  Listeners are added to its charts.
+    recipe : Recipe, optional
+        How to build the same robot again, for :meth:`replay`.  By default it
+        is read from the robot when it has not run yet (parameters, seed and
+        the pose it was powered on in); :meth:`build` records it too.
+    """
+
+    def __init__(self, robot: Robot, recipe: Recipe | None = None) -> None:
+        if recipe is None and robot.steps == 0:
+            recipe = RobotRecipe.of(robot)
+        self.recipe = recipe
+        self.breakpoints: list[Breakpoint] = []
+        self.listener = BreakListener(self.breakpoints)
+        self.actions: list[Action] = []
+        self.forced: dict[tuple[str, str], Any] = {}
+        self._next_id = 1
+        self._pause = threading.Event()
+        self._fingerprints: dict[int, dict[str, Any]] = {}
+        self._names = RobotNames(lambda: self.robot)
+        self._attach(robot)
+        self._remember()
+
+    @classmethod
+    def build(cls, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
+              settle_s: float = 0.0) -> Debugger:
+        """A debugger on a new robot, with its recipe for :meth:`replay`."""
+        recipe = RobotRecipe(params, seed, None if q_start is None else tuple(float(v) for v in q_start),
+                             settle_s)
+        return cls(recipe.build(), recipe)
+
+    def _attach(self, robot: Robot) -> None:
+        self.robot = robot
+        self.trace = Trace()
+        for chart in robot.charts.values():
+            chart.add_listener(self.trace, self.listener)
+        self.index = ChartIndex(dict(robot.charts))
+        self._divider = robot.params.control.chart_divider
+        self._dt = robot.params.control.dt
+        self._names.forget()
+
+    # -- where we are ------------------------------------------------------------
+
+    @property
+    def chart_names(self) -> list[str]:
+        return list(self.robot.charts)
+
+    def chart(self, name: str) -> TickChart:
+        """A chart by name; :class:`DebugError` names the charts there are."""
+        self.index.structure(name)
+        return self.robot.charts[name]
+
+    def where(self) -> dict[str, list[str]]:
+        """Each chart's active states, outermost first (document order)."""
+        out = {}
+        for name, chart in self.robot.charts.items():
+            active = set(chart.configuration_values)
+            out[name] = [s.id for s in type(chart).structure().states if s.id in active]
+        return out
+
+    def signals(self) -> dict[str, Any]:
+        """The robot's signals now (SI units)."""
+        return self.robot.signal_values()
+
+    def datum_decl(self, chart: str, name: str) -> Data:
+        """The declaration of a chart datum (name, unit, default, doc, kind)."""
+        return datum_decl(self.robot, chart, name)
+
+    # -- breakpoints -------------------------------------------------------------
+
+    def add_breakpoint(self, text: str) -> Breakpoint:
+        """Add a breakpoint from its command text, e.g. ``"enter DriveInit1.turn_back"``,
+        ``"transition DriveInit1 turn_fwd->turn_back"``, ``"event DriveInit1.tick"``,
+        ``"when DriveInit1.pos_Encoder > 1.0"``."""
+        bp = parse_breakpoint(self._next_id, text, self.index, self._names)
+        if bp.condition is not None:
+            bp.last_value = bp.condition.evaluate(self._names)
+        self._next_id += 1
+        self.breakpoints.append(bp)
+        return bp
+
+    def _find(self, bp_id: int) -> Breakpoint:
+        for bp in self.breakpoints:
+            if bp.id == bp_id:
+                return bp
+        known = ", ".join(str(b.id) for b in self.breakpoints) or "none"
+        raise DebugError(f"no breakpoint {bp_id}; breakpoints: {known}")
+
+    def delete(self, bp_id: int | None = None) -> None:
+        """Delete one breakpoint, or all of them (``None``)."""
+        if bp_id is None:
+            self.breakpoints.clear()
+        else:
+            self.breakpoints.remove(self._find(bp_id))
+
+    def enable(self, bp_id: int, enabled: bool = True) -> None:
+        bp = self._find(bp_id)
+        if enabled and not bp.enabled and bp.condition is not None:
+            bp.last_value = bp.condition.evaluate(self._names)  # hits when it *becomes* true
+        bp.enabled = enabled
+
+    def disable(self, bp_id: int) -> None:
+        self.enable(bp_id, False)
+
+    # -- running -----------------------------------------------------------------
+
+    def pause(self) -> None:
+        """Ask a running :meth:`run` / :meth:`next` to stop after the current control step.
+
+        Safe to call from another thread (a GUI's pause button).
+        """
+        self._pause.set()
+
+    def step(self, n: int = 1) -> StopReason:
+        """Run ``n`` control steps (fewer if a breakpoint hits)."""
+        _check_count(n, "step")
+        return self._advance(n, end="done")
+
+    def tick(self, n: int = 1) -> StopReason:
+        """Run up to and through the next ``n`` chart ticks (fewer if a breakpoint hits)."""
+        _check_count(n, "tick")
+        return self._advance((n + 1) * self._divider, ticks=n, end="done")
+
+    def next(self, timeout_s: float = 10.0) -> StopReason:
+        """Run until some chart takes a transition, at most ``timeout_s`` simulated seconds."""
+        return self._advance(self._steps_for(timeout_s, "next"), until_transition=True, end="timeout")
+
+    def run(self, max_seconds: float = 60.0) -> StopReason:
+        """Run until a breakpoint hits, ``max_seconds`` of simulated time pass, or a pause."""
+        return self._advance(self._steps_for(max_seconds, "run"), end="timeout")
+
+    def _steps_for(self, seconds: float, what: str) -> int:
+        if not (isinstance(seconds, (int, float)) and math.isfinite(seconds) and seconds > 0):
+            raise DebugError(f"{what}: the time must be a positive number of seconds, got {seconds!r}")
+        return max(1, int(round(seconds / self._dt)))
+
+    def _advance(self, max_steps: int, *, ticks: int | None = None, until_transition: bool = False,
+                 end: StopKind = "timeout") -> StopReason:
+        robot = self.robot
+        listener = self.listener
+        charts = list(robot.charts.values())
+        divider = self._divider
+        listener.hits.clear()
+        self._pause.clear()
+        first = len(self.trace.records)
+        ticks_done = 0
+        kind: StopKind = end
+        when = [bp for bp in self.breakpoints if bp.enabled and bp.kind == "when"]
+        watch_events = any(bp.enabled and bp.kind == "event" for bp in self.breakpoints)
+        with self._sigint_pauses():
+            for _ in range(max_steps):
+                ticking = robot.steps % divider == 0
+                pending = [[e for e, _ in c.pending_events] for c in charts] \
+                    if ticking and watch_events else None
+                mark = len(self.trace.records)
+                robot.control_step()
+                if ticking:
+                    ticks_done += 1
+                    if pending is not None:
+                        for chart, events in zip(charts, pending, strict=True):
+                            if events:
+                                listener.events_handled(chart, events)
+                    if when:
+                        self._check_conditions(when)
+                if listener.hits:
+                    kind = "breakpoint"
+                    break
+                if until_transition and len(self.trace.records) > mark:
+                    kind = "transition"
+                    break
+                if ticks is not None and ticks_done >= ticks:
+                    kind = "done"
+                    break
+                if self._pause.is_set():
+                    kind = "paused"
+                    break
+        self._remember()
+        return StopReason(kind, robot.t, robot.steps, robot.chart_ticks, tuple(listener.hits),
+                          tuple(self.trace.records[first:]))
+
+    def _check_conditions(self, when: list[Breakpoint]) -> None:
+        tick = self.robot.chart_ticks
+        for bp in when:
+            assert bp.condition is not None
+            value = bp.condition.evaluate(self._names)
+            if value and not bp.last_value:
+                bp.hits += 1
+                self.listener.hits.append(Hit(bp.id, bp.spec, None, tick, "became true"))
+            bp.last_value = value
+
+    @contextmanager
+    def _sigint_pauses(self) -> Iterator[None]:
+        """Ctrl-C pauses at the next step boundary instead of breaking a step in half."""
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        try:
+            previous = signal.signal(signal.SIGINT, lambda _sig, _frame: self._pause.set())
+        except ValueError:
+            yield
+            return
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, previous)
+
+    # -- inputs and events (recorded for replay) ---------------------------------
+
+    def parse_value(self, chart: str, name: str, text: str) -> Any:
+        """A value typed for a chart input, by its declared unit (see :func:`.names.parse_input_value`)."""
+        return parse_input_value(self.datum_decl(chart, name), f"{chart}.{name}", text)
+
+    def set_input(self, chart: str, name: str, value: Any, force: bool = False) -> Any:
+        """Set a chart input (``force``: keep it against the wiring until :meth:`release`).
+
+        A string is parsed by :meth:`parse_value`.  Returns the value set.
+        """
+        if isinstance(value, str):
+            value = self.parse_value(chart, name, value)
+        action = Action(self.robot.steps, "force" if force else "set", chart, name, value)
+        self._apply(action, self.robot)
+        self._record(action)
+        return value
+
+    def release(self, chart: str | None = None, name: str | None = None) -> list[tuple[str, str]]:
+        """Stop forcing one input, or every forced input (no arguments); returns those released."""
+        if chart is None:
+            keys = list(self.forced)
+        else:
+            if name is None or (chart, name) not in self.forced:
+                forced = ", ".join(f"{c}.{n}" for c, n in self.forced) or "none"
+                raise DebugError(f"{chart}.{name} is not forced; forced: {forced}")
+            keys = [(chart, name)]
+        for c, n in keys:
+            action = Action(self.robot.steps, "release", c, n)
+            self._apply(action, self.robot)
+            self._record(action)
+        return keys
+
+    def post(self, chart: str, event: str, **data: Any) -> None:
+        """Post an event to a chart; it is handled at the chart's next tick."""
+        action = Action(self.robot.steps, "post", chart, event, data=dict(data))
+        self._apply(action, self.robot)
+        self._record(action)
+
+    def _apply(self, action: Action, robot: Robot) -> None:
+        try:
+            if action.kind in ("set", "force"):
+                robot.set_input(action.chart, action.name, action.value, force=action.kind == "force")
+                if action.kind == "force":
+                    self.forced[(action.chart, action.name)] = action.value
+            elif action.kind == "release":
+                robot.release(action.chart, action.name)
+                self.forced.pop((action.chart, action.name), None)
+            else:
+                robot.post(action.chart, action.name, **action.data)
+        except (RobotError, UnknownEventError) as exc:
+            raise DebugError(str(exc)) from None
+
+    def _record(self, action: Action) -> None:
+        self.actions.append(action)
+        # The future after this step is no longer what the session saw.
+        self._fingerprints = {k: v for k, v in self._fingerprints.items() if k <= action.steps}
+        self._remember()
+        # Conditions keep their last checked value: one the user just made true
+        # hits at the next chart tick.
+        self._names.forget()
+
+    # -- trace, diagrams ---------------------------------------------------------
+
+    def save_trace(self, path: str | Path) -> Path:
+        """Write every transition of the session so far as JSON Lines."""
+        return self.trace.write_jsonl(path)
+
+    def diagram(self, chart: str, path: str | Path | None = None) -> Path:
+        """Write the chart's diagram with its active states highlighted.
+
+        The format follows the extension: ``.svg``, ``.png`` (Graphviz), ``.dot``,
+        ``.md``/``.mmd`` (Mermaid).  Default: ``out/debug/<Chart>-tick<N>.svg``.
+        """
+        c = self.chart(chart)
+        if path is None:
+            path = Path("out/debug") / f"{chart}-tick{self.robot.chart_ticks}.svg"
+        path = Path(path)
+        formats = {".svg": "svg", ".png": "png", ".dot": "dot", ".gv": "dot", ".md": "mermaid",
+                   ".mmd": "mermaid"}
+        fmt = formats.get(path.suffix.lower())
+        if fmt is None:
+            raise DebugError(f"diagram: unknown extension {path.suffix or '(none)'!r} of {str(path)!r};"
+                             f" use {', '.join(formats)}")
+        try:
+            picture = render_active(c, fmt)
+        except GraphvizMissingError as exc:
+            raise DebugError(str(exc)) from None
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(picture, bytes):
+            path.write_bytes(picture)
+        else:
+            path.write_text(picture, encoding="utf-8")
+        return path
+
+    # -- replay ------------------------------------------------------------------
+
+    def fingerprint(self) -> dict[str, Any]:
+        """Everything a replay must reproduce, now (see :func:`.replay.fingerprint`)."""
+        return fingerprint(self.robot, self.forced)
+
+    def _remember(self) -> None:
+        self._fingerprints[self.robot.steps] = self.fingerprint()
+
+    def steps_of_tick(self, tick: int) -> int:
+        """The control step count right after chart tick ``tick`` (0: power-on)."""
+        return 0 if tick == 0 else (tick - 1) * self._divider + 1
+
+    def replay(self, tick: int) -> ReplayResult:
+        """Rebuild the robot and run it to chart ``tick``, re-applying the recorded inputs.
+
+        Inputs and events recorded after that point are dropped (the session
+        continues from the replayed past).  Breakpoints do not hit during a
+        replay; the trace is recorded anew.
+        """
+        if self.recipe is None:
+            raise DebugError("replay needs the robot's recipe: build with Debugger.build(...) or"
+                             " pass recipe=RobotRecipe(params, seed, q_start, settle_s)")
+        if not isinstance(tick, int) or tick < 0:
+            raise DebugError(f"replay: the chart tick must be a whole number >= 0, got {tick!r}")
+        target = self.steps_of_tick(tick)
+        kept = [a for a in self.actions if a.steps <= target]
+        dropped = len(self.actions) - len(kept)
+        self.forced = {}
+        self._attach(self.recipe.build())
+        robot = self.robot
+        queue = deque(kept)
+        self.listener.muted = True
+        try:
+            while True:
+                while queue and queue[0].steps == robot.steps:
+                    self._apply(queue.popleft(), robot)
+                if robot.steps >= target:
+                    break
+                robot.control_step()
+        finally:
+            self.listener.muted = False
+        self.actions = kept
+        now = self.fingerprint()
+        before = self._fingerprints.get(target)
+        diffs = tuple(differences(before, now)) if before is not None else ()
+        if dropped:
+            self._fingerprints = {k: v for k, v in self._fingerprints.items() if k <= target}
+        self._fingerprints[target] = now if before is None else before
+        for bp in self.breakpoints:
+            if bp.condition is not None:
+                bp.last_value = bp.condition.evaluate(self._names)
+        return ReplayResult(tick, robot.steps, robot.t, len(kept), dropped,
+                            None if before is None else not diffs, diffs)
+
+
+def _check_count(n: int, what: str) -> None:
+    if not isinstance(n, int) or n < 1:
+        raise DebugError(f"{what}: the count must be a whole number >= 1, got {n!r}")
+
+

@@ -1,0 +1,63 @@
+"""What the debugger hands back: why it stopped, and what the user did (for replay)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from ..runtime.listeners import TraceRecord
+from .breakpoints import Hit
+
+StopKind = Literal["breakpoint", "timeout", "paused", "transition", "done"]
+
+
+@dataclass(frozen=True)
+class Action:
+    """Something the user did to the robot, at control step ``steps``, for replay."""
+
+    steps: int
+    kind: Literal["set", "force", "release", "post"]
+    chart: str
+    name: str  # input name, or event name for "post"
+    value: Any = None
+    data: dict[str, Any] = field(default_factory=dict)
+
+    def describe(self) -> str:
+        where = f"step {self.steps}"
+        if self.kind == "post":
+            args = "".join(f" {k}={v}" for k, v in self.data.items())
+            return f"{where}: post {self.chart} {self.name}{args}"
+        if self.kind == "release":
+            return f"{where}: release {self.chart}.{self.name}"
+        return f"{where}: {self.kind} {self.chart}.{self.name} {self.value!r}"
+
+
+@dataclass(frozen=True)
+class StopReason:
+    """Why the debugger stopped, and where.
+
+    ``kind``: ``breakpoint`` (``hits`` says which), ``timeout`` (the simulated
+    time given ran out), ``paused`` (:meth:`Debugger.pause` or Ctrl-C),
+    ``transition`` (``next`` saw one), ``done`` (``step``/``tick`` did what
+    was asked).  ``transitions`` are the transitions taken during the command.
+    """
+
+    kind: StopKind
+    t: float
+    steps: int
+    chart_ticks: int
+    hits: tuple[Hit, ...] = ()
+    transitions: tuple[TraceRecord, ...] = ()
+
+    @property
+    def breakpoint(self) -> Hit | None:
+        """The first breakpoint hit, if it stopped on one."""
+        return self.hits[0] if self.hits else None
+
+    def describe(self) -> str:
+        where = f"t = {self.t:.4f} s, step {self.steps}, chart tick {self.chart_ticks}"
+        if self.kind == "breakpoint":
+            return f"stopped at {where}: " + "; ".join(h.describe() for h in self.hits)
+        text = {"timeout": "time is up", "paused": "paused", "transition": "transition",
+                "done": "done"}[self.kind]
+        return f"{text} at {where}"

@@ -1,0 +1,111 @@
+"""Replay: how a robot is built again the same, and how two states are compared exactly.
+
+A run is reproducible from its recipe (parameters, seed, power-on pose) and
+the inputs the user set or posted, each at the control step it was applied.
+:func:`fingerprint` is everything a replay must reproduce; :func:`differences`
+names what does not match, float for float.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping
+from dataclasses import asdict, dataclass
+from types import MappingProxyType
+from typing import Any, Protocol
+
+from ..app.robot import Robot
+from ..params import ArmParams
+from .errors import DebugError
+
+#: Twin quantities a fingerprint compares (arrays of the simulated arm, exact floats).
+TWIN_FIELDS = ("q_true", "q_motor", "q_encoder", "offset_estimate", "current_a", "duty",
+               "speed_motor", "speed_load")
+
+
+class Recipe(Protocol):
+    """How to build the robot again, the same: what :meth:`Debugger.replay` needs."""
+
+    def build(self) -> Robot:
+        """A fresh robot, powered on, not yet stepped."""
+
+
+@dataclass(frozen=True)
+class RobotRecipe:
+    """Parameters, seed and power-on pose: a :class:`Robot` built again bit for bit.
+
+    ``q_start`` and ``settle_s`` are the Robot's own arguments: the pose before
+    the unpowered arm settles under gravity for ``settle_s`` seconds.
+    """
+
+    params: ArmParams
+    seed: int = 0
+    q_start: tuple[float, ...] | None = None
+    settle_s: float = 0.0
+
+    def build(self) -> Robot:
+        return Robot(self.params, seed=self.seed, q_start=self.q_start, settle_s=self.settle_s)
+
+    @classmethod
+    def of(cls, robot: Robot) -> RobotRecipe:
+        """The recipe of a robot not yet stepped: its seed and the pose it was powered on in."""
+        if robot.steps:
+            raise DebugError(f"the robot has run {robot.steps} control steps: its recipe cannot be"
+                             " read back; pass recipe=RobotRecipe(params, seed, q_start, settle_s)")
+        return cls(robot.params, robot.seed, tuple(float(v) for v in robot.sim.q_true))
+
+
+@dataclass(frozen=True)
+class ReplayResult:
+    """What :meth:`Debugger.replay` did and whether it reached the state seen before.
+
+    ``identical`` is ``None`` when the session had not been at that step before
+    (nothing to compare), else whether configuration, chart data and twin state
+    are equal, float for float; ``differences`` names what differs.
+    """
+
+    tick: int
+    steps: int
+    t: float
+    applied: int
+    dropped: int
+    identical: bool | None
+    differences: tuple[str, ...] = ()
+
+    def describe(self) -> str:
+        text = f"replayed to chart tick {self.tick} (t = {self.t:.4f} s, step {self.steps})," \
+               f" {self.applied} recorded input{'s' if self.applied != 1 else ''} re-applied"
+        if self.dropped:
+            text += f", {self.dropped} later one{'s' if self.dropped != 1 else ''} dropped"
+        if self.identical is True:
+            text += "; identical to the first visit"
+        elif self.identical is False:
+            text += "; DIFFERS from the first visit: " + ", ".join(self.differences[:5])
+        return text
+
+
+def fingerprint(robot: Robot, forced: Mapping[tuple[str, str], Any] = MappingProxyType({})) -> dict[str, Any]:
+    """The whole state a replay must reproduce: configurations, chart data (and their
+    previous outputs, clocks, queued events), forced inputs and the twin's state, exact."""
+    sim = robot.sim
+    charts = {}
+    for name, c in robot.charts.items():
+        charts[name] = {"active": sorted(c.configuration_values), "tick": c.tick_count,
+                        "data": c.snapshot(), "previous": c.previous_outputs(),
+                        "pending": c.pending_events}
+    twin = {name: getattr(sim, name).tolist() for name in TWIN_FIELDS}
+    twin["sensors"] = asdict(sim.sensors())
+    return {"steps": robot.steps, "chart_ticks": robot.chart_ticks, "t": sim.t, "charts": charts,
+            "forced": sorted(forced.items()), "twin": twin}
+
+
+def differences(a: Any, b: Any, path: str = "") -> Iterator[str]:
+    """Paths where two fingerprints differ (exact comparison)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in dict.fromkeys([*a, *b]):
+            yield from differences(a.get(key), b.get(key), f"{path}.{key}" if path else str(key))
+    elif isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)) and len(a) == len(b):
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            yield from differences(x, y, f"{path}[{i}]")
+    elif not (a == b or (isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b))):
+        yield path

@@ -1,0 +1,311 @@
+"""The ``ttt-sm debug`` REPL: a :mod:`cmd` shell over :class:`~.debugger.Debugger`.
+
+Interactive on a terminal (line editing, Enter repeats ``step``/``tick``/
+``next``, Ctrl-C pauses a run), or scripted: commands read from a file or a
+pipe are echoed after the prompt so the output reads as a transcript, and the
+end of the input quits.  A bad command prints one ``error: ...`` line and the
+session goes on.
+"""
+
+from __future__ import annotations
+
+import cmd
+import json
+import shlex
+import sys
+from collections.abc import Iterable
+from typing import IO, Any
+
+from ..app.robot import RobotError
+from ..runtime import UnknownDataError, UnknownEventError
+from ..runtime.listeners import jsonable
+from . import views
+from .debugger import Debugger
+from .errors import DebugError
+
+PROMPT = "(ttt-sm) "
+_REPEATABLE = ("step", "tick", "next")
+_SHOW = ("charts", "data", "signals", "trace", "breakpoints", "inputs", "snapshot")
+
+
+def _count(arg: str, what: str, default: int = 1) -> int:
+    if not arg.strip():
+        return default
+    try:
+        n = int(arg)
+    except ValueError:
+        raise DebugError(f"{what}: expected a whole number, got {arg.strip()!r}") from None
+    return n
+
+
+def _seconds(arg: str, what: str, default: float) -> float:
+    if not arg.strip():
+        return default
+    try:
+        return float(arg)
+    except ValueError:
+        raise DebugError(f"{what}: expected simulated seconds, got {arg.strip()!r}") from None
+
+
+def _chart_dot(arg: str, what: str) -> tuple[str, str]:
+    chart, dot, name = arg.partition(".")
+    if not dot or not chart or not name or " " in name:
+        raise DebugError(f"{what}: expected Chart.input, got {arg!r}")
+    return chart, name
+
+
+class DebugShell(cmd.Cmd):
+    """The debugger's commands; ``help COMMAND`` prints a command's docstring."""
+
+    intro = ""
+    prompt = PROMPT
+    doc_header = "commands (help COMMAND for details):"
+
+    def __init__(self, debugger: Debugger, stdout: IO[str] | None = None) -> None:
+        super().__init__(stdout=stdout if stdout is not None else sys.stdout)
+        self.dbg = debugger
+        self.errors = 0
+        self.scripted = False
+
+    # -- plumbing -----------------------------------------------------------------
+
+    def say(self, *lines: str) -> None:
+        for line in lines:
+            self.stdout.write(line + "\n")
+        self.stdout.flush()
+
+    def error(self, message: str) -> None:
+        self.errors += 1
+        self.say(f"error: {message}")
+
+    def onecmd(self, line: str) -> bool:
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            return self.emptyline() if not self.scripted else False
+        try:
+            return bool(super().onecmd(line))
+        except (DebugError, RobotError, UnknownEventError, UnknownDataError) as exc:
+            self.error(str(exc))
+        except Exception as exc:  # a bug in a chart action: say it, keep the session
+            self.error(f"{type(exc).__name__}: {exc}")
+        return False
+
+    def emptyline(self) -> bool:
+        if self.lastcmd.split(" ", 1)[0] in _REPEATABLE:
+            return bool(self.onecmd(self.lastcmd))
+        return False
+
+    def default(self, line: str) -> None:
+        word = line.split()[0]
+        self.error(f"unknown command {word!r}; commands: {', '.join(self.commands())}")
+
+    def commands(self) -> list[str]:
+        return sorted(n[3:] for n in self.get_names() if n.startswith("do_") and n != "do_EOF")
+
+    def run_script(self, lines: Iterable[str]) -> None:
+        """Run commands from a file or a pipe, echoed after the prompt; the end quits."""
+        self.scripted = True
+        for raw in lines:
+            line = raw.rstrip("\r\n")
+            self.say(PROMPT + line)
+            if self.onecmd(line):
+                return
+        self.say("(end of commands)")
+
+    def interact(self) -> None:
+        """Read commands from the terminal until ``quit`` or Ctrl-D; Ctrl-C at the prompt is ignored."""
+        while True:
+            try:
+                self.cmdloop()
+                return
+            except KeyboardInterrupt:
+                self.say("", "(Ctrl-C: type quit to leave; Ctrl-C during run pauses it)")
+                self.intro = ""
+
+    # -- running ------------------------------------------------------------------
+
+    def do_run(self, arg: str) -> None:
+        """run [SECONDS]: run until a breakpoint hits, SECONDS of simulated time pass
+        (default 60), or Ctrl-C pauses."""
+        self.say(*views.stop_lines(self.dbg.run(_seconds(arg, "run", 60.0))))
+
+    def do_step(self, arg: str) -> None:
+        """step [N]: run N control steps (default 1; a chart tick starts every second one)."""
+        self.say(*views.stop_lines(self.dbg.step(_count(arg, "step"))))
+
+    def do_tick(self, arg: str) -> None:
+        """tick [N]: run up to and through the next N chart ticks (default 1)."""
+        self.say(*views.stop_lines(self.dbg.tick(_count(arg, "tick"))))
+
+    def do_next(self, arg: str) -> None:
+        """next [SECONDS]: run until any chart takes a transition (at most SECONDS, default 10)."""
+        self.say(*views.stop_lines(self.dbg.next(_seconds(arg, "next", 10.0))))
+
+    # -- breakpoints --------------------------------------------------------------
+
+    def do_break(self, arg: str) -> None:
+        """break KIND SPEC: add a breakpoint; break alone lists them.
+        break enter Chart.state | break exit Chart.state
+        break transition Chart source->target   (* for any state)
+        break event Chart.event                 (tick: any tick transition)
+        break when CONDITION   e.g. DriveInit1.pos_Encoder > 1.0 and not DriveInit1.index
+                               (hits when it becomes true; signals: q_true[1], t, ...;
+                                numbers may carry deg, mm, ms)"""
+        if not arg.strip():
+            self.say(*views.breakpoint_lines(self.dbg.breakpoints))
+            return
+        bp = self.dbg.add_breakpoint(arg)
+        self.say(f"breakpoint {bp.id}: {bp.spec}")
+
+    def _ids(self, arg: str, what: str) -> list[int]:
+        try:
+            ids = [int(a) for a in arg.split()]
+        except ValueError:
+            raise DebugError(f"{what}: expected breakpoint numbers, got {arg.strip()!r}") from None
+        if not ids:
+            raise DebugError(f"{what}: which breakpoint? (break lists them)")
+        return ids
+
+    def do_delete(self, arg: str) -> None:
+        """delete ID... | delete all: remove breakpoints."""
+        if arg.strip() == "all":
+            self.dbg.delete(None)
+            self.say("all breakpoints deleted")
+            return
+        for bp_id in self._ids(arg, "delete"):
+            self.dbg.delete(bp_id)
+            self.say(f"breakpoint {bp_id} deleted")
+
+    def do_enable(self, arg: str) -> None:
+        """enable ID...: enable breakpoints."""
+        for bp_id in self._ids(arg, "enable"):
+            self.dbg.enable(bp_id)
+            self.say(f"breakpoint {bp_id} enabled")
+
+    def do_disable(self, arg: str) -> None:
+        """disable ID...: disable breakpoints (kept, not checked)."""
+        for bp_id in self._ids(arg, "disable"):
+            self.dbg.disable(bp_id)
+            self.say(f"breakpoint {bp_id} disabled")
+
+    # -- looking ------------------------------------------------------------------
+
+    def do_where(self, arg: str) -> None:
+        """where: time and the active configuration of every chart (same as show charts)."""
+        self.say(*views.where_lines(self.dbg))
+
+    def do_show(self, arg: str) -> None:
+        """show charts | data [CHART] | signals | trace [N] | breakpoints | inputs | snapshot
+        charts: active configurations; data: declared data with units; signals: time,
+        setpoints, encoders, true angles, index switches, currents, tool pose;
+        inputs: what you set, forced and posted (replay re-applies them);
+        snapshot: everything as one JSON document."""
+        what, _, rest = arg.strip().partition(" ")
+        rest = rest.strip()
+        if what == "charts":
+            self.do_where("")
+        elif what == "data":
+            for chart in ([rest] if rest else self.dbg.chart_names):
+                self.say(*views.data_lines(self.dbg, chart))
+        elif what == "signals":
+            self.say(*views.signal_lines(self.dbg))
+        elif what == "trace":
+            self.say(*views.trace_lines(self.dbg.trace.records, _count(rest, "show trace", 10)))
+        elif what == "breakpoints":
+            self.say(*views.breakpoint_lines(self.dbg.breakpoints))
+        elif what == "inputs":
+            self.say(*views.action_lines(self.dbg.actions))
+        elif what == "snapshot":
+            self.say(json.dumps(jsonable(self.dbg.robot.snapshot()), sort_keys=True))
+        else:
+            raise DebugError(f"show what? {what!r} is not one of: {', '.join(_SHOW)}" if what
+                             else f"show what? one of: {', '.join(_SHOW)}")
+
+    def do_trace(self, arg: str) -> None:
+        """trace [N]: the last N transitions (default 10); trace save FILE: all, as JSON Lines."""
+        words = arg.split()
+        if words and words[0] == "save":
+            if len(words) != 2:
+                raise DebugError("trace save: expected one file name, e.g. trace save out/trace.jsonl")
+            path = self.dbg.save_trace(words[1])
+            self.say(f"{len(self.dbg.trace.records)} transitions written to {path}")
+            return
+        self.say(*views.trace_lines(self.dbg.trace.records, _count(arg, "trace", 10)))
+
+    def do_diagram(self, arg: str) -> None:
+        """diagram CHART [FILE]: the chart's diagram, active states highlighted
+        (.svg, .png, .dot, .md; default out/debug/CHART-tickN.svg)."""
+        words = arg.split()
+        if not 1 <= len(words) <= 2:
+            raise DebugError(f"diagram: expected CHART [FILE]; charts: {', '.join(self.dbg.chart_names)}")
+        path = self.dbg.diagram(words[0], words[1] if len(words) == 2 else None)
+        self.say(f"{words[0]} diagram written to {path}")
+
+    # -- changing things ------------------------------------------------------------
+
+    def _set(self, arg: str, force: bool) -> None:
+        what = "force" if force else "set"
+        words = arg.split()
+        if len(words) != 2:
+            raise DebugError(f"{what}: expected Chart.input VALUE, e.g. {what} DriveInit1.stop 1")
+        chart, name = _chart_dot(words[0], what)
+        value = self.dbg.set_input(chart, name, words[1], force=force)
+        decl = self.dbg.datum_decl(chart, name)
+        note = " (forced until release)" if force else ""
+        self.say(f"{chart}.{name} = {views.fmt_value(value, decl.unit)}{note}")
+
+    def do_set(self, arg: str) -> None:
+        """set Chart.input VALUE: set a chart input (1/0 for flags; numbers may carry deg, mm).
+        Inputs the wiring feeds every chart step (index, pos_Encoder, ...) are overwritten
+        at the next one: force them instead."""
+        self._set(arg, False)
+
+    def do_force(self, arg: str) -> None:
+        """force Chart.input VALUE: set an input and keep it against the wiring until release."""
+        self._set(arg, True)
+
+    def do_release(self, arg: str) -> None:
+        """release [Chart.input]: stop forcing one input, or all of them."""
+        if arg.strip():
+            chart, name = _chart_dot(arg.strip(), "release")
+            released = self.dbg.release(chart, name)
+        else:
+            released = self.dbg.release()
+        names = ", ".join(f"{c}.{n}" for c, n in released)
+        self.say(f"released {names}" if released else "nothing was forced")
+
+    def do_post(self, arg: str) -> None:
+        """post CHART EVENT [NAME=VALUE ...]: post an event, handled at the chart's next tick."""
+        words = shlex.split(arg)
+        if len(words) < 2:
+            raise DebugError("post: expected CHART EVENT, e.g. post Homing stop")
+        data: dict[str, Any] = {}
+        for item in words[2:]:
+            key, eq, text = item.partition("=")
+            if not eq or not key.isidentifier():
+                raise DebugError(f"post: event data must be NAME=VALUE, got {item!r}")
+            try:
+                data[key] = float(text)
+            except ValueError:
+                data[key] = text
+        self.dbg.post(words[0], words[1], **data)
+        self.say(f"posted {words[1]} to {words[0]}; handled at its next tick")
+
+    def do_replay(self, arg: str) -> None:
+        """replay TICK: rebuild the robot from its seed and start pose, re-apply the inputs
+        recorded up to there, run to chart tick TICK and compare with the first visit."""
+        if not arg.strip():
+            raise DebugError("replay: to which chart tick? e.g. replay 1510")
+        self.say(self.dbg.replay(_count(arg, "replay")).describe())
+
+    # -- leaving ----------------------------------------------------------------------
+
+    def do_quit(self, arg: str) -> bool:
+        """quit: leave the debugger (also exit, Ctrl-D)."""
+        return True
+
+    do_exit = do_quit
+
+    def do_EOF(self, arg: str) -> bool:  # noqa: N802  (cmd's name for end of input)
+        self.say("")
+        return True

@@ -1,0 +1,152 @@
+"""Text views of the debugger's state: configurations, chart data, signals, trace, stops.
+
+Pure functions from the debugger's data to lines of text; the REPL prints
+them, a GUI can show the same strings or read the data underneath.  Values
+are SI inside; angles are shown in degrees too, lengths of the tool pose in mm.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from ..runtime.listeners import TraceRecord
+from .breakpoints import Breakpoint
+from .debugger import Debugger
+from .records import Action, StopReason
+
+#: Unit of each robot signal, per element where they differ (see Robot.signal_values).
+SIGNAL_UNITS: dict[str, str | tuple[str, ...]] = {
+    "t": "s", "q_set": "rad", "q_encoder": "rad", "q_true": "rad", "offset_estimate": "rad",
+    "index": "bool", "counts": "1", "current_a": "A", "tool_true": ("m", "m", "m", "rad"),
+    "fr_sw": "bool", "ik_error": "",
+}
+#: What a signal is, for `show signals`.
+SIGNAL_DOCS: dict[str, str] = {
+    "t": "simulated time since power-on",
+    "q_set": "joint setpoints to the controllers, q1..q4 (drives 1-3 in encoder coordinates)",
+    "q_encoder": "drive angles from the encoders (relative until initialised)",
+    "q_true": "true joint angles q1..q4 (the twin's truth, not seen by the charts)",
+    "offset_estimate": "encoder offsets the Encoder blocks apply",
+    "index": "index switch levels, drives 1-3",
+    "counts": "encoder counts since power-on, drives 1-3",
+    "current_a": "measured motor currents, drives 1-3",
+    "tool_true": "true tool pose x, y, z, phi",
+    "fr_sw": "slow setpoint filters selected",
+    "ik_error": "why inverse kinematics failed this step, if it did",
+}
+
+
+def fmt_value(value: Any, unit: str) -> str:
+    """A value with its unit; radians also in degrees, metres of a pose also in mm."""
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return str(value)
+    if isinstance(value, (int, float)):
+        v = float(value)
+        if unit == "rad" and math.isfinite(v):
+            return f"{v:.6g} rad ({math.degrees(v):.2f} deg)"
+        if unit == "m" and math.isfinite(v):
+            return f"{v * 1000:.2f} mm"
+        if isinstance(value, int):
+            return f"{value} {unit}".rstrip() if unit not in ("1", "") else str(value)
+        return f"{v:.6g} {unit}".rstrip() if unit not in ("1", "") else f"{v:.6g}"
+    return repr(value)
+
+
+def _vector(values: Sequence[Any], unit: str | tuple[str, ...]) -> str:
+    units = unit if isinstance(unit, tuple) else (unit,) * len(values)
+    if all(u == "rad" for u in units):
+        rad = " ".join(f"{float(v):.4f}" for v in values)
+        deg = " ".join(f"{math.degrees(float(v)):.2f}" for v in values)
+        return f"[{rad}] rad  ([{deg}] deg)"
+    if units == ("m", "m", "m", "rad"):
+        x, y, z, phi = (float(v) for v in values)
+        return (f"x {x * 1000:.2f} mm, y {y * 1000:.2f} mm, z {z * 1000:.2f} mm,"
+                f" phi {math.degrees(phi):.2f} deg")
+    if all(u == "bool" for u in units):
+        return "[" + " ".join("1" if v else "0" for v in values) + "]"
+    text = " ".join(f"{v:.4g}" if isinstance(v, float) else str(v) for v in values)
+    u = units[0] if units and units[0] not in ("1", "") else ""
+    return f"[{text}] {u}".rstrip()
+
+
+def where_lines(dbg: Debugger) -> list[str]:
+    """Time and each chart's active configuration (outermost state first)."""
+    robot = dbg.robot
+    lines = [f"t = {robot.t:.4f} s, step {robot.steps}, chart tick {robot.chart_ticks}"
+             + (", initialised" if robot.initialised else "")]
+    width = max(len(n) for n in robot.charts)
+    for name, states in dbg.where().items():
+        chart = robot.charts[name]
+        structure = type(chart).structure()
+        parents = {s.id: s.parent for s in structure.states}
+        leaves = [s for s in states if not any(parents.get(o) == s for o in states)]
+        paths = []
+        for leaf in leaves:
+            chain = [leaf]
+            while parents.get(chain[0]) is not None:
+                chain.insert(0, parents[chain[0]])  # type: ignore[arg-type]
+            paths.append(" > ".join(chain) + f"  ({chart.ticks_in(leaf)} ticks)")
+        lines.append(f"  {name:<{width}}  " + " | ".join(paths))
+    return lines
+
+
+def data_lines(dbg: Debugger, chart: str) -> list[str]:
+    """The chart's declared data: kind, name, value with unit, meaning."""
+    c = dbg.chart(chart)
+    decls = c.declarations()
+    width = max(len(d.name) for d in decls) if decls else 0
+    values = c.snapshot()
+    forced = {n for (ch, n) in dbg.forced if ch == chart}
+    lines = [f"{chart} data at chart tick {c.tick_count}:"]
+    for d in decls:
+        mark = " (forced)" if d.name in forced else ""
+        lines.append(f"  {d.kind:<6} {d.name:<{width}}  {fmt_value(values[d.name], d.unit)}{mark}"
+                     f"  -- {d.doc}")
+    return lines
+
+
+def signal_lines(dbg: Debugger) -> list[str]:
+    """The robot's signals now, with units (angles also in degrees)."""
+    values = dbg.signals()
+    width = max(len(n) for n in values)
+    lines = []
+    for name, value in values.items():
+        unit = SIGNAL_UNITS.get(name, "")
+        if isinstance(value, (list, tuple)):
+            text = _vector(value, unit)
+        else:
+            text = fmt_value(value, unit if isinstance(unit, str) else "")
+        doc = SIGNAL_DOCS.get(name)
+        lines.append(f"  {name:<{width}}  {text}" + (f"  -- {doc}" if doc else ""))
+    return lines
+
+
+def record_line(r: TraceRecord) -> str:
+    t = f"{r.time_s:.3f} s" if r.time_s is not None else "-"
+    return f"  tick {r.tick} ({t})  {r.chart}: {r.source} -> {r.target}  [{r.trigger}]"
+
+
+def trace_lines(records: Sequence[TraceRecord], last: int = 10) -> list[str]:
+    """The last transitions of the trace, oldest first."""
+    shown = list(records)[-last:] if last > 0 else []
+    head = [f"  ... {len(records) - len(shown)} earlier (trace save FILE writes them all)"] \
+        if len(records) > len(shown) else []
+    return head + [record_line(r) for r in shown] if records else ["  (no transitions yet)"]
+
+
+def stop_lines(stop: StopReason, last: int = 10) -> list[str]:
+    """What a run/step/tick/next command did: the transitions it saw and why it stopped."""
+    lines = []
+    if stop.transitions:
+        lines += trace_lines(stop.transitions, last)
+    return lines + [stop.describe()]
+
+
+def breakpoint_lines(bps: Sequence[Breakpoint]) -> list[str]:
+    return [f"  {bp.describe()}" for bp in bps] or ["  (no breakpoints)"]
+
+
+def action_lines(actions: Sequence[Action]) -> list[str]:
+    return [f"  {a.describe()}" for a in actions] or ["  (no inputs set or events posted)"]

@@ -334,8 +334,11 @@ class _Checker:
         data = chart_data(cls)
         inputs = [n for n, k in data.items() if k == "input"]
         if name not in inputs:
-            kind = f" is an {data[name]}, not an input" if name in data else f" has no input {name!r}"
-            raise self.error(line, f"{what}: {chart}{kind}{_guess(name, inputs)}; inputs: {', '.join(inputs)}")
+            if name in data:
+                problem = f"{chart}.{name} is an {data[name]}, not an input"
+            else:
+                problem = f"{chart} has no input {name!r}{_guess(name, inputs)}"
+            raise self.error(line, f"{what}: {problem}; inputs: {', '.join(inputs)}")
         return ChartRef(chart, name)
 
     def condition(self, text: Any, line: int, what: str) -> Expression:

@@ -5,11 +5,14 @@ Scenario errors must name ``FILE:LINE``.  :class:`MarkedLoader` is PyYAML's
 :class:`MarkedDict` and :class:`MarkedList` instead of ``dict`` and ``list``:
 the same values, plus the line of every key, value and list item.  It also
 refuses a key given twice in one mapping, which plain YAML silently accepts
-(the second ``set:`` of a step would hide the first).
+(the second ``set:`` of a step would hide the first), and reads booleans as
+YAML 1.2 does: only ``true`` and ``false`` (``on``, ``off``, ``yes``, ``no``
+stay text: they may be state names).
 """
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -73,6 +76,16 @@ class MarkedLoader(yaml.SafeLoader):
 MarkedLoader.add_constructor("tag:yaml.org,2002:map", MarkedLoader.construct_marked_map)
 MarkedLoader.add_constructor("tag:yaml.org,2002:seq", MarkedLoader.construct_marked_seq)
 
+# Booleans as YAML 1.2 has them: only true / false.  PyYAML follows YAML 1.1, where
+# on, off, yes, no, y, n are booleans too, and a state named `on` or `off` in
+# `sequence: [off, on]` would silently become [False, True].
+_BOOL = "tag:yaml.org,2002:bool"
+MarkedLoader.yaml_implicit_resolvers = {
+    first: [(tag, regexp) for tag, regexp in resolvers if tag != _BOOL]
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+MarkedLoader.add_implicit_resolver(_BOOL, re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
+
 
 def load_yaml(text: str, file: str) -> Any:
     """Parse YAML text safely; a syntax error becomes a :class:`ScenarioError` at its line."""
@@ -82,8 +95,14 @@ def load_yaml(text: str, file: str) -> Any:
         return loader.get_single_data()
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
-        line = mark.line + 1 if mark is not None else 0
         problem = exc.problem or exc.context or "not valid YAML"
+        if exc.context and exc.context_mark is not None:
+            # "while parsing a flow sequence" on the line it starts: where the mistake usually is,
+            # when the problem itself only shows at the end of the file.
+            problem += f" ({exc.context} started on line {exc.context_mark.line + 1})"
+            if "<stream end>" in str(exc.problem):
+                mark = exc.context_mark
+        line = mark.line + 1 if mark is not None else 0
         raise ScenarioError(file, line, f"not valid YAML: {problem}") from None
     except yaml.YAMLError as exc:
         raise ScenarioError(file, 0, f"not valid YAML: {exc}") from None

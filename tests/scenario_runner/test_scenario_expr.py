@@ -1,0 +1,125 @@
+"""The condition language of scenarios: parsed, never eval-ed."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from ttt_sm.scenario.expr import ExprError, Ref, parse
+
+VALUES = {
+    "DriveInit1.ini_23": True,
+    "DriveInit1.pos_Encoder": 1.5,
+    "DriveInit2.travel": 0.25,
+    "t": 3.0,
+    "q_true[1]": -1.0,
+    "q_true[2]": 0.5,
+}
+
+
+def ev(text: str) -> object:
+    return parse(text).evaluate(lambda ref: VALUES[str(ref)])
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("1 + 2 * 3", 7),
+    ("(1 + 2) * 3", 9),
+    ("-2 - -3", 1),
+    ("7 / 2", 3.5),
+    ("true and not false", True),
+    ("false or true and false", False),  # and binds tighter than or
+    ("not 1 > 2", True),  # not binds looser than a comparison
+    ("0 < DriveInit1.pos_Encoder < 2", True),  # chained, as in Python
+    ("0 < DriveInit1.pos_Encoder < 1", False),
+    ("DriveInit1.ini_23 == true", True),
+    ("DriveInit1.ini_23 != True", False),
+    ("abs(q_true[1]) == 1", True),
+    ("min(q_true[1], q_true[2], 0) == -1", True),
+    ("max(t, 4) == 4", True),
+    ("1e-3 * 1000 == 1", True),
+    (".5 == 0.5", True),
+    ("t > 2 and DriveInit2.travel <= 0.25", True),
+])
+def test_evaluates_like_python(text: str, expected: object) -> None:
+    assert ev(text) == expected
+
+
+def test_numbers_carry_units_converted_to_si() -> None:
+    assert ev("180deg") == pytest.approx(math.pi)
+    assert ev("180 deg") == pytest.approx(math.pi)
+    assert ev("20mm") == pytest.approx(0.02)
+    assert ev("5ms") == pytest.approx(0.005)
+    assert ev("2 rad + 1m + 1s") == 4
+    assert ev("q_true[1] < -45deg") is True
+
+
+def test_references_are_listed_with_their_column() -> None:
+    expr = parse("DriveInit1.stop or q_true[2] > t")
+    assert expr.refs == (Ref("DriveInit1", "stop", None, 1), Ref(None, "q_true", 2, 20), Ref(None, "t", None, 32))
+    assert [str(r) for r in expr.refs] == ["DriveInit1.stop", "q_true[2]", "t"]
+
+
+def test_bind_asks_for_each_getter_once() -> None:
+    asked: list[str] = []
+    box = {"x": 1.0}
+
+    def get(ref: Ref):
+        asked.append(str(ref))
+        return lambda: box["x"]
+
+    f = parse("C.x > 0 and C.x < 2").bind(get)
+    assert asked == ["C.x", "C.x"]
+    assert f() is True
+    box["x"] = 3.0
+    assert f() is False
+    assert asked == ["C.x", "C.x"]
+
+
+def test_and_or_short_circuit() -> None:
+    def get(ref: Ref):
+        if ref.name == "boom":
+            def boom() -> bool:
+                raise AssertionError("evaluated")
+            return boom
+        return lambda: False
+    assert parse("C.off and C.boom").bind(get)() is False
+    assert parse("not C.off or C.boom").bind(get)() is True
+
+
+@pytest.mark.parametrize("text, message, column", [
+    ("", "empty condition", 1),
+    ("DriveInit1.pos_Encoder >> 1", "expected a number, a name or '('", 25),
+    ("x = 1", "use == to compare", 3),
+    ("a && b", "use 'and'", 3),
+    ("(1 + 2", "expected ')'", 7),
+    ("1 2", "unexpected '2'", 3),
+    ("sqrt(2)", "unknown function 'sqrt'", 1),
+    ("abs(1, 2)", "abs() takes 1 argument(s), got 2", 1),
+    ("min(1)", "min() takes 2 or more arguments", 1),
+    ("q_true[x]", "expected an element number", 8),
+    ("q_true[1", "expected ']'", 9),
+    ("5 furlongs", "unknown unit 'furlongs'", 3),
+    ("DriveInit1.", "expected a datum or state name", 12),
+    ("and 1", "'and' needs something before it", 1),
+    ("__import__('os')", "unexpected character", 12),
+])
+def test_syntax_errors_name_the_column(text: str, message: str, column: int) -> None:
+    with pytest.raises(ExprError) as info:
+        parse(text)
+    assert message in str(info.value)
+    assert info.value.column == column
+
+
+def test_nothing_is_executed() -> None:
+    # Attribute access beyond Chart.name, calls of anything but the listed functions, strings: refused.
+    for text in ("C.x.y", "open(1)", "C.__class__()", "'a' == 'a'", "[1][0]"):
+        with pytest.raises(ExprError):
+            parse(text)
+
+
+def test_runtime_errors_are_expr_errors() -> None:
+    with pytest.raises(ExprError, match="cannot compute '/'"):
+        ev("t / 0")
+    with pytest.raises(ExprError, match="not a condition|a condition is text"):
+        parse(3)  # type: ignore[arg-type]

@@ -137,6 +137,7 @@ class ControlParams:
     speed_filter_hz: float
     inner_crossover_hz: float
     outer_crossover_hz: float
+    gear_play_compensation: float
 
     @property
     def dt(self) -> float:

@@ -5,8 +5,8 @@ and (later) the GUIs drive.  It knows the charts by name, steps the loop by a
 control step or a chart step, runs until a condition holds, and exposes the
 chart data and the signals of the current step without anyone reading code.
 
-Today it holds the three drive-initialisation charts; the Control chart and
-the game charts join it in later issues.
+It holds the three drive-initialisation charts and the Control chart; the
+game charts join it in a later issue.
 """
 
 from __future__ import annotations
@@ -21,6 +21,8 @@ from ..runtime import TickChart
 from ..sched.scheduler import Scheduler
 from ..twin.kinematics import fk
 from ..twin.plant import ArmSim
+from .compensation import GearPlayCompensation
+from .control_wiring import ControlStage, make_control_chart
 from .init_wiring import DriveInitStage, make_init_charts, settled_pose
 
 
@@ -57,8 +59,12 @@ class Robot:
         self.sched = Scheduler(params, self.sim)
         init = make_init_charts(params, listeners)
         self.init_stage = DriveInitStage(params, self.sim, self.sched, init)
-        self.sched.joint_stages = [self.init_stage]
-        self.charts: dict[str, TickChart] = {c.chart_name: c for c in init}
+        self.compensation = GearPlayCompensation(params, lambda: self.init_stage.done)
+        self.sched.joint_stages = [self.init_stage, self.compensation]
+        self.control = make_control_chart(params, listeners)
+        self.control_stage = ControlStage(params, self.sim, self.init_stage, self.control)
+        self.sched.task_stages = [self.control_stage]
+        self.charts: dict[str, TickChart] = {c.chart_name: c for c in (*init, self.control)}
 
     # -- time ------------------------------------------------------------------
 

@@ -4,9 +4,10 @@ Charts import the runtime only; the application (`ttt_sm.app`) wires them to
 the twin, the scheduler and the game.
 """
 
+from .control import Control
 from .drive_init import INIT_CHARTS, DriveInit1, DriveInit2, DriveInit3
 
 #: Every chart of the project, in the order the diagrams list them.
-ALL_CHARTS = (*INIT_CHARTS,)
+ALL_CHARTS = (*INIT_CHARTS, Control)
 
-__all__ = ["ALL_CHARTS", "INIT_CHARTS", "DriveInit1", "DriveInit2", "DriveInit3"]
+__all__ = ["ALL_CHARTS", "INIT_CHARTS", "Control", "DriveInit1", "DriveInit2", "DriveInit3"]

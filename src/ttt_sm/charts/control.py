@@ -1,0 +1,576 @@
+"""The Control chart of thesis section 3.6.1 (figs. 3.23-3.27): what the pen does.
+
+It turns the game's commands into tool poses, one per chart tick: `X_out`,
+`Y_out`, `Z_out` (metres) and `phi` (rad), plus `fr_sw`, which slows the
+setpoint filters.  Its sub-charts are compound states, as in fig. 3.24:
+
+- ``start_stop``: waits for the drives to be initialised, rises from the
+  start pose and moves above the board without touching it, then ``go_wait``
+  steps to the waiting pose beside the board with the slow filters (the
+  thesis' ``wait_1`` "step" with a lowered cut-off) and ``wait_1`` waits.
+- ``Drawing_playing_field``: 4 lines parallel to X and 4 parallel to Y, each
+  drawn by incrementing one coordinate per tick (eq. 3.36); the pen is lowered
+  and lifted by Z between lines; sets the field flag `Pl_fld`.
+- ``Drawing_X`` (eqs. 3.37-3.44) and ``Drawing_O`` (four arcs, each a bit
+  over a quarter so the circle closes, eqs. 3.45-3.51) in cell (row, column),
+  on the ``button`` event.
+- ``Drawing_sine``: the sine wave of section 3.5.3, on the ``draw_sine`` event.
+- ``Erase``: phi to 90 deg, sponge down, passes along Y 3 cm apart over the
+  field, flag and counter reset, phi back to 0; then the field is redrawn.
+- ``finishing``: `finish` at any moment (also mid-stroke) lifts the pen and
+  returns the arm to its start pose.
+
+A ``button`` that arrives while the arm is busy (anything but ``wait_1``) is
+ignored and counted in `ignored_buttons`: a drawing is never started twice,
+and the person presses again once the arm waits (the GUI shows when).
+
+Every move is a straight line at a set speed, one increment per tick, towards
+a target held in the local data `tx`, `ty`, `tz`; a state's exit guard is
+"target reached".  Geometry (cell corners, heights, the waiting pose) is local
+data the application sets from the parameter file.
+"""
+
+from __future__ import annotations
+
+import math
+
+from statemachine import State
+
+from ..runtime import Data, TickChart
+
+CHART_PERIOD_S = 0.002
+
+
+class Control(TickChart):
+    """The Control block: start/stop, the field, X, O, a sine wave, erasing, finishing."""
+
+    tick_period_s = CHART_PERIOD_S
+
+    inputs = (
+        Data("row", "1", 1, "row of the cell to draw in, 1..5 (eq. 3.38)"),
+        Data("column", "1", 1, "column of the cell to draw in, 1..5 (eq. 3.37)"),
+        Data("symbol", "1", 1, "symbol the button draws: 1 = X, 0 = O"),
+        Data("finish", "bool", False, "1: finish the application, return to the start pose"),
+        Data("erase", "bool", False, "erasing flag: erase the board at the next wait"),
+        Data("initialised", "bool", False, "every drive passes its position through (init charts)"),
+        Data("X_now", "m", 0.0, "tool x by forward kinematics of the encoders"),
+        Data("Y_now", "m", 0.0, "tool y by forward kinematics of the encoders"),
+        Data("Z_now", "m", 0.0, "tool z by forward kinematics of the encoders"),
+        Data("speed", "m/s", 0.02, "drawing speed (the Operational GUI's speed)"),
+        Data("size", "m", 0.018, "symbol size: the X's side, the O's diameter (GUI magnitude)"),
+        Data("sine_amplitude", "m", 0.02, "amplitude of the sine wave (section 3.5.3)"),
+    )
+    outputs = (
+        Data("X_out", "m", math.nan, "tool x; NaN until initialised (no command)"),
+        Data("Y_out", "m", math.nan, "tool y"),
+        Data("Z_out", "m", math.nan, "tool z (pen tip)"),
+        Data("phi", "rad", 0.0, "tool angle about the global X axis (0: pen down, pi/2: sponge down)"),
+        Data("fr_sw", "bool", False, "slow setpoint filters (the step to wait_1)"),
+        Data("Pl_fld", "bool", False, "playing field flag: the field has been drawn"),
+        Data("ctr", "1", 0, "symbols drawn by the manipulator"),
+    )
+    local = (
+        Data("x11", "m", 0.075, "x of the field's upper right corner (eqs. 3.37, 3.45)"),
+        Data("y11", "m", 0.325, "y of the field's upper right corner (eqs. 3.38, 3.46)"),
+        Data("L", "m", 0.03, "side of one cell"),
+        Data("cells", "1", 5, "cells per row and column"),
+        Data("z_draw", "m", -0.0015, "pen tip height while drawing: presses the spring-loaded pen"),
+        Data("z_up", "m", 0.008, "pen tip height between strokes"),
+        Data("z_travel", "m", 0.04, "height for moves to and from the waiting pose"),
+        Data("z_safe", "m", 0.08, "height for moves from and to the start pose"),
+        Data("z_sponge", "m", 0.0175, "tool height with the sponge pressed on the board (phi = 90 deg)"),
+        Data("x_wait", "m", 0.16, "waiting pose beside the board, out of the camera's way"),
+        Data("y_wait", "m", 0.12, "waiting pose y"),
+        Data("z_wait", "m", 0.06, "waiting pose z"),
+        Data("wait_tol", "m", 0.002, "the arm is at the waiting pose within this distance"),
+        Data("travel_speed", "m/s", 0.06, "speed of pen-up moves"),
+        Data("z_speed", "m/s", 0.02, "speed of lowering and lifting the pen"),
+        Data("phi_rate", "rad/s", 1.0, "how fast phi turns for the sponge"),
+        Data("wipe_speed", "m/s", 0.04, "speed of the sponge passes"),
+        Data("arc_overlap", "rad", 0.035, "each quarter arc of the O is this much longer (closes it)"),
+        Data("sine_length", "m", 0.12, "length of the sine wave along X"),
+        Data("sine_periods", "1", 2.0, "periods of the sine wave"),
+        Data("x_start", "m", 0.0, "start pose x (where the arm stood once initialised)"),
+        Data("y_start", "m", 0.0, "start pose y"),
+        Data("z_start", "m", 0.0, "start pose z"),
+        Data("tx", "m", 0.0, "target x of the current move"),
+        Data("ty", "m", 0.0, "target y of the current move"),
+        Data("tz", "m", 0.0, "target z of the current move"),
+        Data("k", "1", 0, "index of the current line, pass or arc"),
+        Data("x_ini", "m", 0.0, "start of the X's first line (eq. 3.37)"),
+        Data("y_ini", "m", 0.0, "start of the X's first line (eq. 3.38)"),
+        Data("h1", "m", 0.0, "intersection of the X's first line with the Y axis (eq. 3.39)"),
+        Data("h2", "m", 0.0, "intersection of the X's second line with the Y axis (eq. 3.42)"),
+        Data("Y_end", "m", 0.0, "y of the end of the X's first line"),
+        Data("x0", "m", 0.0, "centre of the O (eq. 3.45)"),
+        Data("y0", "m", 0.0, "centre of the O (eq. 3.46)"),
+        Data("R", "m", 0.0, "radius of the O (eq. 3.47)"),
+        Data("arc_end", "rad", 0.0, "angle where the current arc ends"),
+        Data("ignored_buttons", "1", 0, "button events that came while the arm was busy"),
+    )
+
+    class start_stop(State.Compound):
+        wait_ini = State(initial=True)
+        rise = State()
+        go_over = State()
+        go_wait = State()
+        wait_1 = State()
+
+        wait_ini.to(rise, cond="initialised", on="take_start_pose")
+        rise.to(go_over, cond="at_target", on="aim_over_wait")
+        go_over.to(go_wait, cond="at_target")
+        go_wait.to(wait_1, cond="arrived")
+
+    class Drawing_playing_field(State.Compound):
+        to_line = State(initial=True)
+        field_pen_down = State()
+        line = State()
+        field_pen_up = State()
+        field_lift_off = State()
+
+        to_line.to(field_pen_down, cond="at_target", on="aim_down")
+        field_pen_down.to(line, cond="at_target", on="aim_line_end")
+        line.to(field_pen_up, cond="at_target", on="aim_up")
+        field_pen_up.to(to_line, cond="more_lines and at_target", on="next_line")
+        field_pen_up.to(field_lift_off, cond="at_target", on="field_done")
+
+    class Drawing_X(State.Compound):
+        x_to_start = State(initial=True)
+        x_pen_down = State()
+        line_1 = State()
+        x_pen_up = State()
+        to_line_2 = State()
+        x_pen_down_2 = State()
+        line_2 = State()
+        x_pen_up_2 = State()
+        x_lift_off = State()
+
+        x_to_start.to(x_pen_down, cond="at_target", on="aim_down")
+        x_pen_down.to(line_1, cond="at_target")
+        line_1.to(x_pen_up, cond="x_line_done", on="end_line_1")
+        x_pen_up.to(to_line_2, cond="at_target", on="aim_line_2")
+        to_line_2.to(x_pen_down_2, cond="at_target", on="aim_down")
+        x_pen_down_2.to(line_2, cond="at_target")
+        line_2.to(x_pen_up_2, cond="x_line_done", on="aim_up")
+        x_pen_up_2.to(x_lift_off, cond="at_target", on="aim_travel")
+
+    class Drawing_O(State.Compound):
+        o_to_start = State(initial=True)
+        o_pen_down = State()
+        arc_1 = State()
+        arc_2 = State()
+        arc_3 = State()
+        arc_4 = State()
+        o_pen_up = State()
+        o_lift_off = State()
+
+        o_to_start.to(o_pen_down, cond="at_target", on="aim_down")
+        o_pen_down.to(arc_1, cond="at_target", on="start_arc_1")
+        arc_1.to(arc_2, cond="arc_done", on="next_arc")
+        arc_2.to(arc_3, cond="arc_done", on="next_arc")
+        arc_3.to(arc_4, cond="arc_done", on="next_arc")
+        arc_4.to(o_pen_up, cond="arc_done", on="aim_up")
+        o_pen_up.to(o_lift_off, cond="at_target", on="aim_travel")
+
+    class Drawing_sine(State.Compound):
+        s_to_start = State(initial=True)
+        s_pen_down = State()
+        wave = State()
+        s_pen_up = State()
+        s_lift_off = State()
+
+        s_to_start.to(s_pen_down, cond="at_target", on="aim_down")
+        s_pen_down.to(wave, cond="at_target", on="aim_wave_end")
+        wave.to(s_pen_up, cond="sine_done", on="aim_up")
+        s_pen_up.to(s_lift_off, cond="at_target", on="aim_travel")
+
+    class Erase(State.Compound):
+        erase_lift = State(initial=True)
+        turn_sponge = State()
+        to_pass = State()
+        sponge_down = State()
+        wipe = State()
+        sponge_up = State()
+        turn_pen = State()
+
+        erase_lift.to(turn_sponge, cond="at_target")
+        turn_sponge.to(to_pass, cond="phi >= pi_2", on="aim_pass_start")
+        to_pass.to(sponge_down, cond="at_target", on="aim_sponge_down")
+        sponge_down.to(wipe, cond="at_target", on="aim_pass_end")
+        wipe.to(sponge_up, cond="at_target", on="aim_sponge_up")
+        sponge_up.to(to_pass, cond="more_passes and at_target", on="next_pass")
+        sponge_up.to(turn_pen, cond="at_target", on="erased")
+
+    class finishing(State.Compound):
+        home_lift = State(initial=True)
+        go_home_over = State()
+        go_home = State()
+        finished = State()
+
+        home_lift.to(go_home_over, cond="at_target and phi <= 0", on="aim_home_over")
+        go_home_over.to(go_home, cond="at_target", on="aim_home")
+        go_home.to(finished, cond="at_target")
+
+    # -- from the waiting pose: erase first, then the field, then what the person asks.
+    # A button anywhere else is ignored and counted (targetless: nothing is left or entered).
+    start_stop.wait_1.to(Erase, cond="erase")
+    start_stop.wait_1.to(Drawing_playing_field, cond="not Pl_fld")
+    button = (start_stop.wait_1.to(Drawing_X, cond="symbol == 1", on="count_symbol")
+              | start_stop.wait_1.to(Drawing_O, cond="symbol == 0", on="count_symbol")
+              | start_stop.to(None, on="ignore_button")
+              | Drawing_playing_field.to(None, on="ignore_button")
+              | Drawing_X.to(None, on="ignore_button")
+              | Drawing_O.to(None, on="ignore_button")
+              | Drawing_sine.to(None, on="ignore_button")
+              | Erase.to(None, on="ignore_button")
+              | finishing.to(None, on="ignore_button"))
+    draw_sine = start_stop.wait_1.to(Drawing_sine)
+
+    # -- back to the waiting pose once a sub-chart is done (lifted to z_travel)
+    Drawing_playing_field.field_lift_off.to(start_stop.go_wait, cond="at_target")
+    Drawing_X.x_lift_off.to(start_stop.go_wait, cond="at_target")
+    Drawing_O.o_lift_off.to(start_stop.go_wait, cond="at_target")
+    Drawing_sine.s_lift_off.to(start_stop.go_wait, cond="at_target")
+    Erase.turn_pen.to(start_stop.go_wait, cond="phi <= 0 and at_target")
+
+    # -- finish, at any moment (tried before anything inside, as Stateflow does)
+    start_stop.to(finishing, cond="finish and initialised", on="aim_lift")
+    Drawing_playing_field.to(finishing, cond="finish", on="aim_lift")
+    Drawing_X.to(finishing, cond="finish", on="aim_lift")
+    Drawing_O.to(finishing, cond="finish", on="aim_lift")
+    Drawing_sine.to(finishing, cond="finish", on="aim_lift")
+    Erase.to(finishing, cond="finish", on="aim_lift")
+
+    pi_2 = math.pi / 2
+
+    # ---------------------------------------------------------------- guards
+
+    def at_target(self) -> bool:
+        """The output has reached the current move's target."""
+        return self.X_out == self.tx and self.Y_out == self.ty and self.Z_out == self.tz
+
+    def arrived(self) -> bool:
+        """The arm itself (forward kinematics of the encoders) is at the waiting pose."""
+        return (abs(self.X_now - self.x_wait) < self.wait_tol and abs(self.Y_now - self.y_wait) < self.wait_tol
+                and abs(self.Z_now - self.z_wait) < self.wait_tol)
+
+    def more_lines(self) -> bool:
+        """Another of the 4 + 4 field lines is left."""
+        return self.k < 2 * (self.cells - 1) - 1
+
+    def x_line_done(self) -> bool:
+        """The X's current line reached its end (x decreased by the symbol size)."""
+        return self.X_out <= self.x_ini - self.size
+
+    def arc_done(self) -> bool:
+        """The current arc reached its end angle."""
+        return self.X_out == self.tx and self.Y_out == self.ty
+
+    def sine_done(self) -> bool:
+        """The sine wave reached its end."""
+        return self.X_out <= self.tx
+
+    def more_passes(self) -> bool:
+        """Another sponge pass is left."""
+        return self.k < self.cells - 1
+
+    # ------------------------------------------------------- start_stop
+
+    def take_start_pose(self) -> None:
+        """Remember where the arm stands once initialised: finish returns there."""
+        self.x_start, self.y_start, self.z_start = self.X_now, self.Y_now, self.Z_now
+        self.X_out, self.Y_out, self.Z_out, self.phi = self.X_now, self.Y_now, self.Z_now, 0.0
+        self._aim(self.X_now, self.Y_now, self.z_safe)
+
+    def during_rise(self) -> None:
+        self._move(self.z_speed * 2)
+
+    def aim_over_wait(self) -> None:
+        self._aim(self.x_wait, self.y_wait, self.z_safe)
+
+    def during_go_over(self) -> None:
+        self._move(self.travel_speed)
+
+    def on_enter_go_wait(self) -> None:
+        # the thesis' wait_1: a step to the waiting pose, smoothed by slow filters
+        self.X_out, self.Y_out, self.Z_out, self.phi = self.x_wait, self.y_wait, self.z_wait, 0.0
+        self.fr_sw = True
+
+    def on_exit_go_wait(self) -> None:
+        self.fr_sw = False
+        self._aim(self.X_out, self.Y_out, self.Z_out)
+
+    def ignore_button(self) -> None:
+        self.ignored_buttons = self.ignored_buttons + 1
+
+    def count_symbol(self) -> None:
+        self.ctr = self.ctr + 1
+
+    # ----------------------------------------------- shared pen moves
+
+    def _aim(self, x: float, y: float, z: float) -> None:
+        self.tx, self.ty, self.tz = x, y, z
+
+    def _move(self, speed: float) -> None:
+        """One increment of a straight move towards (tx, ty, tz) at `speed` (eq. 3.36)."""
+        dx, dy, dz = self.tx - self.X_out_p, self.ty - self.Y_out_p, self.tz - self.Z_out_p
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        step = speed * CHART_PERIOD_S
+        if dist <= step:
+            self.X_out, self.Y_out, self.Z_out = self.tx, self.ty, self.tz
+        else:
+            f = step / dist
+            self.X_out, self.Y_out, self.Z_out = self.X_out_p + f * dx, self.Y_out_p + f * dy, self.Z_out_p + f * dz
+
+    def aim_down(self) -> None:
+        self._aim(self.X_out, self.Y_out, self.z_draw)
+
+    def aim_up(self) -> None:
+        self._aim(self.X_out, self.Y_out, self.z_up)
+
+    def aim_travel(self) -> None:
+        self._aim(self.X_out, self.Y_out, self.z_travel)
+
+    def aim_lift(self) -> None:
+        """finish: straight up from wherever the pen is, turning phi back to 0 on the way."""
+        self._aim(self.X_out, self.Y_out, max(self.Z_out, self.z_safe))
+
+    def _vertical(self) -> None:
+        self._move(self.z_speed)
+
+    # the pen goes down and up at z_speed in every sub-chart
+    during_field_pen_down = during_field_pen_up = during_field_lift_off = _vertical
+    during_x_pen_down = during_x_pen_up = during_x_pen_down_2 = during_x_pen_up_2 = _vertical
+    during_x_lift_off = _vertical
+    during_o_pen_down = during_o_pen_up = during_o_lift_off = _vertical
+    during_s_pen_down = during_s_pen_up = during_s_lift_off = _vertical
+
+    # ------------------------------------------- Drawing_playing_field
+
+    def _field_line(self, k: int) -> tuple[float, float, float, float]:
+        """Start and end (x, y) of field line k: 0-3 parallel to X, 4-7 parallel to Y.
+
+        Lines run alternately one way and back, so the pen travels little.
+        """
+        n = self.cells - 1
+        size = self.cells * self.L
+        x_lo, y_lo = self.x11 - size, self.y11 - size
+        if k < n:
+            y = self.y11 - (k + 1) * self.L
+            xs = (self.x11, x_lo) if k % 2 == 0 else (x_lo, self.x11)
+            return xs[0], y, xs[1], y
+        x = self.x11 - (k - n + 1) * self.L
+        ys = (self.y11, y_lo) if k % 2 == 0 else (y_lo, self.y11)
+        return x, ys[0], x, ys[1]
+
+    def on_enter_Drawing_playing_field(self) -> None:
+        self.k = 0
+        x, y, _, _ = self._field_line(0)
+        self._aim(x, y, self.z_up)
+
+    def during_to_line(self) -> None:
+        self._move(self.travel_speed)
+
+    def aim_line_end(self) -> None:
+        _, _, x, y = self._field_line(self.k)
+        self._aim(x, y, self.z_draw)
+
+    def during_line(self) -> None:
+        # eq. 3.36: one coordinate changes by inc per tick, the other stays
+        self._move(self.speed)
+
+    def next_line(self) -> None:
+        self.k = self.k + 1
+        x, y, _, _ = self._field_line(self.k)
+        self._aim(x, y, self.z_up)
+
+    def field_done(self) -> None:
+        self.Pl_fld = True
+        self.aim_travel()
+
+    # ------------------------------------------------------- Drawing_X
+
+    def on_enter_Drawing_X(self) -> None:
+        # eqs. 3.37-3.38, with the symbol size as a parameter: L/5 margins for size 3L/5
+        margin = (self.L - self.size) / 2
+        self.x_ini = self.x11 - (self.column - 1) * self.L - margin
+        self.y_ini = self.y11 - (self.row - 1) * self.L - margin
+        self.h1 = self.y_ini - self.x_ini  # eq. 3.39
+        self._aim(self.x_ini, self.y_ini, self.z_up)
+
+    def _travel(self) -> None:
+        self._move(self.travel_speed)
+
+    during_x_to_start = during_o_to_start = during_s_to_start = _travel
+
+    def during_line_1(self) -> None:
+        # eqs. 3.40-3.41: X decreases, Y follows the 45-degree line Y = X + h1
+        self.X_out = max(self.X_out_p - self.speed * CHART_PERIOD_S / math.sqrt(2), self.x_ini - self.size)
+        self.Y_out = self.X_out + self.h1
+
+    def end_line_1(self) -> None:
+        self.Y_end = self.Y_out
+        self.aim_up()
+
+    def aim_line_2(self) -> None:
+        # eq. 3.42: the second line starts at (x_ini, Y_end)
+        self.h2 = self.Y_end + self.x_ini
+        self._aim(self.x_ini, self.Y_end, self.z_up)
+
+    def during_to_line_2(self) -> None:
+        self._move(self.travel_speed)
+
+    def during_line_2(self) -> None:
+        # eqs. 3.43-3.44: Y = -X + h2; X decreases (the printed '+' would leave the cell)
+        self.X_out = max(self.X_out_p - self.speed * CHART_PERIOD_S / math.sqrt(2), self.x_ini - self.size)
+        self.Y_out = -self.X_out + self.h2
+
+    # ------------------------------------------------------- Drawing_O
+
+    def on_enter_Drawing_O(self) -> None:
+        # eqs. 3.45-3.47 (R = L/4 for the default size L/2)
+        self.x0 = self.x11 - (self.column - 1) * self.L - self.L / 2
+        self.y0 = self.y11 - (self.row - 1) * self.L - self.L / 2
+        self.R = self.size / 2
+        a = -0.75 * math.pi  # part 1 starts at the lower left, as in fig. 3.27
+        self._aim(self.x0 + self.R * math.cos(a), self.y0 + self.R * math.sin(a), self.z_up)
+
+    def start_arc_1(self) -> None:
+        self.k = 0
+        self._aim_arc()
+
+    def next_arc(self) -> None:
+        self.k = self.k + 1
+        self._aim_arc()
+
+    def _aim_arc(self) -> None:
+        """End point of arc k: a quarter plus the overlap, counter-clockwise from -135 deg."""
+        self.arc_end = -0.75 * math.pi + (self.k + 1) * (math.pi / 2 + self.arc_overlap)
+        self._aim(self.x0 + self.R * math.cos(self.arc_end), self.y0 + self.R * math.sin(self.arc_end),
+                  self.z_draw)
+
+    def _arc_step(self) -> float:
+        return self.speed * CHART_PERIOD_S * math.sqrt(0.5)
+
+    def during_arc_1(self) -> None:
+        # eqs. 3.48-3.49: X increases along the lower half, Y from the circle
+        self.X_out = min(self.X_out_p + self._arc_step(), self.tx)
+        self.Y_out = self.y0 - math.sqrt(max(self.R ** 2 - (self.X_out - self.x0) ** 2, 0.0))
+        if self.X_out == self.tx:
+            self.Y_out = self.ty
+
+    def during_arc_2(self) -> None:
+        # eqs. 3.50-3.51: Y increases along the right half, X from the circle
+        self.Y_out = min(self.Y_out_p + self._arc_step(), self.ty)
+        self.X_out = self.x0 + math.sqrt(max(self.R ** 2 - (self.Y_out - self.y0) ** 2, 0.0))
+        if self.Y_out == self.ty:
+            self.X_out = self.tx
+
+    def during_arc_3(self) -> None:
+        # like part 1 mirrored: X decreases along the upper half
+        self.X_out = max(self.X_out_p - self._arc_step(), self.tx)
+        self.Y_out = self.y0 + math.sqrt(max(self.R ** 2 - (self.X_out - self.x0) ** 2, 0.0))
+        if self.X_out == self.tx:
+            self.Y_out = self.ty
+
+    def during_arc_4(self) -> None:
+        # like part 2 mirrored: Y decreases along the left half
+        self.Y_out = max(self.Y_out_p - self._arc_step(), self.ty)
+        self.X_out = self.x0 - math.sqrt(max(self.R ** 2 - (self.Y_out - self.y0) ** 2, 0.0))
+        if self.Y_out == self.ty:
+            self.X_out = self.tx
+
+    # ------------------------------------------------------- Drawing_sine
+
+    def on_enter_Drawing_sine(self) -> None:
+        # along the middle row of the field, from its right edge (section 3.5.3)
+        self.x0 = self.x11 - (self.cells * self.L - self.sine_length) / 2
+        self.y0 = self.y11 - self.cells * self.L / 2
+        self._aim(self.x0, self.y0, self.z_up)
+
+    def aim_wave_end(self) -> None:
+        self.tx = self.x0 - self.sine_length
+
+    def during_wave(self) -> None:
+        # X decreases by a set increment; Y follows the sine
+        self.X_out = max(self.X_out_p - self.speed * CHART_PERIOD_S * 0.5, self.tx)
+        s = (self.x0 - self.X_out) / self.sine_length
+        self.Y_out = self.y0 + self.sine_amplitude * math.sin(2 * math.pi * self.sine_periods * s)
+
+    # ----------------------------------------------------------- Erase
+
+    def on_enter_Erase(self) -> None:
+        self._aim(self.X_out, self.Y_out, max(self.Z_out, self.z_travel))
+
+    def during_erase_lift(self) -> None:
+        self._move(self.z_speed * 2)
+
+    def during_turn_sponge(self) -> None:
+        self.phi = min(self.phi + self.phi_rate * CHART_PERIOD_S, self.pi_2)
+
+    def _pass_x(self, k: int) -> float:
+        return self.x11 - self.L / 2 - k * (self.cells * self.L - self.L) / (self.cells - 1)
+
+    def _pass_ends(self, k: int) -> tuple[float, float]:
+        """Passes along Y over the whole field (and 5 mm beyond), alternately one way and back."""
+        far, near = self.y11 + 0.005, self.y11 - self.cells * self.L - 0.005
+        return (far, near) if k % 2 == 0 else (near, far)
+
+    def aim_pass_start(self) -> None:
+        self.k = 0
+        self._aim(self._pass_x(0), self._pass_ends(0)[0], self.z_travel)
+
+    def during_to_pass(self) -> None:
+        self._move(self.travel_speed)
+
+    def aim_sponge_down(self) -> None:
+        self._aim(self.X_out, self.Y_out, self.z_sponge)
+
+    def during_sponge_down(self) -> None:
+        self._move(self.z_speed)
+
+    def aim_pass_end(self) -> None:
+        self._aim(self.X_out, self._pass_ends(self.k)[1], self.z_sponge)
+
+    def during_wipe(self) -> None:
+        self._move(self.wipe_speed)
+
+    def aim_sponge_up(self) -> None:
+        self._aim(self.X_out, self.Y_out, self.z_sponge + 0.01)
+
+    def during_sponge_up(self) -> None:
+        self._move(self.z_speed)
+
+    def next_pass(self) -> None:
+        self.k = self.k + 1
+        self._aim(self._pass_x(self.k), self._pass_ends(self.k)[0], self.z_sponge + 0.01)
+
+    def erased(self) -> None:
+        self.Pl_fld = False
+        self.ctr = 0
+        self._aim(self.X_out, self.Y_out, self.z_travel)
+
+    def during_turn_pen(self) -> None:
+        self._move(self.z_speed * 2)
+        self.phi = max(self.phi - self.phi_rate * CHART_PERIOD_S, 0.0)
+
+    # ------------------------------------------------------- finishing
+
+    def during_finishing(self) -> None:
+        self.fr_sw = False
+        self.phi = max(self.phi - self.phi_rate * CHART_PERIOD_S, 0.0)
+
+    def during_home_lift(self) -> None:
+        self._move(self.z_speed * 2)
+
+    def aim_home_over(self) -> None:
+        self._aim(self.x_start, self.y_start, self.Z_out)
+
+    def during_go_home_over(self) -> None:
+        self._move(self.travel_speed)
+
+    def aim_home(self) -> None:
+        self._aim(self.x_start, self.y_start, self.z_start)
+
+    def during_go_home(self) -> None:
+        self._move(self.z_speed * 2)

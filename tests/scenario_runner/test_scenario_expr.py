@@ -56,7 +56,8 @@ def test_numbers_carry_units_converted_to_si() -> None:
 
 def test_references_are_listed_with_their_column() -> None:
     expr = parse("DriveInit1.stop or q_true[2] > t")
-    assert expr.refs == (Ref("DriveInit1", "stop", None, 1), Ref(None, "q_true", 2, 20), Ref(None, "t", None, 32))
+    assert expr.refs == (Ref("DriveInit1", "stop", None, 1), Ref(None, "q_true", 2, 20),
+                         Ref(None, "t", None, 32))
     assert [str(r) for r in expr.refs] == ["DriveInit1.stop", "q_true[2]", "t"]
 
 

@@ -45,6 +45,9 @@ steps:
 """
 
 
+S = "name: n\nsteps:\n"  # the head of a file whose steps a case is about
+
+
 def load(text: str):
     return load_scenario_text(textwrap.dedent(text), "s.yaml")
 
@@ -63,7 +66,7 @@ def test_every_step_kind_loads_with_its_line() -> None:
     assert kinds == [SetStep, SetStep, ReleaseStep, ReleaseStep, RunStep, RunStep, RunUntilStep, RunUntilStep,
                      RunUntilStep, ExpectStep, ExpectStep, ExpectStep, MarkStep, MarkStep, ExpectStatesStep,
                      ExpectStatesStep]
-    assert [step.where.line for step in s.steps] == [6, 7, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22]
+    assert [step.where.line for step in s.steps] == [6, 7, *range(9, 23)]
     assert str(s.steps[0].where) == "s.yaml:6"
     first = s.steps[0]
     assert isinstance(first, SetStep) and not first.force
@@ -81,7 +84,7 @@ def test_every_step_kind_loads_with_its_line() -> None:
 
 
 def test_defaults() -> None:
-    s = load("name: n\nsteps:\n  - run: {seconds: 1}\n")
+    s = load(S + "  - run: {seconds: 1}\n")
     assert s.seed == 0 and s.start.q_deg is None and s.start.settle_s == 0 and s.description == ""
 
 
@@ -98,8 +101,8 @@ def test_marked_loader_keeps_lines_and_is_safe() -> None:
 
 @pytest.mark.parametrize("text, line, message", [
     # YAML itself
-    ("name: n\nsteps:\n  - run: {seconds: 1\n", 3, "flow mapping started on line 3"),
-    ("name: n\nsteps:\n  - run: {seconds: 1}\n    expect: x\n  - set: [a\n", 5, "not valid YAML"),
+    (S + "  - run: {seconds: 1\n", 3, "flow mapping started on line 3"),
+    (S + "  - run: {seconds: 1}\n    expect: x\n  - set: [a\n", 5, "not valid YAML"),
     ("name: n\nname: m\nsteps: []\n", 2, "key 'name' given twice (first on line 1)"),
     # top level
     ("- run: {seconds: 1}\n", 1, "a scenario file is a mapping"),
@@ -109,64 +112,64 @@ def test_marked_loader_keeps_lines_and_is_safe() -> None:
     ("name: n\nsteps: []\n", 2, "steps: expected a list of steps"),
     ("name: n\nseed: -1\nsteps:\n  - run: {seconds: 1}\n", 2, "seed: expected a whole number >= 0"),
     ("name: 3\nsteps:\n  - run: {seconds: 1}\n", 1, "name: expected text, got number 3"),
-    ("name: n\nstart: {q_deg: [1, 2]}\nsteps:\n  - run: {seconds: 1}\n", 2, "q_deg expected a list of 3 or 4"),
+    ("name: n\nstart: {q_deg: [1, 2]}\nsteps:\n  - run: {seconds: 1}\n", 2, "list of 3 or 4"),
     ("name: n\nstart: {pose: [1, 2, 3]}\nsteps:\n  - run: {seconds: 1}\n", 2, "start: unknown key 'pose'"),
     # step shape
-    ("name: n\nsteps:\n  - runn: {seconds: 1}\n", 3, "unknown step kind 'runn' (did you mean 'run'?)"),
-    ("name: n\nsteps:\n  - wait 1 s\n", 3, "a step is a mapping"),
-    ("name: n\nsteps:\n  - run: {seconds: 1}\n    expect: x\n", 4, "one step, two actions ('run' and 'expect')"),
-    ("name: n\nsteps:\n  - run: {seconds: 1}\n    force: true\n", 4, "run: unknown key 'force'"),
+    (S + "  - runn: {seconds: 1}\n", 3, "unknown step kind 'runn' (did you mean 'run'?)"),
+    (S + "  - wait 1 s\n", 3, "a step is a mapping"),
+    (S + "  - run: {seconds: 1}\n    expect: x\n", 4, "one step, two actions ('run' and 'expect')"),
+    (S + "  - run: {seconds: 1}\n    force: true\n", 4, "run: unknown key 'force'"),
     # set / release
-    ("name: n\nsteps:\n  - set: {DriveInit4.stop: true}\n", 3, "unknown chart 'DriveInit4' (did you mean"),
-    ("name: n\nsteps:\n  - set: {DriveInit1.stopp: true}\n", 3, "DriveInit1 has no input 'stopp' (did you mean 'stop'?)"),
-    ("name: n\nsteps:\n  - set: {DriveInit1.ini_23: true}\n", 3, "DriveInit1.ini_23 is an output, not an input"),
-    ("name: n\nsteps:\n  - set: {DriveInit1.stop: 1}\n", 3, "DriveInit1.stop is a flag: expected true or false, got number 1"),
-    ("name: n\nsteps:\n  - set: {DriveInit1.pos_in: yes please}\n", 3, "DriveInit1.pos_in is a number (rad)"),
-    ("name: n\nsteps:\n  - set:\n      DriveInit1.stop: true\n      DriveInit1.pos_in: x\n", 5, "is a number"),
-    ("name: n\nsteps:\n  - set: {stop: true}\n", 3, "set: expected Chart.input like DriveInit1.stop"),
-    ("name: n\nsteps:\n  - set: {DriveInit1.stop: true}\n    force: 1\n", 4, "force: expected true or false"),
-    ("name: n\nsteps:\n  - set: {DriveInit1.stop: yes}\n", 3, "expected true or false, got text 'yes'"),
-    ("name: n\nsteps:\n  - release:\n    - DriveInit1.index\n    - DriveInit1.offset\n", 5,
+    (S + "  - set: {DriveInit4.stop: true}\n", 3, "unknown chart 'DriveInit4' (did you mean"),
+    (S + "  - set: {DriveInit1.stopp: true}\n", 3, "DriveInit1 has no input 'stopp' (did you mean 'stop'?)"),
+    (S + "  - set: {DriveInit1.ini_23: true}\n", 3, "DriveInit1.ini_23 is an output, not an input"),
+    (S + "  - set: {DriveInit1.stop: 1}\n", 3, "DriveInit1.stop is a flag: expected true or false"),
+    (S + "  - set: {DriveInit1.pos_in: yes please}\n", 3, "DriveInit1.pos_in is a number (rad)"),
+    (S + "  - set:\n      DriveInit1.stop: true\n      DriveInit1.pos_in: x\n", 5, "is a number"),
+    (S + "  - set: {stop: true}\n", 3, "set: expected Chart.input like DriveInit1.stop"),
+    (S + "  - set: {DriveInit1.stop: true}\n    force: 1\n", 4, "force: expected true or false"),
+    (S + "  - set: {DriveInit1.stop: yes}\n", 3, "expected true or false, got text 'yes'"),
+    (S + "  - release:\n    - DriveInit1.index\n    - DriveInit1.offset\n", 5,
      "DriveInit1.offset is an output"),
     # post
-    ("name: n\nsteps:\n  - post: {chart: DriveInit1, event: go}\n", 3,
+    (S + "  - post: {chart: DriveInit1, event: go}\n", 3,
      "DriveInit1 handles no event 'go'; events: (none: all its transitions are tick transitions)"),
-    ("name: n\nsteps:\n  - post: {chart: DriveInit1}\n", 3, "post: missing event:"),
+    (S + "  - post: {chart: DriveInit1}\n", 3, "post: missing event:"),
     # run / run_until
-    ("name: n\nsteps:\n  - run: 1\n", 3, "run: expected {seconds: S} or {chart_steps: N}"),
-    ("name: n\nsteps:\n  - run: {seconds: -1}\n", 3, "run: seconds must be > 0"),
-    ("name: n\nsteps:\n  - run: {chart_steps: 1.5}\n", 3, "chart_steps expected a whole number"),
-    ("name: n\nsteps:\n  - run: {minutes: 1}\n", 3, "run: unknown key 'minutes'"),
-    ("name: n\nsteps:\n  - run_until: {entered: DriveInit1.turn_back}\n", 3, "run_until: missing timeout_s:"),
-    ("name: n\nsteps:\n  - run_until: {timeout_s: 1}\n", 3, "give exactly one of entered, active, condition"),
-    ("name: n\nsteps:\n  - run_until: {entered: DriveInit1.turn_bak, timeout_s: 1}\n", 3,
+    (S + "  - run: 1\n", 3, "run: expected {seconds: S} or {chart_steps: N}"),
+    (S + "  - run: {seconds: -1}\n", 3, "run: seconds must be > 0"),
+    (S + "  - run: {chart_steps: 1.5}\n", 3, "chart_steps expected a whole number"),
+    (S + "  - run: {minutes: 1}\n", 3, "run: unknown key 'minutes'"),
+    (S + "  - run_until: {entered: DriveInit1.turn_back}\n", 3, "run_until: missing timeout_s:"),
+    (S + "  - run_until: {timeout_s: 1}\n", 3, "give exactly one of entered, active, condition"),
+    (S + "  - run_until: {entered: DriveInit1.turn_bak, timeout_s: 1}\n", 3,
      "DriveInit1 has no state 'turn_bak' (did you mean 'turn_back'?)"),
-    ("name: n\nsteps:\n  - run_until: {entered: DriveInit1.h, timeout_s: 1}\n", 3, "history pseudo-state"),
-    ("name: n\nsteps:\n  - run_until: {entered: DriveInit1.turn_back, timeout_s: soon}\n", 3,
+    (S + "  - run_until: {entered: DriveInit1.h, timeout_s: 1}\n", 3, "history pseudo-state"),
+    (S + "  - run_until: {entered: DriveInit1.turn_back, timeout_s: soon}\n", 3,
      "timeout_s expected a number, got text 'soon'"),
-    ("name: n\nsteps:\n  - run_until:\n      condition: DriveInit1.x > 1\n      timeout_s: 1\n", 4,
+    (S + "  - run_until:\n      condition: DriveInit1.x > 1\n      timeout_s: 1\n", 4,
      "DriveInit1 has no datum or state 'x'"),
     # conditions
-    ("name: n\nsteps:\n  - expect: DriveInit1.pos_Encoder >> 1\n", 3, "at column 25"),
-    ("name: n\nsteps:\n  - expect: q_tru[1] > 0\n", 3, "unknown name 'q_tru' (did you mean 'q_true'?)"),
-    ("name: n\nsteps:\n  - expect: q_true[0] > 0\n", 3, "numbered from 1"),
-    ("name: n\nsteps:\n  - expect: q_true[5] > 0\n", 3, "q_true[5] out of range"),
-    ("name: n\nsteps:\n  - expect: q_true > 0\n", 3, "signal q_true has 4 values: pick one"),
-    ("name: n\nsteps:\n  - expect: t[1] > 0\n", 3, "signal t is a single value"),
-    ("name: n\nsteps:\n  - expect: DriveInit1.stop[1]\n", 3, "DriveInit1.stop is not a list"),
-    ("name: n\nsteps:\n  - expect: 3\n", 3, "expect: expected a condition"),
-    ("name: n\nsteps:\n  - expect: {within_s: 1}\n", 3, "expect: missing condition:"),
-    ("name: n\nsteps:\n  - expect:\n      condition: t > 1\n      within_s: 1\n      for_s: 1\n", 6,
+    (S + "  - expect: DriveInit1.pos_Encoder >> 1\n", 3, "at column 25"),
+    (S + "  - expect: q_tru[1] > 0\n", 3, "unknown name 'q_tru' (did you mean 'q_true'?)"),
+    (S + "  - expect: q_true[0] > 0\n", 3, "numbered from 1"),
+    (S + "  - expect: q_true[5] > 0\n", 3, "q_true[5] out of range"),
+    (S + "  - expect: q_true > 0\n", 3, "signal q_true has 4 values: pick one"),
+    (S + "  - expect: t[1] > 0\n", 3, "signal t is a single value"),
+    (S + "  - expect: DriveInit1.stop[1]\n", 3, "DriveInit1.stop is not a list"),
+    (S + "  - expect: 3\n", 3, "expect: expected a condition"),
+    (S + "  - expect: {within_s: 1}\n", 3, "expect: missing condition:"),
+    (S + "  - expect:\n      condition: t > 1\n      within_s: 1\n      for_s: 1\n", 6,
      "within_s (holds at some moment) and for_s (holds all the time) exclude each other"),
     # expect_states
-    ("name: n\nsteps:\n  - expect_states: {chart: DriveInit1}\n", 3, "expect_states: missing sequence:"),
-    ("name: n\nsteps:\n  - expect_states:\n      chart: DriveInit1\n      sequence:\n        - turn_fwd\n"
+    (S + "  - expect_states: {chart: DriveInit1}\n", 3, "expect_states: missing sequence:"),
+    (S + "  - expect_states:\n      chart: DriveInit1\n      sequence:\n        - turn_fwd\n"
      "        - turn_forward\n", 7, "DriveInit1 has no state 'turn_forward'"),
-    ("name: n\nsteps:\n  - expect_states: {chart: DriveInit1, sequence: [run], match: exact}\n", 3,
+    (S + "  - expect_states: {chart: DriveInit1, sequence: [run], match: exact}\n", 3,
      "DriveInit1.run is a compound state; an exact sequence lists the leaf states"),
-    ("name: n\nsteps:\n  - expect_states: {chart: DriveInit1, sequence: [run], match: strict}\n", 3,
+    (S + "  - expect_states: {chart: DriveInit1, sequence: [run], match: strict}\n", 3,
      "match expected one of subsequence, exact"),
-    ("name: n\nsteps:\n  - mark: [1]\n", 3, "mark: expected a label"),
+    (S + "  - mark: [1]\n", 3, "mark: expected a label"),
 ])
 def test_mistakes_name_file_line_and_what(text: str, line: int, message: str) -> None:
     err = error_of(text)
@@ -178,7 +181,7 @@ def test_mistakes_name_file_line_and_what(text: str, line: int, message: str) ->
 
 def test_a_file_error_names_the_path(tmp_path: Path) -> None:
     path = tmp_path / "drive_1_does_something.yaml"
-    path.write_text("name: n\nsteps:\n  - run: {seconds: 1}\n  - expect: DriveInit1.nothing\n")
+    path.write_text(S + "  - run: {seconds: 1}\n  - expect: DriveInit1.nothing\n")
     with pytest.raises(ScenarioError) as info:
         load_scenario(path)
     assert str(info.value).startswith(f"{path}:4: expect: DriveInit1 has no datum or state 'nothing'")

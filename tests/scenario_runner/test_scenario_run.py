@@ -60,10 +60,10 @@ def test_failures_name_the_failing_steps_and_expectations_do_not_stop_the_run() 
     texts = [str(f) for f in r.failures]
     assert texts[0].startswith("s.yaml:4: expect: 'DriveInit1.turn_back or q_true[1] > 10deg' is false;")
     assert "t = 0.004 s; DriveInit1.turn_back = false; q_true[1] = " in texts[0]
-    assert texts[1] == ("s.yaml:5: expect_states: expected DriveInit1 to enter these states in this order since"
-                        " the start: turn_fwd, turn_back; it entered run, initialise, power_on, turn_fwd"
-                        " (no turn_back after turn_fwd); DriveInit1 is in turn_fwd")
-    assert texts[2].startswith("s.yaml:6: run_until: DriveInit1.go_park entered did not happen within 0.2 s"
+    assert texts[1] == ("s.yaml:5: expect_states: expected DriveInit1 to enter these states in this"
+                        " order since the start: turn_fwd, turn_back; it entered run, initialise, power_on,"
+                        " turn_fwd (no turn_back after turn_fwd); DriveInit1 is in turn_fwd")
+    assert texts[2].startswith("s.yaml:6: run_until: DriveInit1 did not enter go_park within 0.2 s"
                                " (from t = 0.004 s to 0.204 s); DriveInit1 is in turn_fwd;"
                                " it entered no state meanwhile")
     assert r.to_dict()["failures"] == texts
@@ -76,7 +76,7 @@ def test_a_condition_that_times_out_reports_its_values() -> None:
           - run_until: {condition: "DriveInit1.pos_Encoder > 1.0", timeout_s: 0.1}
         """)
     assert lines(r) == [3]
-    assert "'DriveInit1.pos_Encoder > 1.0' did not happen within 0.1 s" in r.failures[0].message
+    assert "run_until: 'DriveInit1.pos_Encoder > 1.0' did not hold within 0.1 s" in r.failures[0].message
     assert "values now: t = 0.100 s; DriveInit1.pos_Encoder = " in r.failures[0].message
 
 
@@ -326,5 +326,6 @@ def test_an_expression_error_at_run_time_is_a_failure() -> None:
 def test_post_checks_the_event(text: str, message: str) -> None:
     from ttt_sm.scenario import ScenarioError
 
-    with pytest.raises(ScenarioError, match=message.replace("(", r"\(").replace(")", r"\)").replace("?", r"\?")):
+    with pytest.raises(ScenarioError) as info:
         load_scenario_text(text, "s.yaml", catalog=LAMP)
+    assert message in str(info.value)

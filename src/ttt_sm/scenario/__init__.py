@@ -15,7 +15,7 @@ See ``docs/scenarios.md``.
 """
 
 from .errors import ScenarioError
-from .expr import Expression, ExprError, Ref, parse
+from .expr import ExprError, Expression, Ref, parse
 from .loader import load_scenario, load_scenario_text, scenario_files
 from .model import SIGNALS, Catalog, Scenario
 from .runner import Failure, RunReport, ScenarioResult, coverage_dict, run_scenario, run_scenarios

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import ScenarioError
-from .expr import Expression, ExprError, parse
+from .expr import ExprError, Expression, parse
 from .model import (
     Catalog,
     ChartRef,
@@ -102,7 +102,8 @@ class _Checker:
         description = self.text(doc, "description") if "description" in doc else ""
         seed = doc.get("seed", 0)
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            raise self.error(doc.line_of("seed"), f"seed: expected a whole number >= 0, got {_type_name(seed)}")
+            raise self.error(doc.line_of("seed"),
+                             f"seed: expected a whole number >= 0, got {_type_name(seed)}")
         start = self.start(doc["start"], doc.line_of("start")) if "start" in doc else Start()
         steps_data = doc["steps"]
         if not isinstance(steps_data, MarkedList) or not steps_data:
@@ -138,14 +139,15 @@ class _Checker:
 
     def start(self, data: Any, line: int) -> Start:
         if not isinstance(data, MarkedDict):
-            raise self.error(line, f"start: expected a mapping with q_deg: and settle_s:, got {_type_name(data)}")
+            raise self.error(line, "start: expected a mapping with q_deg: and settle_s:,"
+                                   f" got {_type_name(data)}")
         self.keys(data, ("q_deg", "settle_s"), "start")
         q_deg: tuple[float, ...] | None = None
         if "q_deg" in data:
             q = data["q_deg"]
             if not isinstance(q, list) or len(q) not in (3, 4) or not all(_is_number(v) for v in q):
-                raise self.error(data.line_of("q_deg"), "start: q_deg expected a list of 3 or 4 joint angles in"
-                                                        f" degrees (q1, q2, q3[, q4]), got {q!r}")
+                raise self.error(data.line_of("q_deg"), "start: q_deg expected a list of 3 or 4 joint"
+                                                        f" angles in degrees (q1, q2, q3[, q4]), got {q!r}")
             q_deg = tuple(float(v) for v in q) + ((0.0,) if len(q) == 3 else ())
         settle = self.number(data, "settle_s", "start", positive=False) if "settle_s" in data else 0.0
         return Start(q_deg=q_deg, settle_s=settle, where=Where(self.file, data.line))
@@ -162,8 +164,8 @@ class _Checker:
             raise self.error(item.key_lines[key], f"unknown step kind {key!r}{_guess(key, STEP_OPTIONS)};"
                                                   f" step kinds: {', '.join(STEP_OPTIONS)}")
         if len(kinds) > 1:
-            raise self.error(item.key_lines[kinds[1]], f"one step, two actions ({kinds[0]!r} and {kinds[1]!r}):"
-                                                       " start a new step with '- '")
+            raise self.error(item.key_lines[kinds[1]], f"one step, two actions ({kinds[0]!r} and"
+                                                       f" {kinds[1]!r}): start a new step with '- '")
         kind = kinds[0]
         self.keys(item, (kind, *STEP_OPTIONS[kind]), kind)
         where = Where(self.file, item.key_lines[kind])
@@ -202,7 +204,8 @@ class _Checker:
 
     def step_post(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
         if not isinstance(value, MarkedDict):
-            raise self.error(line, f"post: expected {{chart: ..., event: ..., data: {{...}}}}, got {_type_name(value)}")
+            raise self.error(line, "post: expected {chart: ..., event: ..., data: {...}},"
+                                   f" got {_type_name(value)}")
         self.keys(value, ("chart", "event", "data"), "post")
         for key in ("chart", "event"):
             if key not in value:
@@ -211,8 +214,9 @@ class _Checker:
         event = value["event"]
         events = self.catalog.charts[chart].structure().user_events
         if event not in events:
-            raise self.error(value.line_of("event"), f"post: {chart} handles no event {event!r}{_guess(event, events)};"
-                                                     f" events: {', '.join(events) or '(none: all its transitions are tick transitions)'}")
+            listed = ", ".join(events) or "(none: all its transitions are tick transitions)"
+            raise self.error(value.line_of("event"), f"post: {chart} handles no event {event!r}"
+                                                     f"{_guess(event, events)}; events: {listed}")
         data = value.get("data", {})
         if not isinstance(data, dict) or not all(isinstance(k, str) and k.isidentifier() for k in data):
             raise self.error(value.line_of("data"), "post: data expected a mapping of names to values")
@@ -220,7 +224,8 @@ class _Checker:
 
     def step_run(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
         if not isinstance(value, MarkedDict) or len(value) != 1:
-            raise self.error(line, f"run: expected {{seconds: S}} or {{chart_steps: N}}, got {_type_name(value)}")
+            raise self.error(line, "run: expected {seconds: S} or {chart_steps: N},"
+                                   f" got {_type_name(value)}")
         self.keys(value, ("seconds", "chart_steps"), "run")
         if "seconds" in value:
             return RunStep(where, seconds=self.number(value, "seconds", "run"))
@@ -249,7 +254,9 @@ class _Checker:
             cond = self.condition(value["condition"], value.line_of("condition"), "run_until")
             return RunUntilStep(where, timeout, condition=cond)
         ref = self.chart_ref(value[goal], value.line_of(goal), "run_until", want="state")
-        return RunUntilStep(where, timeout, **{goal: ref})
+        if goal == "entered":
+            return RunUntilStep(where, timeout, entered=ref)
+        return RunUntilStep(where, timeout, active=ref)
 
     def step_expect(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
         if isinstance(value, str):

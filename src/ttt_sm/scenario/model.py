@@ -111,12 +111,13 @@ class RunUntilStep(Step):
     kind = "run_until"
 
     @property
-    def goal(self) -> str:
+    def missed(self) -> str:
+        """What did not happen, for a timeout message."""
         if self.entered is not None:
-            return f"{self.entered} entered"
+            return f"{self.entered.chart} did not enter {self.entered.name}"
         if self.active is not None:
-            return f"{self.active} active"
-        return repr(str(self.condition))
+            return f"{self.active} was not active"
+        return f"{str(self.condition)!r} did not hold"
 
 
 @dataclass(frozen=True)

@@ -62,6 +62,14 @@ class ScenarioFile(pytest.File):
         yield ScenarioItem.from_parent(self, name=self.path.stem)
 
 
+def _shown(path: Path) -> Path:
+    """The path relative to the working folder when it is under it: short, and an editor finds it."""
+    try:
+        return path.relative_to(Path.cwd())
+    except ValueError:
+        return path
+
+
 class ScenarioItem(pytest.Item):
     """One scenario run on a new simulated robot."""
 
@@ -74,7 +82,7 @@ class ScenarioItem(pytest.Item):
         return stash[_PARAMS]
 
     def runtest(self) -> None:
-        scenario = load_scenario(self.path)
+        scenario = load_scenario(_shown(self.path))
         result = run_scenario(scenario, self._params(), coverage=self.config.stash[_COVERAGE])
         self.user_properties.append(("sim_time_s", round(result.sim_time_s, 3)))
         if not result.passed:

@@ -26,7 +26,7 @@ import numpy as np
 from ..params import ArmParams
 from ..runtime import TickChart, states_entered_by
 from ..runtime.listeners import Coverage, CoverageReport, Trace
-from .expr import Expression, ExprError, Ref
+from .expr import ExprError, Expression, Ref
 from .model import (
     ChartRef,
     ExpectStatesStep,
@@ -70,7 +70,7 @@ def default_robot(scenario: Scenario, params: ArmParams, listeners: Sequence[obj
     """The simulated robot at the scenario's power-on pose."""
     from ..app.robot import Robot
 
-    q = np.radians(scenario.start.q_deg) if scenario.start.q_deg is not None else None
+    q = [math.radians(v) for v in scenario.start.q_deg] if scenario.start.q_deg is not None else None
     return Robot(params, seed=scenario.seed, q_start=q, settle_s=scenario.start.settle_s,
                  listeners=listeners)
 
@@ -320,9 +320,10 @@ class _Run:
         else:
             assert target is not None
             since = [e.state for e in self.log.entries.get(target.chart, [])[seen:]]
-            entered = f"; it entered {', '.join(since)} meanwhile" if since else "; it entered no state meanwhile"
+            entered = f"; it entered {', '.join(since)} meanwhile" if since else \
+                "; it entered no state meanwhile"
             detail = f"{self.where_is(target.chart)}{entered}"
-        self.fail(step, f"run_until: {step.goal} did not happen within {_seconds(step.timeout_s)}"
+        self.fail(step, f"run_until: {step.missed} within {_seconds(step.timeout_s)}"
                         f" (from t = {t0:.3f} s to {robot.t:.3f} s); {detail}", stop=True)
 
     def do_expect(self, step: ExpectStep) -> None:
@@ -384,7 +385,8 @@ def _check_start(scenario: Scenario, params: ArmParams) -> str | None:
 
 
 def run_scenario(scenario: Scenario, params: ArmParams, *, coverage: Coverage | None = None,
-                 listeners: Sequence[object] = (), robot_factory: RobotFactory | None = None) -> ScenarioResult:
+                 listeners: Sequence[object] = (),
+                 robot_factory: RobotFactory | None = None) -> ScenarioResult:
     """Run one loaded scenario on a new robot.
 
     Parameters

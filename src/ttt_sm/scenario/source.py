@@ -57,7 +57,8 @@ class MarkedLoader(yaml.SafeLoader):
             try:
                 hash(key)
             except TypeError:
-                raise ScenarioError(self.name, _line(key_node), "a mapping key must be a plain value") from None
+                raise ScenarioError(self.name, _line(key_node),
+                                    "a mapping key must be a plain value") from None
             if key in data:
                 raise ScenarioError(self.name, _line(key_node),
                                     f"key {key!r} given twice (first on line {data.key_lines[key]});"

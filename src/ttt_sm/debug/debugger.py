@@ -364,16 +364,24 @@ class Debugger:
     def replay(self, tick: int) -> ReplayResult:
         """Rebuild the robot and run it to chart ``tick``, re-applying the recorded inputs.
 
-        Inputs and events recorded after that point are dropped (the session
-        continues from the replayed past).  Breakpoints do not hit during a
-        replay; the trace is recorded anew.
+        It stops where a breakpoint at that tick stops: right after the control
+        step holding the tick (:meth:`steps_of_tick`).  Inputs and events
+        recorded after that point are dropped (the session continues from the
+        replayed past).  Breakpoints do not hit during a replay; the trace is
+        recorded anew.
         """
+        if not isinstance(tick, int) or tick < 0:
+            raise DebugError(f"replay: the chart tick must be a whole number >= 0, got {tick!r}")
+        return self.replay_to_step(self.steps_of_tick(tick))
+
+    def replay_to_step(self, steps: int) -> ReplayResult:
+        """:meth:`replay` to any control step count (a position between two ticks, too)."""
         if self.recipe is None:
             raise DebugError("replay needs the robot's recipe: build with Debugger.build(...) or"
                              " pass recipe=RobotRecipe(params, seed, q_start, settle_s)")
-        if not isinstance(tick, int) or tick < 0:
-            raise DebugError(f"replay: the chart tick must be a whole number >= 0, got {tick!r}")
-        target = self.steps_of_tick(tick)
+        if not isinstance(steps, int) or steps < 0:
+            raise DebugError(f"replay: the step must be a whole number >= 0, got {steps!r}")
+        target = steps
         kept = [a for a in self.actions if a.steps <= target]
         dropped = len(self.actions) - len(kept)
         self.forced = {}
@@ -400,7 +408,7 @@ class Debugger:
         for bp in self.breakpoints:
             if bp.condition is not None:
                 bp.last_value = bp.condition.evaluate(self._names)
-        return ReplayResult(tick, robot.steps, robot.t, len(kept), dropped,
+        return ReplayResult(robot.chart_ticks, robot.steps, robot.t, len(kept), dropped,
                             None if before is None else not diffs, diffs)
 
 

@@ -73,7 +73,7 @@ class ReplayResult:
     differences: tuple[str, ...] = ()
 
     def describe(self) -> str:
-        text = f"replayed to chart tick {self.tick} (t = {self.t:.4f} s, step {self.steps})," \
+        text = f"replayed to step {self.steps} (t = {self.t:.4f} s, chart tick {self.tick})," \
                f" {self.applied} recorded input{'s' if self.applied != 1 else ''} re-applied"
         if self.dropped:
             text += f", {self.dropped} later one{'s' if self.dropped != 1 else ''} dropped"

@@ -200,26 +200,41 @@ def sponge_q(x: float, y: float, press: float) -> np.ndarray:
     return q_at(x, y, PARAMS.sponge.offset - press, math.pi / 2)
 
 
-def test_at_phi_90_the_sponge_wipes_what_its_pad_sweeps_and_nothing_else():
+def under_pads(points: np.ndarray, centres: np.ndarray, q1s: np.ndarray, half: float) -> np.ndarray:
+    """Which points lie under a square pad of half-side `half` at any of the centres (edges turned by q1)."""
+    hit = np.zeros(len(points), bool)
+    for (cx, cy), q1 in zip(centres, q1s, strict=True):
+        dx, dy = points[:, 0] - cx, points[:, 1] - cy
+        u = dx * math.cos(q1) + dy * math.sin(q1)
+        v = -dx * math.sin(q1) + dy * math.cos(q1)
+        hit |= (np.abs(u) <= half) & (np.abs(v) <= half)
+    return hit
+
+
+@pytest.mark.parametrize("x_pass", [0.0, -0.06])  # pad square to the axes (q1 = 0), and turned
+def test_at_phi_90_the_sponge_wipes_what_its_pad_sweeps_and_nothing_else(x_pass):
     board = Whiteboard(PARAMS)
     for y in (0.20, 0.23, 0.26, 0.29):  # crossed by the pass
-        board.draw_stroke([(-0.06, y), (0.06, y)], jitter_mm=0.0, author="robot", width_mm=0.8)
-    board.draw_stroke([(0.04, 0.17), (0.04, 0.32)], jitter_mm=0.0)  # beside the pass
+        board.draw_stroke([(-0.1, y), (0.1, y)], jitter_mm=0.0, author="robot", width_mm=0.8)
+    board.draw_stroke([(x_pass + 0.04, 0.17), (x_pass + 0.04, 0.32)], jitter_mm=0.0)  # beside it
     before = board.ink_mask().copy()
-    y_a, y_b = 0.19, 0.30
-    board.update(0.0, sponge_q(0.0, y_a, 0.002))  # pressed onto the board
+    ys_pass = np.arange(0.19, 0.30, 0.05 * DT)  # a pass along Y at 50 mm/s
+    qs = [sponge_q(x_pass, y, 0.002) for y in ys_pass]
+    board.update(0.0, qs[0])  # pressed onto the board
     assert board.contact.sponge_touching and not board.contact.pen_touching
-    for k, y in enumerate(np.arange(y_a, y_b, 0.05 * DT)):  # a pass along Y at 50 mm/s
-        board.update((k + 1) * DT, sponge_q(0.0, y, 0.002))
-    board.update(10.0, q_at(0.0, y_b, 0.03, math.pi / 2))
+    for k, q in enumerate(qs[1:]):
+        board.update((k + 1) * DT, q)
+    board.update(10.0, q_at(x_pass, ys_pass[-1], 0.03, math.pi / 2))
     assert not board.contact.sponge_touching
 
     half = PARAMS.sponge.width / 2
+    centres = np.column_stack((np.full(len(ys_pass), x_pass), ys_pass))
+    q1s = np.array([q[0] for q in qs])
     ys, xs = np.nonzero(before)
-    px = board.extent[0] + (xs + 0.5) * RES
-    py = board.extent[2] + (ys + 0.5) * RES
-    inside = (np.abs(px) <= half - RES) & (py >= y_a - half + RES) & (py <= y_b + half - RES)
-    outside = (np.abs(px) > half + RES) | (py < y_a - half - RES) | (py > y_b + half + RES)
+    pixels = board.pixel_centers_m(before)
+    inside = under_pads(pixels, centres[::5], q1s[::5], half - RES)
+    outside = ~under_pads(pixels, centres, q1s, half + RES)
+    assert inside.sum() > 1000 and outside.sum() > 1000
     after = board.ink_mask()
     assert not after[ys[inside], xs[inside]].any()
     assert after[ys[outside], xs[outside]].all()
@@ -229,7 +244,7 @@ def test_at_phi_90_the_sponge_wipes_what_its_pad_sweeps_and_nothing_else():
     strokes = board.strokes
     assert len(strokes) == 4 * 2 + 1  # each crossed line split in two, the side line whole
     for s in strokes:
-        assert not np.any(np.abs(s.points[:, 0]) < half - RES)
+        assert not under_pads(s.points, centres[::5], q1s[::5], half - RES).any()
     # strokes and raster agree: every stroke point sits on ink, all ink lies along a stroke
     ix = ((np.concatenate([s.points[:, 0] for s in strokes]) - board.extent[0]) / RES).astype(int)
     iy = ((np.concatenate([s.points[:, 1] for s in strokes]) - board.extent[2]) / RES).astype(int)

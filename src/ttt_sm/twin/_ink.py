@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _index_lo(v: float, lo: float, res: float, n: int) -> int:
     """First pixel index whose centre is >= v, clipped to [0, n]."""
     f = math.ceil((v - lo) / res - 0.5)
@@ -30,7 +30,7 @@ def _index_lo(v: float, lo: float, res: float, n: int) -> int:
     return int(f)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _index_hi(v: float, lo: float, res: float, n: int) -> int:
     """Last pixel index whose centre is <= v, clipped to [-1, n - 1]."""
     f = math.floor((v - lo) / res - 0.5)
@@ -109,25 +109,50 @@ def _convex_hull(px: np.ndarray, py: np.ndarray, hx: np.ndarray, hy: np.ndarray)
 
 
 @njit(cache=True)
-def _row_span(hx: np.ndarray, hy: np.ndarray, m: int, y: float) -> tuple[float, float]:
-    """x interval where the horizontal line at `y` crosses a convex polygon (lo > hi: misses)."""
-    lo = math.inf
-    hi = -math.inf
+def _bounds(hx: np.ndarray, hy: np.ndarray, m: int, bnd: np.ndarray, row: int) -> tuple[int, int]:
+    """Half-planes of a convex CCW polygon as bounds on x along a row: ``x >= a + b y`` or ``x <= a + b y``.
+
+    Edge k (from vertex k to k + 1) keeps the polygon on the side
+    ``nx x + ny y <= d`` with the outward normal ``(nx, ny) = (dy, -dx)``,
+    that is ``x <= a + b y`` (nx > 0) or ``x >= a + b y`` (nx < 0) with
+    ``(a, b) = (d / nx, -ny / nx)``.  Lower bounds go to ``bnd[row]`` (a) and
+    ``bnd[row + 1]`` (b), upper bounds to ``bnd[row + 2]`` and ``bnd[row + 3]``.
+    Horizontal edges only bound y, which the caller's row range already does.
+    Returns ``(n_lower, n_upper)``.
+    """
+    n_lo = 0
+    n_hi = 0
     for k in range(m):
         xa = hx[k]
         ya = hy[k]
         xb = hx[(k + 1) % m]
         yb = hy[(k + 1) % m]
-        if (ya - y) * (yb - y) > 0.0:
+        nx = yb - ya
+        ny = xa - xb
+        if abs(nx) <= 1e-12 * (abs(nx) + abs(ny)):
             continue
-        if ya == yb:
-            lo = min(lo, xa, xb)
-            hi = max(hi, xa, xb)
+        d = nx * xa + ny * ya
+        if nx > 0.0:
+            bnd[row + 2, n_hi] = d / nx
+            bnd[row + 3, n_hi] = -ny / nx
+            n_hi += 1
         else:
-            x = xa + (y - ya) * (xb - xa) / (yb - ya)
-            lo = min(lo, x)
-            hi = max(hi, x)
-    return lo, hi
+            bnd[row, n_lo] = d / nx
+            bnd[row + 1, n_lo] = -ny / nx
+            n_lo += 1
+    return n_lo, n_hi
+
+
+@njit(cache=True, inline="always")
+def _span(bnd: np.ndarray, row: int, n_lo: int, n_hi: int, y: float) -> tuple[float, float]:
+    """x interval of a convex polygon (given by :func:`_bounds`) along the row at `y`."""
+    a = -math.inf
+    for k in range(n_lo):
+        a = max(a, bnd[row, k] + bnd[row + 1, k] * y)
+    b = math.inf
+    for k in range(n_hi):
+        b = min(b, bnd[row + 2, k] + bnd[row + 3, k] * y)
+    return a, b
 
 
 @njit(cache=True)
@@ -143,47 +168,53 @@ def _square(cx: float, cy: float, c: float, s: float, half: float,
 
 
 @njit(cache=True)
-def wipe_sweep(raster: np.ndarray, stamp: np.ndarray, x0: float, y0: float, res: float,
-               c: float, s: float, half: float, ax: float, ay: float, bx: float, by: float,
+def wipe_sweep(raster: np.ndarray, stamp: np.ndarray, x0: float, y0: float, res: float, half: float,
+               ax: float, ay: float, ca: float, sa: float, bx: float, by: float, cb: float, sb: float,
                skip_a: bool, seq: int) -> int:
     """Wipe the pixels a square pad sweeps moving from a to b; returns the ink pixels wiped.
 
-    The pad is a square of half-side `half` (m) whose edges run along (c, s)
-    and (-s, c); the swept area is the convex hull of the pad at a and at b.
-    With `skip_a` the pad at a (already wiped at the previous step, shrunk by
-    one pixel against round-off and a slight turn of the pad) is left out, so
-    a moving pad costs only the strip it newly covers.  Every wiped pixel
-    gets `seq` in `stamp`: a stroke point laid before that is gone.
+    The pad is a square of half-side `half` (m); at a its edges run along
+    (ca, sa) and (-sa, ca), at b along (cb, sb) and (-sb, cb).  The swept
+    area is taken as the convex hull of the pad at a and at b.  With
+    `skip_a` the pad at a, which the previous call wiped as its pad at b, is
+    left out (shrunk by 0.1 um against round-off), so a moving pad costs only
+    the strip it newly covers.
+
+    Every wiped ink pixel gets `seq` in `stamp`; a stroke point laid there
+    before `seq` is gone.  Clean pixels need no stamp: a stroke point always
+    lies on ink when laid (the line is wider than a pixel's half-diagonal),
+    so a clean pixel's points were stamped out by the wipe that cleaned it.
     """
     ny, nx = raster.shape
     px = np.empty(8)
     py = np.empty(8)
-    _square(ax, ay, c, s, half, px, py, 0)
-    _square(bx, by, c, s, half, px, py, 4)
+    _square(ax, ay, ca, sa, half, px, py, 0)
+    _square(bx, by, cb, sb, half, px, py, 4)
     hx = np.empty(9)
     hy = np.empty(9)
     m = _convex_hull(px, py, hx, hy)
-    sx = np.empty(4)
-    sy = np.empty(4)
-    inner = half - res
-    if skip_a and inner > 0.0:
-        _square(ax, ay, c, s, inner, sx, sy, 0)
-    else:
-        skip_a = False
+    bnd = np.empty((8, 8))  # rows 0-3: the hull's bounds, 4-7: the pad at a's
+    n_lo, n_hi = _bounds(hx, hy, m, bnd, 0)
+    s_lo = s_hi = 0
+    sy_min = sy_max = 0.0
+    if skip_a:
+        _square(ax, ay, ca, sa, half - 1e-7, hx, hy, 0)
+        s_lo, s_hi = _bounds(hx, hy, 4, bnd, 4)
+        sy_min, sy_max = hy[:4].min(), hy[:4].max()
     j0 = _index_lo(py.min(), y0, res, ny)
     j1 = _index_hi(py.max(), y0, res, ny)
     wiped = 0
     for j in range(j0, j1 + 1):
         yc = y0 + (j + 0.5) * res
-        lo, hi = _row_span(hx, hy, m, yc)
+        lo, hi = _span(bnd, 0, n_lo, n_hi, yc)
         if lo > hi:
             continue
         i0 = _index_lo(lo, x0, res, nx)
         i1 = _index_hi(hi, x0, res, nx)
         k0 = nx
         k1 = -1  # skipped columns (inside the pad at a)
-        if skip_a:
-            slo, shi = _row_span(sx, sy, 4, yc)
+        if skip_a and sy_min <= yc <= sy_max:
+            slo, shi = _span(bnd, 4, s_lo, s_hi, yc)
             if slo <= shi:
                 k0 = _index_lo(slo, x0, res, nx)
                 k1 = _index_hi(shi, x0, res, nx)
@@ -195,15 +226,15 @@ def wipe_sweep(raster: np.ndarray, stamp: np.ndarray, x0: float, y0: float, res:
     return wiped
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _wipe_run(raster: np.ndarray, stamp: np.ndarray, j: int, i0: int, i1: int, seq: int) -> int:
-    """Wipe pixels i0..i1 of row j; returns how many held ink."""
+    """Wipe pixels i0..i1 of row j, stamping the inked ones; returns how many held ink."""
     wiped = 0
     for i in range(i0, i1 + 1):
         if raster[j, i] != 0:
             wiped += 1
             raster[j, i] = 0
-        stamp[j, i] = seq
+            stamp[j, i] = seq
     return wiped
 
 

@@ -248,6 +248,7 @@ class Whiteboard:
         # sponge
         self._sp_on = False
         self._sp_x = self._sp_y = 0.0  # pad centre when it last wiped
+        self._sp_c, self._sp_s = 1.0, 0.0  # and the pad's edge direction then (the base azimuth)
         self._sp_press = 0.0
         self._sp_over = False
         self._sp_over_count = 0
@@ -451,13 +452,14 @@ class Whiteboard:
         if self._sp_on:
             if abs(fx - self._sp_x) + abs(fy - self._sp_y) < self._min_step:
                 return  # not moved: nothing new under the pad
-            wiped = wipe_sweep(self._ink, self._stamp, self._x0, self._y0, self._res, c1, s1, h,
-                               self._sp_x, self._sp_y, fx, fy, True, self._seq)
+            wiped = wipe_sweep(self._ink, self._stamp, self._x0, self._y0, self._res, h,
+                               self._sp_x, self._sp_y, self._sp_c, self._sp_s, fx, fy, c1, s1,
+                               True, self._seq)
         else:
             self._sp_on = True
-            wiped = wipe_sweep(self._ink, self._stamp, self._x0, self._y0, self._res, c1, s1, h,
-                               fx, fy, fx, fy, False, self._seq)
-        self._sp_x, self._sp_y = fx, fy
+            wiped = wipe_sweep(self._ink, self._stamp, self._x0, self._y0, self._res, h,
+                               fx, fy, c1, s1, fx, fy, c1, s1, False, self._seq)
+        self._sp_x, self._sp_y, self._sp_c, self._sp_s = fx, fy, c1, s1
         if wiped:
             self.wiped_pixels += wiped
             self._last_wipe_seq = self._seq
@@ -791,7 +793,7 @@ class Whiteboard:
         img = np.full((H, W, 3), 255.0, np.float32)  # rows along +y, columns along +x for now
         if grid_mm:
             self._draw_grid(img, rx0, ry0, px_per_m)
-        interp = cv2.INTER_AREA if px_per_m <= 1.0 / self._res else cv2.INTER_NEAREST
+        interp = cv2.INTER_AREA if px_per_m <= 1.0 / self._res else cv2.INTER_LINEAR
         for code, colour in ((1, ROBOT_INK_BGR), (2, HAND_INK_BGR)):
             cover = cv2.resize((sub == code).astype(np.float32), (W, H), interpolation=interp)
             if cover.any():

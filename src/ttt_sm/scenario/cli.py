@@ -64,7 +64,7 @@ def _report_errors(errors: list[ScenarioError], as_json: bool) -> int:
 
 def _line(result: ScenarioResult) -> str:
     verdict = "PASS" if result.passed else "FAIL"
-    head = (f"{verdict} {result.name}  ({result.file}; {result.sim_time_s:.2f} s simulated"
+    head = (f"{verdict} {result.name}  ({result.file}; {result.sim_time_s:.3f} s simulated"
             f" in {result.wall_time_s:.2f} s)")
     return "\n".join([head, *(f"  {f}" for f in result.failures)])
 

@@ -7,7 +7,9 @@ so every path here is exactly what forward kinematics of those angles says.
 from __future__ import annotations
 
 import math
+import re
 import time
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -477,3 +479,17 @@ def test_update_is_cheap():
     # generous bounds (measured ~1 and ~2 us): 500 updates must fit far inside 1/50 s
     assert lifted_us < 20.0
     assert inking_us < 40.0
+
+
+def test_docs_example_runs_and_prints_what_the_docs_say(tmp_path, monkeypatch, capsys):
+    doc = Path(__file__).resolve().parents[2] / "docs" / "whiteboard.md"
+    text = doc.read_text(encoding="utf-8")
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    assert blocks
+    monkeypatch.chdir(tmp_path)  # the example writes board.png
+    namespace: dict = {"__name__": "whiteboard_docs"}
+    for i, block in enumerate(blocks):
+        exec(compile(block, f"{doc.name}[block {i}]", "exec"), namespace)  # noqa: S102
+    printed = capsys.readouterr().out
+    assert printed.strip() in text
+    assert cv2.imread(str(tmp_path / "board.png")) is not None

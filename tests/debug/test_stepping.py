@@ -65,3 +65,21 @@ def test_bad_counts_and_times(dbg: Debugger, call, message):
     with pytest.raises(DebugError, match=message):
         call(dbg)
     assert dbg.robot.steps == 0
+
+
+def test_ctrl_c_during_a_run_pauses_it_between_two_control_steps(dbg: Debugger):
+    import os
+    import signal
+
+    class CtrlC:  # the user presses Ctrl-C as drive 1 turns back
+        def after_transition(self, target) -> None:
+            if target.id == "turn_back":
+                os.kill(os.getpid(), signal.SIGINT)
+
+    before = signal.getsignal(signal.SIGINT)
+    dbg.robot.chart("DriveInit1").add_listener(CtrlC())
+    stop = dbg.run(20.0)
+    assert stop.kind == "paused"
+    assert dbg.trace.records[-1].target == "turn_back"
+    assert stop.steps - dbg.steps_of_tick(dbg.trace.records[-1].tick) <= 2
+    assert signal.getsignal(signal.SIGINT) is before  # Ctrl-C means KeyboardInterrupt again

@@ -10,6 +10,7 @@ session goes on.
 from __future__ import annotations
 
 import cmd
+import inspect
 import json
 import shlex
 import sys
@@ -99,8 +100,29 @@ class DebugShell(cmd.Cmd):
         word = line.split()[0]
         self.error(f"unknown command {word!r}; commands: {', '.join(self.commands())}")
 
+    def get_names(self) -> list[str]:
+        return [n for n in super().get_names() if n != "do_EOF"]
+
     def commands(self) -> list[str]:
-        return sorted(n[3:] for n in self.get_names() if n.startswith("do_") and n != "do_EOF")
+        return sorted(n[3:] for n in self.get_names() if n.startswith("do_"))
+
+    def do_help(self, arg: str) -> None:
+        """help [COMMAND]: the commands, one line each, or one command in full."""
+        if arg.strip():
+            func = getattr(self, "do_" + arg.strip(), None)
+            if func is None or arg.strip() == "EOF":
+                raise DebugError(f"no command {arg.strip()!r}; commands: {', '.join(self.commands())}")
+            self.say(inspect.cleandoc(func.__doc__ or arg))
+            return
+        self.say("commands (help COMMAND for details):")
+        seen: set[object] = set()
+        for name in self.commands():
+            func = getattr(self, "do_" + name)
+            if func.__func__ in seen:
+                continue
+            seen.add(func.__func__)
+            first = inspect.cleandoc(func.__doc__ or name).splitlines()[0]
+            self.say(f"  {first}")
 
     def run_script(self, lines: Iterable[str]) -> None:
         """Run commands from a file or a pipe, echoed after the prompt; the end quits."""
@@ -125,8 +147,8 @@ class DebugShell(cmd.Cmd):
     # -- running ------------------------------------------------------------------
 
     def do_run(self, arg: str) -> None:
-        """run [SECONDS]: run until a breakpoint hits, SECONDS of simulated time pass
-        (default 60), or Ctrl-C pauses."""
+        """run [SECONDS]: run until a breakpoint hits or SECONDS pass (default 60); Ctrl-C pauses.
+        SECONDS are simulated seconds; the run stops between two control steps."""
         self.say(*views.stop_lines(self.dbg.run(_seconds(arg, "run", 60.0))))
 
     def do_step(self, arg: str) -> None:
@@ -292,10 +314,19 @@ class DebugShell(cmd.Cmd):
         self.say(f"posted {words[1]} to {words[0]}; handled at its next tick")
 
     def do_replay(self, arg: str) -> None:
-        """replay TICK: rebuild the robot from its seed and start pose, re-apply the inputs
-        recorded up to there, run to chart tick TICK and compare with the first visit."""
-        if not arg.strip():
-            raise DebugError("replay: to which chart tick? e.g. replay 1510")
+        """replay TICK | replay step N: rebuild the robot and run it again to chart tick TICK.
+        The robot is rebuilt from its parameters, seed and start pose; the inputs you set,
+        forced and posted up to there are re-applied at the same control steps (later ones
+        are dropped), and the state reached is compared with the one the session saw there
+        before: configurations, chart data and twin state, float for float."""
+        words = arg.split()
+        if not words:
+            raise DebugError("replay: to which chart tick? e.g. replay 1510 (or replay step 3021)")
+        if words[0] == "step":
+            if len(words) != 2:
+                raise DebugError("replay step: which control step? e.g. replay step 3021")
+            self.say(self.dbg.replay_to_step(_count(words[1], "replay step")).describe())
+            return
         self.say(self.dbg.replay(_count(arg, "replay")).describe())
 
     # -- leaving ----------------------------------------------------------------------

@@ -195,6 +195,28 @@ def test_the_pen_inks_only_on_the_board():
     assert not board.contact.pen_touching
 
 
+def test_a_tip_coming_from_beneath_or_beside_the_board_collides_and_does_not_write():
+    board = Whiteboard(PARAMS)
+    zone = BOARD.zone_depth
+    y_edge = board.extent[2]
+    # hanging below the plane beside the board, then under it below its stand: free space
+    run_path(board, [(0.0, y_edge - 0.02, -0.1), (0.0, y_edge + 0.05, -0.1), (0.0, 0.25, -(zone + 0.01))])
+    assert board.contact.pen_collision_count == 0
+    # rising through the stand and the board from beneath
+    run_path(board, [(0.0, 0.25, z) for z in np.linspace(-zone + 0.002, -0.001, 10)])
+    c = board.contact
+    assert c.pen_colliding and not c.pen_touching and c.pen_collision_count == 1
+    run_path(board, [(0.0, 0.25, 0.005)])  # out above the surface ...
+    assert not board.contact.pen_colliding
+    run_path(board, [(0.0, 0.25, -0.001), (0.01, 0.25, -0.001)])  # ... and down onto it: writing
+    assert board.contact.pen_touching
+    run_path(board, [(0.01, 0.25, 0.005), (0.0, y_edge - 0.01, 0.005), (0.0, y_edge - 0.01, -0.01),
+                     (0.0, y_edge + 0.01, -0.01)])  # into the board's edge from the side
+    assert board.contact.pen_collision_count == 2
+    (stroke,) = board.strokes
+    assert stroke.points[:, 0].min() >= -1e-9 and stroke.points[:, 0].max() <= 0.01
+
+
 # --------------------------------------------------------------------------- sponge
 
 def sponge_q(x: float, y: float, press: float) -> np.ndarray:

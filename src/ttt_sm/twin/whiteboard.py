@@ -120,6 +120,12 @@ class Contact:
     ----------
     pen_touching : bool
         The pen tip rests on the board (and inks).
+    pen_colliding : bool
+        The pen tip is inside the board or its stand (``zone_depth`` below
+        the surface), having come in from the edge or from beneath: a
+        collision, not writing.
+    pen_collision_count : int
+        Such collisions since :meth:`Whiteboard.reset` (rising edges).
     compression_m : float
         How far the pen is pushed into its holder along the tool axis, m.
     pen_overpress : bool
@@ -144,6 +150,8 @@ class Contact:
     """
 
     pen_touching: bool
+    pen_colliding: bool
+    pen_collision_count: int
     compression_m: float
     pen_overpress: bool
     pen_overpress_count: int
@@ -211,6 +219,7 @@ class Whiteboard:
         self._ink = np.zeros((ny, nx), np.uint8)
         self._stamp = np.zeros((ny, nx), np.int32)  # sequence number of each pixel's last wipe
         self._travel = params.pen.spring_travel
+        self._zone_depth = b.zone_depth
         self._tip_dev = params.pen.holder_clearance * TIP_DEVIATION_PER_CLEARANCE
         self._sp_off = params.sponge.offset
         self._sp_half = params.sponge.width / 2
@@ -245,10 +254,14 @@ class Whiteboard:
         self._pen_over = False
         self._pen_over_count = 0
         self._max_drag = 0.0
+        self._pen_above = True  # the tip was last above the surface (or no update yet)
+        self._pen_colliding = False
+        self._collision_count = 0
         # sponge
         self._sp_on = False
         self._sp_x = self._sp_y = 0.0  # pad centre when it last wiped
         self._sp_c, self._sp_s = 1.0, 0.0  # and the pad's edge direction then (the base azimuth)
+        self._sp_above = True  # the pad face was last above the surface
         self._sp_press = 0.0
         self._sp_over = False
         self._sp_over_count = 0
@@ -281,6 +294,8 @@ class Whiteboard:
         drag = math.hypot(self._cx - self._tip_x, self._cy - self._tip_y) if self._pen_on else 0.0
         return Contact(
             pen_touching=self._pen_on,
+            pen_colliding=self._pen_colliding,
+            pen_collision_count=self._collision_count,
             compression_m=self._compression,
             pen_overpress=self._pen_over,
             pen_overpress_count=self._pen_over_count,
@@ -321,6 +336,12 @@ class Whiteboard:
         ``n = (0, -cos phi, -sin phi)`` (straight down at phi = 90 deg); it
         touches when that face is at or below the surface (phi within
         :data:`SPONGE_MAX_TILT_RAD` of 90 deg), and wipes the square it sweeps.
+
+        Both touch only after coming down onto the surface from above: a tip
+        that reaches the board's plane from beside the board or from beneath
+        it (the power-on pose hangs below the plane) is inside the board or
+        its stand, a collision (:attr:`Contact.pen_collision_count`), and
+        does not write.
         """
         if type(q) is np.ndarray:
             q1, q2, q3, q4 = q.tolist()
@@ -339,13 +360,19 @@ class Whiteboard:
         depth = self._surface - z
         if depth >= 0.0:
             self._pen_contact(t, q1, sa, ca, r, depth)
-        elif self._pen_on:
-            self._pen_lift()
-        if sa >= _SPONGE_MIN_SIN:
-            press = self._surface - (z - self._sp_off * sa)
-            if press >= 0.0:
+        else:
+            if self._pen_on:
+                self._pen_lift()
+            self._pen_above = True
+            self._pen_colliding = False
+        press = self._surface - (z - self._sp_off * sa)
+        if press >= 0.0:
+            if sa >= _SPONGE_MIN_SIN and (self._sp_on or self._sp_above):
                 self._sponge_contact(q1, ca, r, press)
                 return
+            self._sp_above = False
+        else:
+            self._sp_above = True
         if self._sp_on:
             self._sp_on = False
             self._sp_press = 0.0
@@ -366,6 +393,15 @@ class Whiteboard:
         if not (self._x0 <= cx <= self._x1 and self._y0 <= cy <= self._y1):
             if self._pen_on:  # beyond the board's edge there is nothing to touch
                 self._pen_lift()
+            self._pen_above = self._pen_colliding = False  # below the board's plane, beside it
+            return
+        if not (self._pen_on or self._pen_above):
+            # The tip came into the board from its edge or from beneath: a
+            # collision with the board or its stand (zone_depth thick), not writing.
+            colliding = depth <= self._zone_depth
+            if colliding and not self._pen_colliding:
+                self._collision_count += 1
+            self._pen_colliding = colliding
             return
         if over and not self._pen_over:
             self._pen_over_count += 1

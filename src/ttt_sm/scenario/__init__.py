@@ -8,7 +8,7 @@ piece of documentation: ``tests/scenarios/drive_1_turns_back_at_a_hard_stop.yaml
 - :mod:`.source`: YAML with line numbers (a ``SafeLoader`` subclass);
 - :mod:`.expr`: the condition language (parsed, never ``eval``-ed);
 - :mod:`.model`, :mod:`.loader`: the steps, checked against the charts;
-- :mod:`.runner`: runs scenarios on the simulated robot, with coverage;
+- :mod:`.runner`: runs a scenario on the simulated robot; :mod:`.suite`: several, with coverage;
 - :mod:`.cli`: ``ttt-sm scenario run``; :mod:`.pytest_plugin`: YAML files as tests.
 
 See ``docs/scenarios.md``.
@@ -18,7 +18,8 @@ from .errors import ScenarioError
 from .expr import ExprError, Expression, Ref, parse
 from .loader import load_scenario, load_scenario_text, scenario_files
 from .model import SIGNALS, Catalog, Scenario
-from .runner import Failure, RunReport, ScenarioResult, coverage_dict, run_scenario, run_scenarios
+from .runner import Failure, ScenarioResult, run_scenario
+from .suite import RunReport, coverage_dict, run_scenarios
 
 __all__ = [
     "SIGNALS",

@@ -16,7 +16,8 @@ from typing import Any
 from .errors import ScenarioError
 from .loader import load_scenario, scenario_files
 from .model import Scenario
-from .runner import ScenarioResult, run_scenarios
+from .runner import ScenarioResult
+from .suite import run_scenarios
 
 
 def register(sub: Any) -> None:

@@ -124,8 +124,9 @@ def signal_lines(dbg: Debugger) -> list[str]:
 
 
 def record_line(r: TraceRecord) -> str:
-    t = f"{r.time_s:.3f} s" if r.time_s is not None else "-"
-    return f"  tick {r.tick} ({t})  {r.chart}: {r.source} -> {r.target}  [{r.trigger}]"
+    """One transition: chart tick, chart time (ticks x period, the trace's ``time_s``), what."""
+    t = f" (chart time {r.time_s:.3f} s)" if r.time_s is not None else ""
+    return f"  tick {r.tick}{t}  {r.chart}: {r.source} -> {r.target}  [{r.trigger}]"
 
 
 def trace_lines(records: Sequence[TraceRecord], last: int = 10) -> list[str]:

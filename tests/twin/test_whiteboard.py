@@ -118,6 +118,8 @@ def test_the_spring_takes_the_compression_and_the_holder_overpresses_beyond_its_
     assert not board.contact.pen_overpress
     board.update(4 * DT, q_at(0.003, Y_LINE, -(travel + 0.001)))
     assert board.contact.pen_overpress_count == 2
+    (running,) = board.strokes  # the stroke being drawn is listed too
+    assert running.points[-1, 0] > 0.002
     board.update(5 * DT, q_at(0.003, Y_LINE, 0.002))
     (stroke,) = board.strokes  # the overpressed pen still inked
     assert stroke.points[-1, 0] > 0.002

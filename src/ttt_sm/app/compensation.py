@@ -25,7 +25,7 @@ import numpy as np
 
 from ..params import ArmParams
 from ..sched.scheduler import Signals
-from ..twin.plant import gravity_torques
+from ..twin.plant import gravity_coefficients, gravity_torques
 
 
 def play_offsets(params: ArmParams, q: np.ndarray) -> np.ndarray:
@@ -33,10 +33,12 @@ def play_offsets(params: ArmParams, q: np.ndarray) -> np.ndarray:
     tau = gravity_torques(params, q)
     out = np.zeros(3)
     for d in (1, 2):
-        p = params.drives[d]
-        if tau[d] != 0.0:
-            out[d] = math.copysign(p.gear_clearance / 2 + abs(tau[d]) / p.gear_stiffness, tau[d])
+        out[d] = _offset(tau[d], params.drives[d].gear_clearance, params.drives[d].gear_stiffness)
     return out
+
+
+def _offset(tau: float, clearance: float, stiffness: float) -> float:
+    return 0.0 if tau == 0.0 else math.copysign(clearance / 2 + abs(tau) / stiffness, tau)
 
 
 class GearPlayCompensation:
@@ -46,14 +48,20 @@ class GearPlayCompensation:
         self.params = params
         self.gain = params.control.gear_play_compensation
         self.active = active
+        d2, d3 = params.drives[1], params.drives[2]
+        self._play = (d2.gear_clearance, d2.gear_stiffness, d3.gear_clearance, d3.gear_stiffness)
+        self._gravity = gravity_coefficients(params)
 
     def tick(self, signals: Signals) -> None:
         """Add the offset to the setpoints once the drives are initialised."""
         if self.gain == 0.0 or not self.active():
             return
-        q = np.asarray(signals.q_set, dtype=float)
-        comp = play_offsets(self.params, q)
-        q = q.copy()
-        q[:3] -= self.gain * comp
-        signals.q_set = q
+        q = [float(v) for v in signals.q_set]
+        g2, g23 = self._gravity
+        tau23 = -g23 * math.sin(q[1] + q[2])  # as gravity_torques, on plain floats
+        tau2 = -g2 * math.sin(q[1]) + tau23
+        c2, k2, c3, k3 = self._play
+        q[1] -= self.gain * _offset(tau2, c2, k2)
+        q[2] -= self.gain * _offset(tau23, c3, k3)
+        signals.q_set = np.array(q)
 

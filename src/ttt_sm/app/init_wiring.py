@@ -26,6 +26,7 @@ from ..sched.scheduler import Scheduler, Signals
 from ..twin.kinematics import link_points
 from ..twin.plant import ArmSim
 
+
 def servo_init_angle(params: ArmParams) -> float:
     """Servo angle during initialisation: the pen vertical (phi = 0) once drives 2 and 3 park."""
     return -(params.drives[1].park_rad + params.drives[2].park_rad)
@@ -70,31 +71,38 @@ class DriveInitStage:
     def tick(self, signals: Signals) -> None:
         """Encoder blocks in, charts ticked, offsets applied, pos_out out."""
         c1, c2, c3 = self.charts
-        sensors = signals.sensors
-        assert sensors is not None
-        sim = self.sim
-        enc = sim.q_encoder
-        pos_in = signals.q_set
-        offsets = sim.offset_estimate
-        latched = [sensors.index_count[d] * self.rad_per_count[d] + offsets[d] for d in range(3)]
+        pos_in = [float(v) for v in signals.q_set]
         # Each chart reads the others' flags as they were at the end of the last step.
         ini_23, ini2, ini3 = c1.ini_23, c2.ini2, c3.ini3
-        c1.pos_in, c1.index, c1.pos_Encoder, c1.index_pos = pos_in[0], sensors.index[0], enc[0], latched[0]
-        c1.ini2, c1.ini3 = ini2, ini3
-        c2.pos_in, c2.index, c2.index_pos, c2.ini1, c2.ini3 = (pos_in[1], sensors.index[1], latched[1],
-                                                               ini_23, ini3)
-        c3.pos_in, c3.index, c3.index_pos, c3.ini1, c3.ini2 = (pos_in[2], sensors.index[2], latched[2],
-                                                               ini_23, ini2)
+        if self.done:
+            # Initialised: only pos_in and the flags matter; skip the Encoder blocks.
+            vars(c1).update(pos_in=pos_in[0], ini2=ini2, ini3=ini3)
+            vars(c2).update(pos_in=pos_in[1], ini1=ini_23, ini3=ini3)
+            vars(c3).update(pos_in=pos_in[2], ini1=ini_23, ini2=ini2)
+        else:
+            sensors = signals.sensors
+            assert sensors is not None
+            enc = self.sim.q_encoder.tolist()
+            offsets = self.sim.offset_estimate.tolist()
+            idx, counts, rpc = sensors.index, sensors.index_count, self.rad_per_count
+            latched = [counts[d] * rpc[d] + offsets[d] for d in range(3)]
+            # vars(...).update: the inputs are plain attributes; this skips the
+            # chart's state-name check on every assignment (a hot path).
+            vars(c1).update(pos_in=pos_in[0], index=idx[0], pos_Encoder=enc[0], index_pos=latched[0],
+                            ini2=ini2, ini3=ini3)
+            vars(c2).update(pos_in=pos_in[1], index=idx[1], index_pos=latched[1], ini1=ini_23, ini3=ini3)
+            vars(c3).update(pos_in=pos_in[2], index=idx[2], index_pos=latched[2], ini1=ini_23, ini2=ini2)
         for (d, name), value in self.overrides.items():
             setattr(self.charts[d], name, value)
         # Posted events may move a chart without a tick transition.
-        moved = any(c.pending_events for c in self.charts)
+        moved = bool(c1._queue or c2._queue or c3._queue)
+        applied = self.applied
         for d, chart in enumerate(self.charts):
             if chart.tick() is not None:
                 moved = True
-            if chart.offset != self.applied[d]:
-                sim.set_offset_estimate(d + 1, chart.offset)
-                self.applied[d] = chart.offset
+            if chart.offset != applied[d]:
+                self.sim.set_offset_estimate(d + 1, chart.offset)
+                applied[d] = chart.offset
                 self.sched.homed[d] = True
         if moved:
             self._update_status()

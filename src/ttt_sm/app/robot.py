@@ -18,12 +18,25 @@ import numpy as np
 
 from ..params import ArmParams
 from ..runtime import TickChart
-from ..sched.scheduler import Scheduler
+from ..sched.scheduler import Scheduler, Signals
 from ..twin.kinematics import fk
 from ..twin.plant import ArmSim
+from ..twin.whiteboard import Whiteboard
 from .compensation import GearPlayCompensation
 from .control_wiring import ControlStage, make_control_chart
 from .init_wiring import DriveInitStage, make_init_charts, settled_pose
+
+
+class BoardStage:
+    """Joint stage run after the setpoints are set: the whiteboard sees the true pen and sponge."""
+
+    def __init__(self, board: Whiteboard, sim: ArmSim) -> None:
+        self.board = board
+        self.sim = sim
+
+    def tick(self, signals: Signals) -> None:
+        """Ink or wipe where the true tool touches the board now."""
+        self.board.update(signals.t, self.sim.q_true)
 
 
 class RobotError(ValueError):
@@ -60,7 +73,8 @@ class Robot:
         init = make_init_charts(params, listeners)
         self.init_stage = DriveInitStage(params, self.sim, self.sched, init)
         self.compensation = GearPlayCompensation(params, lambda: self.init_stage.done)
-        self.sched.joint_stages = [self.init_stage, self.compensation]
+        self.board = Whiteboard(params, seed=seed)
+        self.sched.joint_stages = [self.init_stage, self.compensation, BoardStage(self.board, self.sim)]
         self.control = make_control_chart(params, listeners)
         self.control_stage = ControlStage(params, self.sim, self.init_stage, self.control)
         self.sched.task_stages = [self.control_stage]

@@ -153,6 +153,11 @@ def _jacobian_into(J: np.ndarray, q1: float, q2: float, q3: float, q4: float,
     J[3, 0], J[3, 1], J[3, 2], J[3, 3] = 0.0, 1.0, 1.0, 1.0
 
 
+#: Forward kinematics on plain floats, compiled: (q1..q4, L1, L2, L3, L4, l_f) -> (x, y, z, phi).
+#: For hot loops; :func:`fk` is the documented entry point.
+fk_floats = _fk_floats
+
+
 def _as_shape4(values: Any, what: str) -> np.ndarray:
     """`values` as a float vector of shape (4,), not yet checked for NaN."""
     v = np.asarray(values, dtype=float)

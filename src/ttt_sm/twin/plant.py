@@ -101,12 +101,13 @@ def gravity_torques(params: ArmParams, q: Angles) -> np.ndarray:
     Joint 2 carries link 2, link 3 and the tool; joint 3 carries link 3 and
     the tool (at the end of L3).  Joint 1 turns about the vertical: none.
     """
-    g2, g23 = _gravity_coefficients(params)
+    g2, g23 = gravity_coefficients(params)
     s23 = math.sin(q[1] + q[2])
     return np.array([0.0, -g2 * math.sin(q[1]) - g23 * s23, -g23 * s23])
 
 
-def _gravity_coefficients(params: ArmParams) -> tuple[float, float]:
+def gravity_coefficients(params: ArmParams) -> tuple[float, float]:
+    """(g2, g23), N m: gravity torques are -g2 sin q2 - g23 sin(q2 + q3) on joint 2, -g23 sin(q2 + q3) on 3."""
     m, geo = params.masses, params.geometry
     g2 = G * (m.link2_kg * m.link2_com + (m.link3_kg + m.tool_kg) * geo.L2)
     g23 = G * (m.link3_kg * m.link3_com + m.tool_kg * geo.L3)
@@ -160,6 +161,7 @@ class ArmSim:
         self.dt = params.control.dt
         self._slow_row = setpoint_filter_row(params.control.setpoint_cutoff_slow_hz, self.dt)
         self._dp = self._drive_rows(params, gains, self.dt / self.substeps)
+        self._rpc = tuple(self._dp[:, K.P_RPC].tolist())
         self._gp = self._global_row(params, self.substeps, current_noise_a)
         self._ds = np.zeros((3, K.N_DS))
         self._di = np.zeros((3, K.N_DI), dtype=np.int64)
@@ -220,7 +222,7 @@ class ArmSim:
         gp = np.zeros(K.N_GP)
         gp[K.G_DT] = c.dt
         gp[K.G_NSUB] = substeps
-        gp[K.G_GRAV2], gp[K.G_GRAV23] = _gravity_coefficients(params)
+        gp[K.G_GRAV2], gp[K.G_GRAV23] = gravity_coefficients(params)
         gp[K.G_SF_NORMAL:K.G_SF_NORMAL + 6] = setpoint_filter_row(c.setpoint_cutoff_hz, c.dt)
         gp[K.G_SF_SLOW:K.G_SF_SLOW + 6] = setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt)
         gp[K.G_SV_MIN] = s.min_rad
@@ -315,7 +317,8 @@ class ArmSim:
     @property
     def q_true(self) -> np.ndarray:
         """True load-side joint angles q1..q4 (rad), a copy."""
-        return np.append(self._ds[:, K.S_Q], self._gs[K.GS_SV_Q])
+        # built from a list: np.append costs several microseconds, and this runs every chart step
+        return np.array([*self._ds[:, K.S_Q].tolist(), float(self._gs[K.GS_SV_Q])])
 
     @property
     def q_motor(self) -> np.ndarray:
@@ -325,7 +328,14 @@ class ArmSim:
     @property
     def q_encoder(self) -> np.ndarray:
         """What the controllers see: counts * rad_per_count + offset estimate (rad)."""
-        return self._di[:, K.I_COUNTS] * self._dp[:, K.P_RPC] + self._ds[:, K.S_OFFSET]
+        return np.array(self.encoder_angles())
+
+    def encoder_angles(self) -> tuple[float, float, float]:
+        """:attr:`q_encoder` as plain floats, for code that runs every chart step."""
+        c1, c2, c3 = self._di[:, K.I_COUNTS].tolist()
+        o1, o2, o3 = self._ds[:, K.S_OFFSET].tolist()
+        r1, r2, r3 = self._rpc
+        return c1 * r1 + o1, c2 * r2 + o2, c3 * r3 + o3
 
     @property
     def offset_estimate(self) -> np.ndarray:
@@ -456,4 +466,4 @@ class ArmSim:
 
 
 __all__ = ["ArmSim", "Sensors", "Trace", "SimError", "REST_POSE", "SUBSTEPS", "CURRENT_NOISE_A",
-           "gravity_torques"]
+           "gravity_coefficients", "gravity_torques"]

@@ -1,0 +1,302 @@
+"""Drawing with the Control chart on the simulated whiteboard, and its precision.
+
+Thesis section 3.5 compares three paths: the desired one, the one forward
+kinematics gives from the encoder angles, and the true one measured by a
+sensor.  Here the "sensor" is the whiteboard itself: the ink the true pen
+tip leaves.  :func:`draw` commands one drawing through the Control chart
+(the field, an X, an O or the sine wave of section 3.5.3) and measures it:
+`rms_error_mm` / `max_error_mm` (true ink against the desired pen-down
+path), `fk_vs_true_max_mm` (what clearance and model error hide from the
+encoders), `closure_gap_mm` for an O, the longest pen-lift/lower tail, and
+the duration.  It writes the board PNG and the desired/FK/true plot along X,
+Y and Z over time (figs. 3.15-3.18).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..params import ArmParams
+from ..sched.scheduler import Signals
+from ..sched.trajectory import distance_to_path
+from ..twin.kinematics import fk
+from .robot import Robot
+
+KINDS = ("field", "X", "O", "sine")
+
+
+class DrawError(ValueError):
+    """A drawing request that cannot be carried out (bad cell, size, speed, or a stuck chart)."""
+
+
+@dataclass
+class DrawRecord:
+    """Per chart step: desired pose, forward kinematics of the encoders, the true tip."""
+
+    t: list[float] = field(default_factory=list)
+    desired: list[tuple[float, float, float]] = field(default_factory=list)
+    fk_encoder: list[tuple[float, float, float]] = field(default_factory=list)
+    fk_true: list[tuple[float, float, float]] = field(default_factory=list)
+    tip: list[tuple[float, float]] = field(default_factory=list)  # NaN while the pen is lifted
+
+
+class RecordStage:
+    """Joint stage run last: records the three paths of section 3.5 while `on`."""
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+        self.on = False
+        self.record = DrawRecord()
+
+    def tick(self, signals: Signals) -> None:
+        """Append this chart step's desired, encoder and true positions."""
+        if not self.on:
+            return
+        r = self.robot
+        c = r.control
+        g = r.params.geometry
+        q_enc = r.sim.q_encoder
+        servo = float(signals.q_set[3])
+        rec = self.record
+        rec.t.append(r.sim.t)
+        rec.desired.append((c.X_out, c.Y_out, c.Z_out))
+        rec.fk_encoder.append(tuple(fk((q_enc[0], q_enc[1], q_enc[2], servo), g)[:3]))
+        rec.fk_true.append(tuple(fk(r.sim.q_true, g)[:3]))
+        contact = r.board.contact
+        rec.tip.append(contact.tip_m if contact.pen_touching and contact.tip_m else (math.nan, math.nan))
+
+
+@dataclass(frozen=True)
+class DrawResult:
+    """What `ttt-sm draw` reports (lengths in mm, times in s)."""
+
+    kind: str
+    row: int | None
+    column: int | None
+    speed_mm_s: float
+    size_mm: float | None
+    rms_error_mm: float
+    max_error_mm: float
+    fk_vs_true_max_mm: float
+    closure_gap_mm: float | None
+    longest_tail_mm: float
+    ink_points: int
+    duration_s: float
+    sim_time_s: float
+    wall_time_s: float
+    board_png: str | None = None
+    plot_png: str | None = None
+
+
+def _pen_down_runs(desired: np.ndarray, surface_z: float) -> list[np.ndarray]:
+    """The desired xy path split where the pen is commanded off the board."""
+    down = desired[:, 2] <= surface_z
+    runs, start = [], None
+    for i, d in enumerate(down):
+        if d and start is None:
+            start = i
+        elif not d and start is not None:
+            runs.append(desired[start:i, :2])
+            start = None
+    if start is not None:
+        runs.append(desired[start:, :2])
+    return [r for r in runs if len(r) > 1]
+
+
+def _distance_to_runs(points: np.ndarray, runs: list[np.ndarray]) -> np.ndarray:
+    return np.min(np.vstack([distance_to_path(points, run) for run in runs]), axis=0)
+
+
+def closure_gap_mm(board: Any, x0: float, y0: float, radius: float, tol_m: float) -> float:
+    """Longest arc of the desired circle with no ink within `tol_m` of it, in mm.
+
+    A closed O leaves none (0 mm, within the raster's resolution).
+    """
+    n = max(64, int(2 * math.pi * radius / 1e-4))
+    a = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    ink = board.pixel_centers_m(board.ink_mask())
+    if len(ink) == 0:
+        return 2 * math.pi * radius * 1e3
+    pts = np.column_stack([x0 + radius * np.cos(a), y0 + radius * np.sin(a)])
+    near = np.zeros(n, dtype=bool)
+    # only ink close to the circle matters
+    d_centre = np.hypot(ink[:, 0] - x0, ink[:, 1] - y0)
+    ring = ink[np.abs(d_centre - radius) <= tol_m]
+    for i in range(0, n, 256):
+        block = pts[i:i + 256, None, :] - ring[None, :, :]
+        near[i:i + 256] = (np.hypot(block[..., 0], block[..., 1]) <= tol_m).any(axis=1) if len(ring) else False
+    if near.all():
+        return 0.0
+    # longest circular run of uninked samples
+    gaps = ~near
+    doubled = np.concatenate([gaps, gaps])
+    best = run = 0
+    for g in doubled:
+        run = run + 1 if g else 0
+        best = max(best, run)
+    best = min(best, n)
+    return best * (2 * math.pi * radius / n) * 1e3
+
+
+#: Ink farther than this from the desired pen-down path is outside the intended strokes.
+TAIL_TOL_M = 0.0003
+
+
+def longest_tail_mm(strokes: list[Any], runs: list[np.ndarray], tol_m: float) -> float:
+    """Longest stretch of one stroke that stays farther than `tol_m` from the desired path, mm.
+
+    The ink a pen leaves while it lands or lifts away from the desired path
+    shows up here (the strokes are this drawing's own, not the whole board).
+    """
+    best = 0.0
+    for s in strokes:
+        pts = s.points
+        if len(pts) < 2:
+            continue
+        out = _distance_to_runs(pts, runs) > tol_m
+        seg = np.hypot(*np.diff(pts, axis=0).T)
+        run = 0.0
+        for i in range(1, len(pts)):
+            run = run + seg[i - 1] if (out[i] and out[i - 1]) else 0.0
+            best = max(best, run)
+    return best * 1e3
+
+
+class DrawSession:
+    """A robot, its whiteboard and a recorder, ready to draw on command."""
+
+    def __init__(self, params: ArmParams, seed: int = 0, progress: Callable[[str], None] | None = None) -> None:
+        self.params = params
+        self.robot = Robot(params, seed=seed)
+        self.recorder = RecordStage(self.robot)
+        self.robot.sched.joint_stages.append(self.recorder)
+        self.say = progress or (lambda _m: None)
+
+    def _control_in(self, state: str) -> bool:
+        return state in self.robot.control.configuration_values
+
+    def run_to_wait(self, timeout_s: float) -> None:
+        """Run until the Control chart waits in wait_1 (raises DrawError on timeout)."""
+        r = self.robot
+        if not r.run_until(lambda: self._control_in("wait_1"), timeout_s):
+            raise DrawError(f"the Control chart did not reach wait_1 within {timeout_s:.0f} s "
+                            f"(active: {sorted(r.active('Control'))})")
+
+    def start(self) -> float:
+        """Initialise and wait for the first wait_1 without drawing the field: returns sim time."""
+        r = self.robot
+        self.say("initialising the drives (init charts)")
+        if not r.run_until(lambda: r.initialised, 40.0):
+            raise DrawError("the drives did not initialise within 40 s")
+        self.say(f"initialised after {r.t:.1f} s; moving to the waiting pose")
+        r.control.Pl_fld = True  # hold the field back: the first command decides what is drawn
+        self.run_to_wait(40.0)
+        return r.t
+
+    def draw(self, kind: str, row: int = 3, column: int = 3, speed: float | None = None,
+             size: float | None = None, out_dir: Path | None = None) -> DrawResult:
+        """Draw one thing from wait_1 and measure it."""
+        if kind not in KINDS:
+            raise DrawError(f"unknown drawing {kind!r}; choose from {', '.join(KINDS)}")
+        b = self.params.board
+        if not (1 <= row <= b.cells and 1 <= column <= b.cells):
+            raise DrawError(f"cell ({row}, {column}) is off the {b.cells}x{b.cells} field")
+        c = self.robot.control
+        if speed is not None:
+            if not 0.001 <= speed <= 0.1:
+                raise DrawError(f"speed {speed * 1000:.1f} mm/s is outside 1..100 mm/s")
+            c.speed = speed
+        if size is not None:
+            if not 0.004 <= size <= b.cell_size:
+                raise DrawError(f"size {size * 1000:.1f} mm does not fit a {b.cell_size * 1000:.0f} mm cell")
+            c.size = size
+        if not self._control_in("wait_1"):
+            raise DrawError("the arm is busy: draw only from wait_1")
+        wall0 = time.perf_counter()
+        self.recorder.record = DrawRecord()
+        self.recorder.on = True
+        t0 = self.robot.t
+        strokes_before = len(self.robot.board.strokes)
+        c.row, c.column = row, column
+        if kind == "field":
+            c.Pl_fld = False
+        elif kind == "sine":
+            self.robot.post("Control", "draw_sine")
+        else:
+            c.symbol = 1 if kind == "X" else 0
+            self.robot.post("Control", "button")
+        self.say(f"drawing {kind}" + (f" in cell ({row}, {column})" if kind in ("X", "O") else ""))
+        r = self.robot
+        r.chart_step()
+        r.chart_step()
+        self.run_to_wait(300.0)
+        self.recorder.on = False
+        result = self._measure(kind, row, column, t0, strokes_before, wall0)
+        if out_dir is not None:
+            result = self._write(result, out_dir)
+        return result
+
+    def _measure(self, kind: str, row: int, column: int, t0: float, strokes_before: int,
+                 wall0: float) -> DrawResult:
+        rec = self.recorder.record
+        params, board, c = self.params, self.robot.board, self.robot.control
+        desired = np.asarray(rec.desired)
+        runs = _pen_down_runs(desired, params.board.surface_z)
+        if not runs:
+            raise DrawError(f"drawing {kind} commanded no pen-down path")
+        strokes = [s for s in board.strokes[strokes_before:] if s.author == "robot"]
+        ink = np.vstack([s.points for s in strokes]) if strokes else np.zeros((0, 2))
+        err = _distance_to_runs(ink, runs) * 1e3 if len(ink) else np.array([math.inf])
+        tip = np.asarray(rec.tip)
+        fk_enc = np.asarray(rec.fk_encoder)[:, :2]
+        touching = np.isfinite(tip[:, 0])
+        fk_vs_true = np.hypot(*(fk_enc[touching] - tip[touching]).T) * 1e3 if touching.any() else np.zeros(1)
+        gap = None
+        if kind == "O":
+            gap = round(closure_gap_mm(board, c.x0, c.y0, c.R, tol_m=0.0005), 3)
+        tail = longest_tail_mm(strokes, runs, tol_m=TAIL_TOL_M)
+        return DrawResult(
+            kind=kind, row=row if kind in ("X", "O") else None, column=column if kind in ("X", "O") else None,
+            speed_mm_s=round(c.speed * 1e3, 3), size_mm=round(c.size * 1e3, 3) if kind in ("X", "O") else None,
+            rms_error_mm=round(float(np.sqrt(np.mean(err ** 2))), 4), max_error_mm=round(float(err.max()), 4),
+            fk_vs_true_max_mm=round(float(fk_vs_true.max()), 4), closure_gap_mm=gap,
+            longest_tail_mm=round(float(tail), 3), ink_points=int(len(ink)),
+            duration_s=round(self.robot.t - t0, 3), sim_time_s=round(self.robot.t, 3),
+            wall_time_s=round(time.perf_counter() - wall0, 3),
+        )
+
+    def _write(self, result: DrawResult, out_dir: Path) -> DrawResult:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        name = result.kind + (f"_r{result.row}c{result.column}" if result.row else "")
+        board_png = self.robot.board.save_png(out_dir / f"board_{name}.png", grid_mm=True)
+        plot_png = out_dir / f"paths_{name}.png"
+        plot_paths(self.recorder.record, plot_png, title=f"{result.kind}: desired, FK of encoders, true")
+        return DrawResult(**{**asdict(result), "board_png": str(board_png), "plot_png": str(plot_png)})
+
+
+def plot_paths(rec: DrawRecord, path: Path, title: str) -> None:
+    """Desired, forward kinematics of the encoders and true tool, along X, Y, Z over time."""
+    from matplotlib.figure import Figure
+
+    t = np.asarray(rec.t)
+    desired, enc, true = (np.asarray(a) * 1e3 for a in (rec.desired, rec.fk_encoder, rec.fk_true))
+    fig = Figure(figsize=(9, 7))
+    axes = fig.subplots(3, 1, sharex=True)
+    for i, (ax, name) in enumerate(zip(axes, "XYZ", strict=True)):
+        ax.plot(t, desired[:, i], "k--", lw=1, label="desired")
+        ax.plot(t, enc[:, i], lw=1, label="FK of encoders")
+        ax.plot(t, true[:, i], lw=1, label="true (sensor)")
+        ax.set_ylabel(f"{name} (mm)")
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="best", fontsize=8)
+    axes[0].set_title(title)
+    axes[-1].set_xlabel("time (s)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)

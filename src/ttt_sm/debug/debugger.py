@@ -83,7 +83,7 @@ class Debugger:
         self.trace = Trace()
         for chart in robot.charts.values():
             chart.add_listener(self.trace, self.listener)
-        self.index = ChartIndex(dict(robot.charts))
+        self._index = ChartIndex(dict(robot.charts))
         self._divider = robot.params.control.chart_divider
         self._dt = robot.params.control.dt
         self._names.forget()
@@ -96,7 +96,7 @@ class Debugger:
 
     def chart(self, name: str) -> TickChart:
         """A chart by name; :class:`DebugError` names the charts there are."""
-        self.index.structure(name)
+        self._index.structure(name)
         return self.robot.charts[name]
 
     def where(self) -> dict[str, list[str]]:
@@ -121,7 +121,7 @@ class Debugger:
         """Add a breakpoint from its command text, e.g. ``"enter DriveInit1.turn_back"``,
         ``"transition DriveInit1 turn_fwd->turn_back"``, ``"event DriveInit1.tick"``,
         ``"when DriveInit1.pos_Encoder > 1.0"``."""
-        bp = parse_breakpoint(self._next_id, text, self.index, self._names)
+        bp = parse_breakpoint(self._next_id, text, self._index, self._names)
         if bp.condition is not None:
             bp.last_value = bp.condition.evaluate(self._names)
         self._next_id += 1

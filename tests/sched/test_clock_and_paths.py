@@ -82,3 +82,15 @@ def test_distance_to_path_is_geometric():
     # chunking does not change the answer
     many = np.random.default_rng(0).uniform(-1, 2, size=(1500, 2))
     assert np.allclose(distance_to_path(many, path, chunk=7), distance_to_path(many, path))
+
+
+def test_simplify_keeps_the_shape_and_drops_collinear_points():
+    from ttt_sm.sched.trajectory import distance_to_path, simplify_polyline
+
+    line = np.column_stack([np.linspace(0, 0.15, 3751), np.full(3751, 0.2)])
+    assert len(simplify_polyline(line)) == 2
+    a = np.linspace(0, 2 * np.pi, 2000)
+    circle = np.column_stack([0.0075 * np.cos(a), 0.0075 * np.sin(a)])
+    short = simplify_polyline(circle, tol=1e-6)
+    assert 10 < len(short) < 500
+    assert distance_to_path(circle, short).max() <= 1e-6 + 1e-12

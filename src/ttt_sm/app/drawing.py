@@ -25,7 +25,7 @@ import numpy as np
 
 from ..params import ArmParams
 from ..sched.scheduler import Signals
-from ..sched.trajectory import distance_to_path
+from ..sched.trajectory import distance_to_path, simplify_polyline
 from ..twin.kinematics import fk
 from .robot import Robot
 
@@ -107,7 +107,8 @@ def _pen_down_runs(desired: np.ndarray, surface_z: float) -> list[np.ndarray]:
             start = None
     if start is not None:
         runs.append(desired[start:, :2])
-    return [r for r in runs if len(r) > 1]
+    # one vertex per chart tick is far more than the shape needs (exact to 1 um)
+    return [simplify_polyline(r) for r in runs if len(r) > 1]
 
 
 def _distance_to_runs(points: np.ndarray, runs: list[np.ndarray]) -> np.ndarray:

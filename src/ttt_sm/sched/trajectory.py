@@ -110,3 +110,28 @@ def distance_to_path(points: np.ndarray, path: np.ndarray, chunk: int = 512) -> 
         nearest = a + s[..., None] * ab
         out[i:i + chunk] = np.sqrt(np.min(np.sum((p - nearest) ** 2, axis=2), axis=1))
     return out
+
+
+def simplify_polyline(points: np.ndarray, tol: float = 1e-6) -> np.ndarray:
+    """The polyline with the vertices dropped that lie within `tol` of it (Ramer-Douglas-Peucker).
+
+    A chart-rate path has a vertex every 0.04 mm; a straight 15 cm line needs
+    two.  Geometric comparisons against the simplified path are exact to `tol`.
+    """
+    pts = np.asarray(points, dtype=float)
+    if len(pts) < 3:
+        return pts
+    keep = np.zeros(len(pts), dtype=bool)
+    keep[0] = keep[-1] = True
+    stack = [(0, len(pts) - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j <= i + 1:
+            continue
+        a, b = pts[i], pts[j]
+        d = distance_to_path(pts[i + 1:j], np.vstack([a, b]))
+        k = int(np.argmax(d))
+        if d[k] > tol:
+            keep[i + 1 + k] = True
+            stack.extend([(i, i + 1 + k), (i + 1 + k, j)])
+    return pts[keep]

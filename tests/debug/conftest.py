@@ -3,8 +3,6 @@ and a robot with one extra event-driven chart (the drive-init charts take no eve
 
 from __future__ import annotations
 
-import math
-
 import pytest
 from statemachine import State
 
@@ -12,8 +10,6 @@ from ttt_sm.app.robot import Robot
 from ttt_sm.debug import Debugger, RobotRecipe
 from ttt_sm.params import ArmParams, load_params
 from ttt_sm.runtime import Data, TickChart, after
-
-HARD_STOP_DEG = 170.0
 
 
 @pytest.fixture(scope="session")
@@ -74,6 +70,3 @@ def lamp_dbg(params: ArmParams) -> Debugger:
     recipe = LampRecipe(params)
     return Debugger(recipe.build(), recipe)
 
-
-def q1_deg(d: Debugger) -> float:
-    return math.degrees(float(d.robot.sim.q_true[0]))

@@ -6,9 +6,14 @@ import math
 
 import pytest
 
-from conftest import HARD_STOP_DEG, q1_deg
 from ttt_sm.debug import DebugError, Debugger
 from ttt_sm.debug.expr import parse_condition
+
+HARD_STOP_DEG = 170.0  # drive 1's upper joint limit (arm.toml)
+
+
+def q1_deg(d: Debugger) -> float:
+    return math.degrees(float(d.robot.sim.q_true[0]))
 
 
 def test_break_on_entering_turn_back_stops_at_the_tick_the_hard_stop_was_detected(dbg: Debugger, params):

@@ -9,8 +9,6 @@ import pytest
 from ttt_sm.debug import DebugError, Debugger
 from ttt_sm.debug.expr import parse_condition
 
-HARD_STOP_DEG = 170.0  # drive 1's upper joint limit (arm.toml)
-
 
 def q1_deg(d: Debugger) -> float:
     return math.degrees(float(d.robot.sim.q_true[0]))
@@ -32,7 +30,8 @@ def test_break_on_entering_turn_back_stops_at_the_tick_the_hard_stop_was_detecte
     assert dbg.robot.steps == dbg.steps_of_tick(record.tick)  # right after the tick's control step
     assert "turn_back" in dbg.where()["DriveInit1"]
     # The drive stalled on its +170 deg hard stop: the twin's true angle is there.
-    assert q1_deg(dbg) == pytest.approx(HARD_STOP_DEG, abs=0.5)
+    assert math.degrees(params.drives[0].limit_max_rad) == pytest.approx(170.0)
+    assert q1_deg(dbg) == pytest.approx(170.0, abs=0.5)
     assert bp.hits == 1
 
 

@@ -94,9 +94,7 @@ def test_tune_json_keys(capsys, tmp_path):
     assert (tmp_path / rows[0]["plot"].split("/")[-1]).exists()
 
 
-def test_play_draws_and_reports(capsys):
-    code, data = run_json(capsys, "play", "--side", "20")
-    assert code == 0
-    assert data["square_side_mm"] == 20.0
-    assert data["ik_failures"] == 0 and data["limit_clamps"] == 0
-    assert data["drawing_max_error_mm"] < 2.0
+def test_draw_rejects_a_cell_off_the_field(capsys):
+    code = main(["draw", "X", "--row", "6", "--column", "1"])
+    assert code == 2
+    assert "cell (6, 1) is off the 5x5 field" in capsys.readouterr().err

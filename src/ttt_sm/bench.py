@@ -115,6 +115,13 @@ def bench_init(params: ArmParams, starts: int, seed: int = 0) -> dict[str, Any]:
     return {f"init_{k}": v for k, v in report.items()}
 
 
+def bench_game_motion(params: ArmParams, seed: int = 0) -> dict[str, Any]:
+    """The field, 12 symbols and erasing through the Control chart, on virtual time."""
+    from .app.play import game_motion
+
+    return game_motion(params, seed=seed)
+
+
 SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "steps": lambda p, a: bench_steps(p, a["out"]),
     "ik": lambda p, a: bench_ik_section(p, a["seed"]),
@@ -122,6 +129,7 @@ SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "pacing": lambda p, a: bench_pacing(p, a["pacing_seconds"], a["seed"]),
     "charts": lambda p, a: bench_charts(p),
     "init": lambda p, a: bench_init(p, a["init_starts"], a["seed"]),
+    "motion": lambda p, a: bench_game_motion(p, a["seed"]),
 }
 
 

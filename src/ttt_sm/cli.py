@@ -53,14 +53,30 @@ def _jsonable(obj: Any) -> Any:
 
 
 def cmd_play(args: argparse.Namespace) -> int:
-    from .app.draw_demo import run_draw_demo
+    from .app.play import run_play
 
     params = load_params(args.params)
-    result = run_draw_demo(params, seed=args.seed, speed=args.speed / 1000, side=args.side / 1000,
-                           progress=_progress(True))
+    result = run_play(params, seed=args.seed, out_dir=Path(args.out), progress=_progress(True))
+    lines = [f"  {k}: {v}" for k, v in result.items() if k != "drawings"]
+    _emit(result, args.json, "play:\n" + "\n".join(lines))
+    return 0
+
+
+def cmd_draw(args: argparse.Namespace) -> int:
+    from .app.drawing import DrawError, DrawSession, check_request
+
+    params = load_params(args.params)
+    speed = None if args.speed is None else args.speed / 1000
+    size = None if args.size is None else args.size / 1000
+    try:
+        check_request(params, args.kind, args.row, args.column, speed, size)
+        session = DrawSession(params, seed=args.seed, progress=_progress(True))
+        session.start()
+        result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=Path(args.out))
+    except DrawError as exc:
+        raise CliError(str(exc)) from exc
     data = dataclasses.asdict(result)
-    lines = [f"  {k}: {v}" for k, v in data.items()]
-    _emit(data, args.json, "play (drawing demo):\n" + "\n".join(lines))
+    _emit(data, args.json, "\n".join(f"  {k}: {v}" for k, v in data.items()))
     return 0
 
 
@@ -166,13 +182,19 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
         return sp
 
-    sp = add("play", cmd_play, "run the main job: for now the simulated arm draws a square")
-    sp.add_argument("--speed", type=float, default=20.0, help="drawing speed, mm/s (default 20)")
-    sp.add_argument("--side", type=float, default=30.0, help="side of the square, mm (default 30)")
+    sp = add("play", cmd_play, "run the main job: initialise, draw the field, an X and an O, erase, finish")
+    sp.add_argument("--out", default="out/play", help="folder for the board PNGs (default out/play)")
+    sp = add("draw", cmd_draw, "draw one thing with the Control chart and measure its precision (thesis 3.5)")
+    sp.add_argument("kind", choices=["field", "X", "O", "sine"])
+    sp.add_argument("--row", type=int, default=3, help="cell row 1..5 for X and O (default 3)")
+    sp.add_argument("--column", type=int, default=3, help="cell column 1..5 for X and O (default 3)")
+    sp.add_argument("--speed", type=float, default=None, help="drawing speed, mm/s (default 20)")
+    sp.add_argument("--size", type=float, default=None, help="symbol size, mm (default 18)")
+    sp.add_argument("--out", default="out/draw", help="folder for the board PNG and the path plot")
     sp = add("tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
     sp = add("bench", cmd_bench, "measure the speed and quality targets")
-    sp.add_argument("--only", default=None, help="comma-separated sections: steps,ik,loop,pacing,charts,init")
+    sp.add_argument("--only", default=None, help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
     sp = add("ik", cmd_ik, "solve inverse kinematics for one tool pose")

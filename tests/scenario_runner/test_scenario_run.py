@@ -120,14 +120,14 @@ def test_mark_starts_a_new_window() -> None:
           - run: {chart_steps: 1}
           - set: {DriveInit1.stop: false}
           - run: {chart_steps: 2}
-          - expect_states: {chart: DriveInit1, sequence: [stopped, power_on, turn_fwd], match: exact}
-          - expect_states: {chart: DriveInit1, sequence: [stopped, run, initialise, power_on]}
+          - expect_states: {chart: DriveInit1, sequence: [stopped, turn_fwd], match: exact}
+          - expect_states: {chart: DriveInit1, sequence: [stopped, run, initialise, turn_fwd]}
           - expect_states: {chart: DriveInit1, sequence: [stopped], match: exact}
         """)
     assert lines(r) == [5, 12]
     assert "since mark 'turning' (line 4)" in r.failures[0].message
     assert "it entered nothing" in r.failures[0].message
-    assert "it entered stopped, power_on, turn_fwd (not exactly those)" in r.failures[1].message
+    assert "it entered stopped, turn_fwd (not exactly those)" in r.failures[1].message
 
 
 def test_an_input_the_wiring_feeds_needs_force() -> None:

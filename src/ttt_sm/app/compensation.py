@@ -24,7 +24,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..params import ArmParams
-from ..sched.scheduler import Signals
+from ..sched.scheduler import Signals, as_floats
 from ..twin.plant import gravity_coefficients, gravity_torques
 
 
@@ -56,7 +56,7 @@ class GearPlayCompensation:
         """Add the offset to the setpoints once the drives are initialised."""
         if self.gain == 0.0 or not self.active():
             return
-        q = [float(v) for v in signals.q_set]
+        q = as_floats(signals.q_set)
         g2, g23 = self._gravity
         tau23 = -g23 * math.sin(q[1] + q[2])  # as gravity_torques, on plain floats
         tau2 = -g2 * math.sin(q[1]) + tau23

@@ -18,12 +18,12 @@ from ..charts.control import Control
 from ..params import ArmParams
 from ..sched.scheduler import Signals
 from ..twin.kinematics import fk_floats
+from ..twin.plant import ArmSim
+from .init_wiring import DriveInitStage
 
 # The compiled forward kinematics' Python original: a numba call with nine
 # float arguments costs ~10 us in dispatch, the plain function ~2 us.
 _fk_python = fk_floats.py_func
-from ..twin.plant import ArmSim
-from .init_wiring import DriveInitStage
 
 
 def make_control_chart(params: ArmParams, listeners: Sequence[object] = ()) -> Control:

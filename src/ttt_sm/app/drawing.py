@@ -170,6 +170,20 @@ def longest_tail_mm(strokes: list[Any], runs: list[np.ndarray], tol_m: float) ->
     return best * 1e3
 
 
+def check_request(params: ArmParams, kind: str, row: int, column: int, speed: float | None,
+                  size: float | None) -> None:
+    """Reject a drawing request that cannot be drawn, naming what is wrong (before anything moves)."""
+    if kind not in KINDS:
+        raise DrawError(f"unknown drawing {kind!r}; choose from {', '.join(KINDS)}")
+    b = params.board
+    if not (1 <= row <= b.cells and 1 <= column <= b.cells):
+        raise DrawError(f"cell ({row}, {column}) is off the {b.cells}x{b.cells} field")
+    if speed is not None and not 0.001 <= speed <= 0.1:
+        raise DrawError(f"speed {speed * 1000:.1f} mm/s is outside 1..100 mm/s")
+    if size is not None and not 0.004 <= size <= b.cell_size:
+        raise DrawError(f"size {size * 1000:.1f} mm does not fit a {b.cell_size * 1000:.0f} mm cell (4 mm at least)")
+
+
 class DrawSession:
     """A robot, its whiteboard and a recorder, ready to draw on command."""
 
@@ -204,19 +218,11 @@ class DrawSession:
     def draw(self, kind: str, row: int = 3, column: int = 3, speed: float | None = None,
              size: float | None = None, out_dir: Path | None = None) -> DrawResult:
         """Draw one thing from wait_1 and measure it."""
-        if kind not in KINDS:
-            raise DrawError(f"unknown drawing {kind!r}; choose from {', '.join(KINDS)}")
-        b = self.params.board
-        if not (1 <= row <= b.cells and 1 <= column <= b.cells):
-            raise DrawError(f"cell ({row}, {column}) is off the {b.cells}x{b.cells} field")
+        check_request(self.params, kind, row, column, speed, size)
         c = self.robot.control
         if speed is not None:
-            if not 0.001 <= speed <= 0.1:
-                raise DrawError(f"speed {speed * 1000:.1f} mm/s is outside 1..100 mm/s")
             c.speed = speed
         if size is not None:
-            if not 0.004 <= size <= b.cell_size:
-                raise DrawError(f"size {size * 1000:.1f} mm does not fit a {b.cell_size * 1000:.0f} mm cell")
             c.size = size
         if not self._control_in("wait_1"):
             raise DrawError("the arm is busy: draw only from wait_1")

@@ -17,12 +17,13 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..charts.drive_init import DriveInit1, DriveInit2, DriveInit3
 from ..params import ArmParams
-from ..sched.scheduler import Scheduler, Signals
+from ..sched.scheduler import Scheduler, Signals, as_floats
 from ..twin.kinematics import link_points
 from ..twin.plant import ArmSim
 
@@ -71,7 +72,7 @@ class DriveInitStage:
     def tick(self, signals: Signals) -> None:
         """Encoder blocks in, charts ticked, offsets applied, pos_out out."""
         c1, c2, c3 = self.charts
-        pos_in = [float(v) for v in signals.q_set]
+        pos_in = as_floats(signals.q_set)
         # Each chart reads the others' flags as they were at the end of the last step.
         ini_23, ini2, ini3 = c1.ini_23, c2.ini2, c3.ini3
         if self.done:
@@ -205,7 +206,7 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
     )
 
 
-def init_report(params: ArmParams, starts: int, seed: int = 0) -> dict[str, float | int]:
+def init_report(params: ArmParams, starts: int, seed: int = 0) -> dict[str, Any]:
     """Initialise from `starts` random power-on poses: what `ttt-sm init --json` prints."""
     rng = np.random.default_rng(seed)
     wall0 = time.perf_counter()

@@ -45,6 +45,9 @@ class Control(TickChart):
     """The Control block: start/stop, the field, X, O, a sine wave, erasing, finishing."""
 
     tick_period_s = CHART_PERIOD_S
+    # for type checkers: data that actions update from their own previous value
+    ctr: int
+    ignored_buttons: int
 
     inputs = (
         Data("row", "1", 1, "row of the cell to draw in, 1..5 (eq. 3.38)"),
@@ -217,13 +220,13 @@ class Control(TickChart):
     start_stop.wait_1.to(Drawing_playing_field, cond="not Pl_fld")
     button = (start_stop.wait_1.to(Drawing_X, cond="symbol == 1", on="count_symbol")
               | start_stop.wait_1.to(Drawing_O, cond="symbol == 0", on="count_symbol")
-              | start_stop.to(None, on="ignore_button")
-              | Drawing_playing_field.to(None, on="ignore_button")
-              | Drawing_X.to(None, on="ignore_button")
-              | Drawing_O.to(None, on="ignore_button")
-              | Drawing_sine.to(None, on="ignore_button")
-              | Erase.to(None, on="ignore_button")
-              | finishing.to(None, on="ignore_button"))
+              | start_stop.to(None, on="ignore_button")  # type: ignore[arg-type]
+              | Drawing_playing_field.to(None, on="ignore_button")  # type: ignore[arg-type]
+              | Drawing_X.to(None, on="ignore_button")  # type: ignore[arg-type]
+              | Drawing_O.to(None, on="ignore_button")  # type: ignore[arg-type]
+              | Drawing_sine.to(None, on="ignore_button")  # type: ignore[arg-type]
+              | Erase.to(None, on="ignore_button")  # type: ignore[arg-type]
+              | finishing.to(None, on="ignore_button"))  # type: ignore[arg-type]
     draw_sine = start_stop.wait_1.to(Drawing_sine)
 
     # -- back to the waiting pose once a sub-chart is done (lifted to z_travel)

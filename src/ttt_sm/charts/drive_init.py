@@ -41,6 +41,7 @@ class DriveInit1(TickChart):
     """Drive 1: find the index (or a hard stop, then the index), park, wait, pass pos_in."""
 
     tick_period_s = CHART_PERIOD_S
+    offset: float  # for type checkers: set_home adds to its own value
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
@@ -84,7 +85,7 @@ class DriveInit1(TickChart):
             go_park.to(wait_23, cond="parked")
 
         pass_pos = State()
-        h = HistoryState()
+        h = HistoryState(type="deep")  # back into the very state `stop` interrupted
         initialise.wait_23.to(pass_pos, cond="ini2 and ini3")
 
     stopped = State()
@@ -173,6 +174,7 @@ class DriveInit2(TickChart):
     """Drive 2: wait for drive 1, turn a set angle, turn back if the index did not pass, wait, park."""
 
     tick_period_s = CHART_PERIOD_S
+    offset: float  # for type checkers: set_home adds to its own value
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
@@ -248,6 +250,7 @@ class DriveInit3(TickChart):
     """Drive 3: turn towards the index-and-limit switch with a shrinking increment."""
 
     tick_period_s = CHART_PERIOD_S
+    offset: float  # for type checkers: set_home adds to its own value
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),

@@ -62,6 +62,11 @@ class Signals:
         self.ik_error = None
 
 
+def as_floats(values: np.ndarray | Sequence[float]) -> list[float]:
+    """A short vector as a list of Python floats (cheap for an array: `tolist`)."""
+    return values.tolist() if isinstance(values, np.ndarray) else [float(v) for v in values]
+
+
 class Stage(Protocol):
     """Something ticked at the chart rate: a chart, or a plain setpoint source."""
 
@@ -195,7 +200,7 @@ class Scheduler:
         s.q_set = s.q_des
         for stage in self.joint_stages:
             stage.tick(s)
-        q = [float(v) for v in s.q_set]
+        q = as_floats(s.q_set)
         clamped = False
         for i in range(4):
             if self.homed[i]:

@@ -1,0 +1,111 @@
+"""The main job: the whole arm at work on the simulated whiteboard.
+
+For now (the game itself comes with the game issue): the drives initialise
+with their charts, the Control chart moves above the board, draws the
+playing field, an X and an O, erases the board, and finishes back at its
+start pose.  Every drawing is measured as in thesis section 3.5, and the
+board is saved as PNG before and after erasing.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+from ..params import ArmParams
+from .drawing import DrawError, DrawSession
+
+
+def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
+             progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Initialise, draw the field, an X and an O, erase, finish; return what happened."""
+    say = progress or (lambda _m: None)
+    wall0 = time.perf_counter()
+    session = DrawSession(params, seed=seed, progress=say)
+    robot = session.robot
+    t_ready = session.start()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    drawings = []
+    for kind, row, column in (("field", 3, 3), ("X", 2, 2), ("O", 3, 3)):
+        d = session.draw(kind, row, column)
+        drawings.append(d)
+        say(f"  {d.kind}: rms {d.rms_error_mm:.3f} mm, max {d.max_error_mm:.3f} mm, {d.duration_s:.1f} s"
+            + (f", closes within {d.closure_gap_mm:.2f} mm" if d.kind == "O" else ""))
+    before = robot.board.save_png(out_dir / "board_drawn.png", grid_mm=True)
+    ink_drawn = robot.board.ink_area_mm2()
+    say(f"board saved: {before}")
+
+    say("erasing")
+    robot.control_stage.erase_requested = True
+    if not robot.run_until(lambda: "Erase" in robot.active("Control"), 30.0):
+        raise DrawError("the Control chart did not start erasing")
+    if not robot.run_until(lambda: "go_wait" in robot.active("Control"), 300.0):
+        raise DrawError("erasing did not finish within 300 s")
+    ink_left = robot.board.ink_area_mm2()
+    after = robot.board.save_png(out_dir / "board_erased.png", grid_mm=True)
+    say(f"erased: {ink_drawn:.0f} mm2 of ink before, {ink_left:.1f} mm2 after")
+
+    say("finishing: back to the start pose")
+    robot.control.finish = True
+    if not robot.run_until(lambda: "finished" in robot.active("Control"), 120.0):
+        raise DrawError("finishing did not end within 120 s")
+    wall = time.perf_counter() - wall0
+    say(f"finished after {robot.t:.1f} s simulated in {wall:.1f} s ({robot.t / wall:.0f}x real time)")
+    return {
+        "seed": seed,
+        "ready_time_s": round(t_ready, 3),
+        "drawings": [asdict(d) for d in drawings],
+        "ink_drawn_mm2": round(ink_drawn, 1),
+        "ink_after_erase_mm2": round(ink_left, 3),
+        "erased": ink_left == 0.0,
+        "pen_overpress": robot.board.contact.pen_overpress_count,
+        "ik_failures": robot.sched.ik_failures,
+        "limit_clamps": robot.sched.limit_clamps,
+        "ignored_buttons": robot.control.ignored_buttons,
+        "sim_time_s": round(robot.t, 3),
+        "wall_time_s": round(wall, 3),
+        "realtime_factor": round(robot.t / wall, 1),
+        "board_png": str(before),
+        "board_erased_png": str(after),
+    }
+
+
+def game_motion(params: ArmParams, seed: int = 0, symbols: int = 12) -> dict[str, float]:
+    """The motion of a whole game on virtual time: the field, `symbols` symbols, erasing.
+
+    What `bench` reports as `game_motion_realtime_factor` (no recording, no plots).
+    """
+    from .robot import Robot
+
+    robot = Robot(params, seed=seed)
+    c = robot.control
+    wall0 = time.perf_counter()
+
+    def waiting() -> bool:
+        return "wait_1" in c.configuration_values and c.Pl_fld
+
+    if not robot.run_until(waiting, 200.0):
+        raise DrawError("the field was not drawn within 200 s")
+    cells = [(r, col) for r in range(1, 6) for col in range(1, 6)]
+    for k in range(symbols):
+        c.row, c.column = cells[(7 * k) % 25]
+        c.symbol = k % 2
+        robot.post("Control", "button")
+        robot.chart_step()
+        robot.chart_step()
+        if not robot.run_until(lambda: "wait_1" in c.configuration_values, 60.0):
+            raise DrawError(f"symbol {k + 1} did not finish within 60 s")
+    robot.control_stage.erase_requested = True
+    robot.run_until(lambda: "Erase" in c.configuration_values, 10.0)
+    if not robot.run_until(lambda: "go_wait" in c.configuration_values, 300.0):
+        raise DrawError("erasing did not finish within 300 s")
+    wall = time.perf_counter() - wall0
+    return {
+        "game_motion_realtime_factor": round(robot.t / wall, 1),
+        "game_motion_sim_s": round(robot.t, 2),
+        "game_motion_wall_s": round(wall, 2),
+        "game_motion_ink_left_mm2": round(robot.board.ink_area_mm2(), 3),
+    }

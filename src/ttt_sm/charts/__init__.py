@@ -6,8 +6,10 @@ the twin, the scheduler and the game.
 
 from .control import Control
 from .drive_init import INIT_CHARTS, DriveInit1, DriveInit2, DriveInit3
+from .game import AlgorithmActivator, Game
 
 #: Every chart of the project, in the order the diagrams list them.
-ALL_CHARTS = (*INIT_CHARTS, Control)
+ALL_CHARTS = (*INIT_CHARTS, Control, AlgorithmActivator, Game)
 
-__all__ = ["ALL_CHARTS", "INIT_CHARTS", "Control", "DriveInit1", "DriveInit2", "DriveInit3"]
+__all__ = ["ALL_CHARTS", "INIT_CHARTS", "AlgorithmActivator", "Control", "DriveInit1", "DriveInit2",
+           "DriveInit3", "Game"]

@@ -1,0 +1,149 @@
+"""The game's charts: the algorithm activator (thesis fig. 3.30) and the game flow (section 3.7).
+
+- ``AlgorithmActivator``: "compares the coordinates of the moves made by the
+  opponent in the current time step to the same coordinates in the previous
+  time step, and allows the user to activate the Tic-tac-toe algorithm using
+  the manual switch only once as long as the coordinates are the same".  Its
+  output `enable` is true for exactly one chart tick per activation.
+- ``Game``: whose turn it is, when the manipulator draws, the result, erasing
+  and turning off, with the messages of the thesis' Tic-tac-toe GUI as its
+  `message` output.
+"""
+
+from __future__ import annotations
+
+from statemachine import State
+
+from ..runtime import Data, TickChart, after, after_s
+
+CHART_PERIOD_S = 0.002
+
+#: The Tic-tac-toe GUI's messages (thesis section 3.7, Text box2), and the results.
+MSG_COMPILING = "Wait for the model to be compiled."
+MSG_INITIALISING = "The compilation is done wait for the manipulator to be initialized."
+MSG_YOUR_TURN = "If it is your turn to play draw your next move, otherwise click for the manipulator to play"
+MSG_DRAWING = "The manipulator is drawing."
+MSG_ERASING = "The manipulator is erasing."
+MSG_TURNING_OFF = "The manipulator is being turned off."
+RESULT_MESSAGES = {1: "The manipulator wins.", 2: "You win.", 3: "Draw: the board is full."}
+
+
+class AlgorithmActivator(TickChart):
+    """Fig. 3.30: the Play trigger activates the game algorithm once per change of o_pos."""
+
+    tick_period_s = CHART_PERIOD_S
+    activations: int  # for type checkers: counts up from its own value
+    ignored_triggers: int
+
+    inputs = (
+        Data("o_pos", "1", 0, "the opponent's moves: bit 5*(row-1)+(column-1) set per occupied cell"),
+        Data("hold", "bool", False, "a new game: forget the moves the algorithm was last run for"),
+    )
+    outputs = (
+        Data("enable", "bool", False, "enables the game algorithm's sub-system for this one tick"),
+    )
+    local = (
+        Data("o_pos_used", "1", -1, "o_pos when the algorithm was last enabled (-1: never)"),
+        Data("activations", "1", 0, "times the algorithm was enabled"),
+        Data("ignored_triggers", "1", 0, "Play clicks while the opponent's moves had not changed"),
+    )
+
+    armed = State(initial=True)
+    enabled = State()
+    spent = State()
+
+    trigger = armed.to(enabled) | spent.to(None, on="ignore_trigger") | enabled.to(None, on="ignore_trigger")
+    enabled.to(spent, cond=after(1))  # the enable pulse lasts one chart tick
+    spent.to(armed, cond="o_pos != o_pos_used or hold")
+
+    def on_enter_enabled(self) -> None:
+        self.enable = True
+        self.o_pos_used = self.o_pos
+        self.activations = self.activations + 1
+
+    def on_enter_spent(self) -> None:
+        self.enable = False
+
+    def on_enter_armed(self) -> None:
+        if self.hold:
+            self.o_pos_used = -1
+
+    def ignore_trigger(self) -> None:
+        self.ignored_triggers = self.ignored_triggers + 1
+
+
+class Game(TickChart):
+    """The game flow behind the Tic-tac-toe GUI: turns, drawing, result, erasing, turning off."""
+
+    tick_period_s = CHART_PERIOD_S
+
+    inputs = (
+        Data("initialised", "bool", False, "every drive is initialised (init charts)"),
+        Data("ready", "bool", False, "the Control chart waits in wait_1 with the field drawn"),
+        Data("busy", "bool", False, "the Control chart is drawing, erasing or moving"),
+        Data("result", "1", 0, "0: game on; 1: the manipulator won; 2: the person won; 3: draw"),
+        Data("erased", "bool", False, "the Control chart has erased the board and left Erase"),
+        Data("play_again", "bool", False, "start a new game after erasing instead of turning off"),
+        Data("finished", "bool", False, "the Control chart is back at its start pose"),
+    )
+    outputs = (
+        Data("message", "text", MSG_COMPILING, "what the Tic-tac-toe GUI shows (thesis section 3.7)"),
+        Data("erase", "bool", False, "ask the Control chart to erase the board"),
+        Data("finish", "bool", False, "ask the Control chart to finish and return to its start pose"),
+    )
+    local = (
+        Data("games", "1", 0, "games finished"),
+    )
+
+    compiling = State(initial=True)
+    initialising = State()
+
+    class playing(State.Compound):
+        your_turn = State(initial=True)
+        drawing = State()
+        your_turn.to(drawing, cond="busy")
+        drawing.to(your_turn, cond="ready")
+
+    game_over = State()
+    erasing = State()
+    turning_off = State()
+    off = State(final=True)
+
+    compiling.to(initialising)
+    initialising.to(playing, cond="ready")
+    playing.to(game_over, cond="result != 0 and ready")
+    game_over.to(erasing, cond=after_s(2.0))  # the result stays on show for 2 s
+    erasing.to(playing, cond="erased and ready and play_again", on="new_game")
+    erasing.to(turning_off, cond="erased and not play_again")
+    turning_off.to(off, cond="finished")
+    stop = (compiling.to(turning_off) | initialising.to(turning_off) | playing.to(turning_off)
+            | game_over.to(turning_off) | erasing.to(turning_off))
+
+    def on_enter_initialising(self) -> None:
+        self.message = MSG_INITIALISING
+
+    def on_enter_your_turn(self) -> None:
+        self.message = MSG_YOUR_TURN
+
+    def on_enter_drawing(self) -> None:
+        self.message = MSG_DRAWING
+
+    def on_enter_game_over(self) -> None:
+        self.message = RESULT_MESSAGES.get(self.result, "Game over.")
+        self.games = self.games + 1
+
+    def on_enter_erasing(self) -> None:
+        self.message = MSG_ERASING
+        self.erase = True
+
+    def on_exit_erasing(self) -> None:
+        self.erase = False
+
+    def new_game(self) -> None:
+        self.result = 0
+
+    def on_enter_turning_off(self) -> None:
+        self.message = MSG_TURNING_OFF
+        self.finish = True
+
+    games: int  # for type checkers: counts up from its own value

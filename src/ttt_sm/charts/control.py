@@ -20,9 +20,12 @@ setpoint filters.  Its sub-charts are compound states, as in fig. 3.24:
 - ``finishing``: `finish` at any moment (also mid-stroke) lifts the pen and
   returns the arm to its start pose.
 
-A ``button`` that arrives while the arm is busy (anything but ``wait_1``) is
-ignored and counted in `ignored_buttons`: a drawing is never started twice,
-and the person presses again once the arm waits (the GUI shows when).
+A ``button`` that arrives while the arm is busy (anything but ``wait_1``, or
+``wait_1`` with the field or an erase still to do) is ignored and counted in
+`ignored_buttons`: a drawing is never started twice, the field and erasing
+come first, and the person presses again once the arm waits (the GUI shows
+when).  A ``draw_sine`` then is dropped.  ``finish`` before the first move
+ends at once: the arm still stands at its start pose.
 
 Every move is a straight line at a set speed, one increment per tick, towards
 a target held in the local data `tx`, `ty`, `tz`; a state's exit guard is
@@ -215,11 +218,14 @@ class Control(TickChart):
         go_home.to(finished, cond="at_target")
 
     # -- from the waiting pose: erase first, then the field, then what the person asks.
-    # A button anywhere else is ignored and counted (targetless: nothing is left or entered).
+    # Events are handled before tick transitions, so the person's events also wait for
+    # `idle` (Stateflow tries wait_1's erase and field transitions first, in order).
+    # A button anywhere else, or before the arm is idle, is ignored and counted
+    # (targetless: nothing is left or entered).
     start_stop.wait_1.to(Erase, cond="erase")
     start_stop.wait_1.to(Drawing_playing_field, cond="not Pl_fld")
-    button = (start_stop.wait_1.to(Drawing_X, cond="symbol == 1", on="count_symbol")
-              | start_stop.wait_1.to(Drawing_O, cond="symbol == 0", on="count_symbol")
+    button = (start_stop.wait_1.to(Drawing_X, cond="symbol == 1 and idle", on="count_symbol")
+              | start_stop.wait_1.to(Drawing_O, cond="symbol == 0 and idle", on="count_symbol")
               | start_stop.to(None, on="ignore_button")  # type: ignore[arg-type]
               | Drawing_playing_field.to(None, on="ignore_button")  # type: ignore[arg-type]
               | Drawing_X.to(None, on="ignore_button")  # type: ignore[arg-type]
@@ -227,7 +233,7 @@ class Control(TickChart):
               | Drawing_sine.to(None, on="ignore_button")  # type: ignore[arg-type]
               | Erase.to(None, on="ignore_button")  # type: ignore[arg-type]
               | finishing.to(None, on="ignore_button"))  # type: ignore[arg-type]
-    draw_sine = start_stop.wait_1.to(Drawing_sine)
+    draw_sine = start_stop.wait_1.to(Drawing_sine, cond="idle")
 
     # -- back to the waiting pose once a sub-chart is done (lifted to z_travel)
     Drawing_playing_field.field_lift_off.to(start_stop.go_wait, cond="at_target")
@@ -251,6 +257,10 @@ class Control(TickChart):
     def at_target(self) -> bool:
         """The output has reached the current move's target."""
         return self.X_out == self.tx and self.Y_out == self.ty and self.Z_out == self.tz
+
+    def idle(self) -> bool:
+        """Nothing of the arm's own is pending: the field is drawn and no erase is asked for."""
+        return bool(self.Pl_fld and not self.erase)
 
     def arrived(self) -> bool:
         """The arm itself (forward kinematics of the encoders) is at the waiting pose."""
@@ -336,6 +346,11 @@ class Control(TickChart):
 
     def aim_lift(self) -> None:
         """finish: straight up from wherever the pen is, turning phi back to 0 on the way."""
+        if math.isnan(self.X_out):
+            # finish came before the first move: the arm still stands at its start pose
+            self.take_start_pose()
+            self._aim(self.x_start, self.y_start, self.z_start)
+            return
         self._aim(self.X_out, self.Y_out, max(self.Z_out, self.z_safe))
 
     def _vertical(self) -> None:
@@ -431,7 +446,7 @@ class Control(TickChart):
     # ------------------------------------------------------- Drawing_O
 
     def on_enter_Drawing_O(self) -> None:
-        # eqs. 3.45-3.47 (R = L/4 for the default size L/2)
+        # eqs. 3.45-3.47; R = size/2 (the printed R = L/4 is the size L/2)
         self.x0 = self.x11 - (self.column - 1) * self.L - self.L / 2
         self.y0 = self.y11 - (self.row - 1) * self.L - self.L / 2
         self.R = self.size / 2

@@ -51,13 +51,23 @@ class LineFramer:
         self._garbage = bytearray()    # the first bytes of the current garbage run
         self._garbage_size = 0
         self._discarding = 0           # bytes dropped after an overlong sentence, 0 when not discarding
+        self._sync_left = 0            # after resync(): bytes that may still be skipped as a line's tail
+        self.skipped = 0
+        """Bytes dropped as the tail of a line that began before the last :meth:`resync`."""
 
     def feed(self, data: bytes) -> list[bytes | Rejection]:
         """Consume ``data``; return the sentences (bytes, ``$`` .. ``\\r\\n``) and rejections it completes."""
         out: list[bytes | Rejection] = []
         i, n = 0, len(data)
         while i < n:
-            if self._discarding:
+            if self._sync_left:
+                k = _find_end(data, i)
+                stop = n if k < 0 else k + (data[k] == 0x0A)
+                take = min(stop - i, self._sync_left)
+                self.skipped += take
+                self._sync_left = 0 if (k >= 0 and i + take == stop) else self._sync_left - take
+                i += take
+            elif self._discarding:
                 j = _find_end(data, i)
                 if j < 0:
                     self._discarding += n - i
@@ -113,6 +123,16 @@ class LineFramer:
         self._sentence.clear()
         self._in_sentence = False
         return [r for r in out if isinstance(r, Rejection)]
+
+    def resync(self) -> None:
+        """Start mid-stream (a port just opened): the tail of a line before the first '$' is skipped.
+
+        Call after :meth:`flush`.  A port opened while the camera is sending
+        may start with the end of a line; that is no fault of the line.  Up
+        to the first line end or '$' (at most one sentence's length) is
+        skipped and counted in :attr:`skipped`; garbage after it is garbage.
+        """
+        self._sync_left = self._max
 
     @property
     def pending(self) -> int:

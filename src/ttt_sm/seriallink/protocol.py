@@ -137,7 +137,7 @@ def encode_status(level: Level | str, text: str) -> bytes:
     except ValueError:
         raise EncodeError(f"status level must be one of {', '.join(Level)}, got {level!r}") from None
     raw = text.encode("ascii", errors="replace")
-    if len(raw) > MAX_STATUS_TEXT or not set(raw) <= _TEXT_BYTES:
+    if len(raw) > MAX_STATUS_TEXT or not set(raw) <= _TEXT_BYTES or not text.isascii():
         raise EncodeError(f"status text must be <= {MAX_STATUS_TEXT} printable ASCII characters"
                           f" without '$' or '*', got {text!r}")
     return _wrap(b"TTS," + lvl.value.encode("ascii") + b"," + raw)

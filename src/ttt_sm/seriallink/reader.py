@@ -94,6 +94,8 @@ class LinkStats:
     """Times the port stayed open but no valid frame came for ``silence_s``."""
     statuses: int
     garbage_bytes: int
+    skipped_bytes: int
+    """Bytes dropped after an open up to the first '$' (the end of a line sent before the port opened)."""
     bytes_read: int
 
     @property
@@ -277,7 +279,8 @@ class SerialCameraReader:
         """Counts so far (a snapshot)."""
         n = self._n
         return LinkStats(n.frames_ok, dict(n.rejected), n.gaps, n.frames_missed, n.duplicates, n.seq_restarts,
-                         n.disconnects, n.reconnects, n.silences, n.statuses, n.garbage_bytes, n.bytes_read)
+                         n.disconnects, n.reconnects, n.silences, n.statuses, n.garbage_bytes,
+                         self._framer.skipped, n.bytes_read)
 
     # -- one step: read a chunk, or try to (re)open --------------------------
 
@@ -366,6 +369,7 @@ class SerialCameraReader:
             except (OSError, serial.SerialException):
                 pass  # not every URL handler can; stale bytes are then read and judged like any others
         self._ser = ser
+        self._framer.resync()
         if self._ever_connected:
             self._n.reconnects += 1
             assert self._down_since is not None

@@ -53,6 +53,9 @@ class ControlStage:
         self.chart = chart
         #: The game's request to erase (the thesis' Erase_flag); cleared once erased.
         self.erase_requested = False
+        #: Inputs forced by a test or scenario (``Robot.set_input(..., force=True)``),
+        #: applied after the wiring's own: name -> value.
+        self.overrides: dict[str, object] = {}
         self._no_task = np.full(4, np.nan)
         g = params.geometry
         self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
@@ -70,6 +73,8 @@ class ControlStage:
             self.erase_requested = False
         # plain attribute writes: this runs every chart step
         vars(c).update(X_now=x, Y_now=y, Z_now=z, initialised=self.init.done, erase=self.erase_requested)
+        if self.overrides:
+            vars(c).update(self.overrides)
         c.tick()
         if math.isfinite(c.X_out):
             signals.task = np.array([c.X_out, c.Y_out, c.Z_out, c.phi])

@@ -130,8 +130,9 @@ class Robot:
         """Set a chart input.
 
         Inputs that the wiring feeds every chart step (the Encoder block's
-        `index`, ...) would be overwritten at the next step: `force` keeps the
-        value there until :meth:`release`, as a test of a broken switch needs.
+        `index`, the Control chart's `erase` from :attr:`ControlStage.erase_requested`,
+        ...) would be overwritten at the next step: `force` keeps the value
+        there until :meth:`release`, as a test of a broken switch needs.
         """
         c = self.chart(chart)
         names = {d.name for d in c.declarations() if d.kind == "input"}
@@ -139,11 +140,19 @@ class Robot:
             raise RobotError(f"{chart} has no input {name!r}; inputs: {', '.join(sorted(names))}")
         setattr(c, name, value)
         if force:
-            self.init_stage.overrides[(self._init_index(chart), name)] = value
+            overrides, key = self._forced(chart, name)
+            overrides[key] = value
 
     def release(self, chart: str, name: str) -> None:
         """Stop forcing an input (see :meth:`set_input`)."""
-        self.init_stage.overrides.pop((self._init_index(chart), name), None)
+        overrides, key = self._forced(chart, name)
+        overrides.pop(key, None)
+
+    def _forced(self, chart: str, name: str) -> tuple[dict[Any, object], Any]:
+        """Where a forced input of `chart` is kept, and its key there."""
+        if chart == self.control.chart_name:
+            return self.control_stage.overrides, name
+        return self.init_stage.overrides, (self._init_index(chart), name)
 
     def post(self, chart: str, event: str, **data: Any) -> None:
         """Send an event to a chart; it is handled at the chart's next tick."""
@@ -160,7 +169,7 @@ class Robot:
     def _init_index(self, chart: str) -> int:
         names = [c.chart_name for c in self.init_stage.charts]
         if chart not in names:
-            raise RobotError(f"only the init charts' inputs can be forced, not {chart!r}")
+            raise RobotError(f"only the init charts' and Control's inputs can be forced, not {chart!r}")
         return names.index(chart)
 
     # -- signals -------------------------------------------------------------------

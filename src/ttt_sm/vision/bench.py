@@ -1,0 +1,123 @@
+"""The vision targets: every cell right on 200 simulated photos, <= 10 ms per 640 x 480 frame.
+
+Each photo is a fresh :func:`~ttt_sm.vision.scenes.random_scene` (the field,
+0-14 symbols: the robot's thin ones and the person's hand-drawn ones) seen
+by a fresh :class:`~ttt_sm.vision.simulated.SimulatedCamera` (pose jitter,
+a lighting gradient down to 25 %, blur, noise), every third one with the
+arm's shadow across the board.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ttt_sm.params import ArmParams, load_params
+from ttt_sm.twin.kinematics import ik_closed_form
+
+from .detect import detect
+from .errors import VisionError
+from .orientation import board_text
+from .scenes import Scene, random_scene
+from .simulated import Shadow, SimulatedCamera, shadow_of
+
+#: Photos in the benchmark.
+BENCH_PHOTOS = 200
+
+
+def random_shadow(params: ArmParams, rng: np.random.Generator) -> Shadow:
+    """The arm hovering somewhere over the board (pen 4-12 cm up), as a shadow."""
+    b = params.board
+    for _ in range(20):
+        target = (b.field_center_x + rng.uniform(-0.1, 0.1), b.field_center_y + rng.uniform(-0.1, 0.06),
+                  b.surface_z + rng.uniform(0.04, 0.12), 0.0)
+        try:
+            q = ik_closed_form(target, params.geometry)
+        except ValueError:
+            continue
+        if np.all(np.isfinite(q)):
+            return shadow_of(q)
+    raise VisionError("random_shadow: no reachable pose found")
+
+
+def photo(params: ArmParams, seed: int, *, shadow: bool | None = None) -> tuple[Scene, SimulatedCamera]:
+    """The benchmark's photo number `seed`: a random scene and the camera that sees it."""
+    scene = random_scene(params, seed)
+    rng = np.random.default_rng(seed + 7_000_000)
+    with_shadow = (seed % 3 == 0) if shadow is None else shadow
+    cam = SimulatedCamera(scene.board, params, seed=seed,
+                          shadow=random_shadow(params, rng) if with_shadow else None)
+    return scene, cam
+
+
+def bench_vision(seed: int = 0, photos: int = BENCH_PHOTOS, params: ArmParams | None = None,
+                 progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Detect the cells of `photos` simulated photos; accuracy and time per frame.
+
+    Returns
+    -------
+    dict
+        ``vision_photos``; ``vision_accuracy`` (share of all cells read
+        right, X and O told apart), ``vision_occupancy_accuracy`` (empty vs
+        occupied only), ``vision_photos_all_right``, ``vision_grid_failures``;
+        ``vision_detect_ms_median`` / ``_p95`` / ``_max`` (wall time of
+        :func:`detect` per 640 x 480 frame, grid location included) and
+        ``vision_detect_cpu_ms_median`` (process CPU time: the same without
+        other programs' share of the machine); ``vision_min_dim`` and
+        ``vision_max_roll_deg`` (the harshest lighting and tilt met);
+        ``vision_wrong`` (up to 10 photos that were not read right).
+    """
+    params = params if params is not None else load_params()
+    right = right_occ = total = all_right = failures = 0
+    wall, cpu, wrong = [], [], []
+    dims, rolls = [], []
+    first = None
+    for i in range(photos):
+        s = seed * 100_000 + i
+        scene, cam = photo(params, s)
+        image = cam.frame()
+        dims.append(cam.lighting.dim)
+        rolls.append(abs(cam.pose.roll_deg))
+        if first is None:
+            first = detect(image)  # warm the code paths once
+        c0, t0 = time.process_time(), time.perf_counter()
+        try:
+            d = detect(image)
+        except VisionError as exc:
+            failures += 1
+            total += 25
+            if len(wrong) < 10:
+                wrong.append({"seed": s, "error": str(exc)})
+            continue
+        wall.append((time.perf_counter() - t0) * 1e3)
+        cpu.append((time.process_time() - c0) * 1e3)
+        seen = board_text(d.cells, cam.view())
+        ok = sum(a == b for a, b in zip(seen, scene.text, strict=True))
+        ok_occ = sum((a == ".") == (b == ".") for a, b in zip(seen, scene.text, strict=True))
+        right += ok
+        right_occ += ok_occ
+        total += 25
+        all_right += ok == 25
+        if ok < 25 and len(wrong) < 10:
+            wrong.append({"seed": s, "truth": scene.text, "seen": seen})
+        if progress is not None and (i + 1) % 50 == 0:
+            progress(f"vision: {i + 1}/{photos} photos, {right}/{total} cells right")
+    w = np.array(wall) if wall else np.array([math.nan])
+    return {
+        "vision_photos": photos,
+        "vision_accuracy": right / total if total else math.nan,
+        "vision_occupancy_accuracy": right_occ / total if total else math.nan,
+        "vision_photos_all_right": all_right,
+        "vision_grid_failures": failures,
+        "vision_detect_ms_median": float(np.median(w)),
+        "vision_detect_ms_p95": float(np.percentile(w, 95)),
+        "vision_detect_ms_max": float(np.max(w)),
+        "vision_detect_cpu_ms_median": float(np.median(cpu)) if cpu else math.nan,
+        "vision_min_dim": float(min(dims)),
+        "vision_max_roll_deg": float(max(rolls)),
+        "vision_wrong": wrong,
+    }

@@ -1,0 +1,82 @@
+"""Exceptions of the vision package: each names what was wrong and what to do.
+
+All are ``ValueError`` subclasses through :class:`VisionError`, so a caller
+(the CLI, the game) can catch the whole family with one clause.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+Cell = tuple[int, int]
+
+
+class VisionError(ValueError):
+    """Something the vision package was given, or saw, that it cannot use."""
+
+
+class ImageError(VisionError):
+    """The input is not a usable camera image: not an array, wrong type, shape or size, unreadable file."""
+
+
+class GridNotFoundError(VisionError):
+    """No 5x5 field (4 + 4 drawn lines) could be located in the image."""
+
+
+class CameraError(VisionError):
+    """A camera could not be opened or did not deliver a frame."""
+
+
+def _cells_text(cells: Iterable[Cell]) -> str:
+    return ", ".join(f"({r}, {c})" for r, c in cells)
+
+
+class MoveError(VisionError):
+    """What the camera sees is not one legal move of the person (percent-process, thesis 3.6.3).
+
+    Attributes
+    ----------
+    cells : tuple[tuple[int, int], ...]
+        The board cells (row, column) concerned, 1-based.
+    message_for_person : str
+        A sentence the game can show the person (what to do about it).
+    """
+
+    def __init__(self, message: str, cells: Iterable[Cell], message_for_person: str) -> None:
+        super().__init__(message)
+        self.cells: tuple[Cell, ...] = tuple(cells)
+        self.message_for_person = message_for_person
+
+
+class TooManyMovesError(MoveError):
+    """Two or more new symbols appeared at once: only one move per turn."""
+
+    def __init__(self, cells: Iterable[Cell]) -> None:
+        cells = tuple(cells)
+        super().__init__(
+            f"{len(cells)} new symbols at once in cells {_cells_text(cells)}; one move per turn",
+            cells,
+            f"I see {len(cells)} new symbols ({_cells_text(cells)}). Please draw only one per turn"
+            " and wipe the others.")
+
+
+class RobotCellMarkedError(MoveError):
+    """The person drew into a cell the robot already occupies."""
+
+    def __init__(self, cells: Iterable[Cell]) -> None:
+        cells = tuple(cells)
+        super().__init__(
+            f"new ink in the robot's cell(s) {_cells_text(cells)}",
+            cells,
+            f"Cell {_cells_text(cells)} is already mine. Please wipe your mark there and draw in an empty cell.")
+
+
+class SymbolVanishedError(MoveError):
+    """A symbol that was on the board (the robot's or the person's) is gone."""
+
+    def __init__(self, cells: Iterable[Cell]) -> None:
+        cells = tuple(cells)
+        super().__init__(
+            f"symbol(s) disappeared from cell(s) {_cells_text(cells)}",
+            cells,
+            f"The symbol in {_cells_text(cells)} has disappeared. Please redraw it (or restart the game).")

@@ -10,6 +10,7 @@ one line on standard error and exit status 2.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import itertools
 import json
@@ -18,6 +19,7 @@ import math
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -75,13 +77,20 @@ def _fail(command: str, message: str) -> int:
     return 2
 
 
-def _log_to_stderr(level: int) -> logging.Handler:
+@contextlib.contextmanager
+def _log_to_stderr(level: int) -> Iterator[None]:
+    """Show the link's log (rejections, reconnects) on standard error while the command runs."""
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(levelname)s %(message)s"))
     log = logging.getLogger("ttt_sm.seriallink")
+    old_level = log.level
     log.addHandler(handler)
     log.setLevel(level)
-    return handler
+    try:
+        yield
+    finally:
+        log.removeHandler(handler)
+        log.setLevel(old_level)
 
 
 def cmd_camera_serve(args: argparse.Namespace) -> int:
@@ -97,10 +106,9 @@ def cmd_camera_serve(args: argparse.Namespace) -> int:
         cam = CameraEmulator(source, rate_hz=args.rate, link=args.link)
     except (ValueError, SerialLinkError) as exc:
         return _fail("serve", str(exc))
-    handler = _log_to_stderr(logging.WARNING)
     faults = itertools.cycle(_DEMO_FAULTS)
     try:
-        with cam:
+        with _log_to_stderr(logging.WARNING), cam:
             print(f"camera: serving {args.rate:g} frames/s on {cam.port} -> {cam.device};"
                   f" read it with: ttt-sm camera read --port {cam.port}"
                   + ("" if args.duration is not None else "; Ctrl-C stops"), file=sys.stderr, flush=True)
@@ -114,8 +122,6 @@ def cmd_camera_serve(args: argparse.Namespace) -> int:
                     cam.inject(next(faults))
     except KeyboardInterrupt:
         pass
-    finally:
-        logging.getLogger("ttt_sm.seriallink").removeHandler(handler)
     stats = dataclasses.asdict(cam.stats)
     if args.json:
         print(json.dumps({"link": args.link, "stats": stats}, indent=2))
@@ -130,28 +136,29 @@ def cmd_camera_read(args: argparse.Namespace) -> int:
         return _fail("read", f"--count must be at least 1, got {args.count}")
     if not (args.timeout > 0 and args.give_up >= 0):
         return _fail("read", f"--timeout must be > 0 and --give-up >= 0 seconds, got {args.timeout}, {args.give_up}")
-    handler = _log_to_stderr(logging.INFO if args.verbose else logging.WARNING)
     policy = ReconnectPolicy(max_duration_s=args.give_up)
     frames = []
     reader = SerialCameraReader(args.port, args.timeout, baudrate=args.baud, reconnect=policy)
     try:
-        for frame in reader.frames(args.count, idle_timeout_s=args.timeout):
-            frames.append(frame)
-            if not args.json:
-                print(_grid(frame), flush=True)
+        with _log_to_stderr(logging.INFO if args.verbose else logging.WARNING):
+            for frame in reader.frames(args.count, idle_timeout_s=args.timeout):
+                frames.append(frame)
+                if not args.json:
+                    print(_grid(frame), flush=True)
     except SerialLinkError as exc:
         return _fail("read", str(exc))
     finally:
         reader.close()
-        logging.getLogger("ttt_sm.seriallink").removeHandler(handler)
     stats = reader.stats
     if args.json:
         doc = {"port": args.port, "frames": [{"seq": f.seq, "percentages": list(f.percentages)} for f in frames],
                "stats": {**dataclasses.asdict(stats), "rejected_total": stats.rejected_total}}
         print(json.dumps(doc, indent=2))
     else:
-        print(f"{stats.frames_ok} frames, rejected {stats.rejected_total} {stats.rejected or ''}, gaps {stats.gaps}"
-              f" ({stats.frames_missed} frames missed), reconnects {stats.reconnects}", file=sys.stderr)
+        why = ", ".join(f"{k} {v}" for k, v in sorted(stats.rejected.items()))
+        print(f"{stats.frames_ok} frames, rejected {stats.rejected_total}{f' ({why})' if why else ''},"
+              f" gaps {stats.gaps} ({stats.frames_missed} frames missed), reconnects {stats.reconnects}",
+              file=sys.stderr)
     return 0
 
 

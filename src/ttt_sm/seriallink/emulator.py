@@ -35,10 +35,10 @@ from enum import StrEnum
 from pathlib import Path
 
 from .errors import EncodeError, SerialLinkError
-from .protocol import CELLS, SEQ_MODULUS, Level, crc16, encode_frame, encode_status
+from .protocol import CELLS, MAX_STATUS_TEXT, SEQ_MODULUS, Level, crc16, encode_frame, encode_status
 
 FrameSource = Callable[[], Sequence[float]]
-"""Returns the 25 percentages of the field as the camera sees it now (row-major, percent)."""
+"""Returns the 25 percentages of the field as the camera sees it now (row-major, image order, percent)."""
 
 _LOG = logging.getLogger(__name__)
 
@@ -159,6 +159,12 @@ def apply_fault(line: bytes, fault: Fault | None) -> bytes:
     if kind is FaultKind.OVERLONG:
         return b"$TTT," + b"1" * fault.count + b"\r\n" + line
     return line
+
+
+def _status_text(text: str) -> str:
+    """``text`` made fit for a status line: printable ASCII without '$' and '*', at most 80 characters."""
+    clean = "".join(ch if " " <= ch <= "~" and ch not in "$*" else "?" for ch in text)
+    return clean if len(clean) <= MAX_STATUS_TEXT else clean[:MAX_STATUS_TEXT - 3] + "..."
 
 
 def _body(line: bytes) -> bytes:
@@ -386,7 +392,7 @@ class CameraEmulator:
             except Exception as exc:  # the camera reports it and carries on
                 self._n["source_errors"] += 1
                 self._log.warning("camera emulator: frame_source failed: %r", exc)
-                self.send_status(Level.ERROR, f"frame source failed: {type(exc).__name__}"[:80])
+                self.send_status(Level.ERROR, _status_text(f"no frame: {type(exc).__name__}: {exc}"))
                 return b""
         with self._lock:
             seq = self._seq
@@ -397,7 +403,7 @@ class CameraEmulator:
             except EncodeError as exc:
                 self._n["source_errors"] += 1
                 self._log.warning("camera emulator: cannot send frame %d: %s", seq, exc)
-                self.send_status(Level.ERROR, "bad frame from the detector")
+                self.send_status(Level.ERROR, _status_text(f"bad frame from the detector: {exc}"))
                 return b""
             self._seq = (seq + 1) % SEQ_MODULUS
             data = apply_fault(line, fault)

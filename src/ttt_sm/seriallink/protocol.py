@@ -55,18 +55,21 @@ class Level(StrEnum):
 
 @dataclass(frozen=True)
 class Frame:
-    """One camera frame: its sequence number and the 25 percentages, row-major.
+    """One camera frame: its sequence number and the 25 percentages, row-major in image order.
 
     ``percentages[5 * (row - 1) + (column - 1)]`` is the share of dark pixels,
-    in percent (0..100), in the field at ``row``, ``column`` (1..5), the order
-    of the vision detector's ``Detection.percentages``.
+    in percent (0..100), in the field at ``row``, ``column`` (1..5) *as the
+    camera's image shows it* (row 1 at the top): the order of the vision
+    detector's ``Detection.percentages``, which is what the camera sends.
+    ``ttt_sm.vision.board_values(frame.percentages, view)`` turns it into
+    board order for percent-process.
     """
 
     seq: int
     percentages: tuple[float, ...]
 
     def cell(self, row: int, column: int) -> float:
-        """Percentage of the field at ``row``, ``column`` (1..5 each), percent."""
+        """Percentage of the image's field at ``row``, ``column`` (1..5 each, row 1 at the top), percent."""
         if not (1 <= row <= 5 and 1 <= column <= 5):
             raise IndexError(f"row and column are 1..5, got {row}, {column}")
         return self.percentages[5 * (row - 1) + (column - 1)]

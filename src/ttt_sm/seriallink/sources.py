@@ -31,7 +31,9 @@ def detection_source(camera: _Camera, detect: Callable[[Any], _Detection]) -> Fr
     """``frame_source`` that photographs with ``camera.frame()`` and returns ``detect(image).percentages``.
 
     This is the thesis' camera program (section 3.6.3): take a picture, count
-    the dark pixels in each of the 25 fields, send the percentages.
+    the dark pixels in each of the 25 fields, send the percentages (in the
+    detector's image order, as the camera would).  If the detector raises
+    (no field found), the emulator sends an ERROR status line instead.
     """
     def source() -> list[float]:
         return [float(p) for p in detect(camera.frame()).percentages]

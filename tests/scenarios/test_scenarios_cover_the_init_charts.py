@@ -3,18 +3,13 @@ of the three drive-initialisation charts (thesis section 3.1.2)."""
 
 from __future__ import annotations
 
-from pathlib import Path
+from ttt_sm.scenario import RunReport
 
-from ttt_sm.params import load_params
-from ttt_sm.scenario import load_scenario, run_scenarios, scenario_files
-
-HERE = Path(__file__).parent
 INIT_CHARTS = ("DriveInit1", "DriveInit2", "DriveInit3")
 
 
-def test_scenarios_cover_every_state_and_transition_of_the_init_charts() -> None:
-    scenarios = [load_scenario(p) for p in scenario_files([HERE])]
-    report = run_scenarios(scenarios, load_params(None), coverage=True)
+def test_scenarios_cover_every_state_and_transition_of_the_init_charts(scenario_report: RunReport) -> None:
+    report = scenario_report  # the folder's scenarios, run once per session (conftest.py)
     assert report.passed, [str(f) for r in report.results for f in r.failures]
     assert report.coverage is not None
     charts = {c.chart: c for c in report.coverage.charts}

@@ -14,7 +14,7 @@ camera and the scenes use the twin.
 """
 
 from .camera import Camera, ImageFileCamera, OpenCVCamera, check_image, read_image
-from .detect import Detection, detect
+from .detection import Detection, detect
 from .errors import (
     CameraError,
     GridNotFoundError,

@@ -19,7 +19,7 @@ import numpy as np
 from ttt_sm.params import ArmParams, load_params
 from ttt_sm.twin.kinematics import ik_closed_form
 
-from .detect import detect
+from .detection import detect
 from .errors import VisionError
 from .orientation import board_text
 from .scenes import Scene, random_scene

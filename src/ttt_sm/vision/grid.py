@@ -5,7 +5,7 @@ field's outer border is not drawn.  So the field is located from the lines
 themselves, with no fixed region of interest:
 
 1. the ink mask (pixels clearly darker than their local background, see
-   :func:`ttt_sm.vision.detect.ink_image`) is split into connected pieces;
+   :func:`ttt_sm.vision.detection.ink_image`) is split into connected pieces;
    the drawn grid is one piece (every line crosses the four of the other
    direction), the biggest;
 2. a Hough transform over that piece's bounding box finds straight lines;
@@ -22,6 +22,7 @@ themselves, with no fixed region of interest:
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from dataclasses import dataclass
@@ -36,8 +37,12 @@ MIN_GRID_PX = 60
 #: The cross-ratio of four evenly spaced lines, and how far a chosen four may be from it.
 EVEN_CROSS_RATIO = 4.0 / 3.0
 CROSS_RATIO_TOL = 0.12
-#: Lines are searched among this many strongest Hough lines per direction.
-CANDIDATES_PER_FAMILY = 8
+#: Four lines are chosen among this many best-inked, distinct lines per direction.
+CANDIDATES_PER_FAMILY = 10
+#: The strongest Hough lines per direction whose ink coverage is measured.
+HOUGH_LINES_PER_FAMILY = 40
+#: The grid is looked for in this many of the biggest pieces of ink, biggest first.
+CANDIDATE_PIECES = 4
 #: Ink pixels within this distance of a Hough line refit it, pixels.
 REFIT_BAND_PX = 4.0
 #: Largest RMS distance of the 16 crossings from the fitted homography, as a share of a cell.
@@ -86,10 +91,6 @@ class Grid:
         return Grid(self.homography @ S, self.corners * factor, self.crossings * factor, self.rms_cells)
 
 
-def _cross_ratio(p: np.ndarray) -> float:
-    return float((p[2] - p[0]) * (p[3] - p[1]) / ((p[2] - p[1]) * (p[3] - p[0])))
-
-
 def _families(lines: np.ndarray, centre: tuple[float, float]) -> list[np.ndarray]:
     """Split Hough lines (rho, theta, votes) into near-vertical and near-horizontal.
 
@@ -116,40 +117,88 @@ def _families(lines: np.ndarray, centre: tuple[float, float]) -> list[np.ndarray
     return out
 
 
-def _choose_four(fam: np.ndarray, min_sep: float, which: str) -> np.ndarray:
-    """Four lines of a family that look evenly spaced in perspective, strongest first."""
-    kept: list[np.ndarray] = []
-    for row in fam[np.argsort(-fam[:, 4], kind="stable")]:
-        if all(abs(row[3] - k[3]) >= min_sep for k in kept):
-            kept.append(row)
-            if len(kept) == CANDIDATES_PER_FAMILY:
+def _coverage(fam: np.ndarray, ink: np.ndarray, vertical: bool) -> np.ndarray:
+    """Share of each line's run across the box that lies on ink (`ink`: a slightly thickened mask).
+
+    A drawn grid line is inked all along; a line that Hough assembled from
+    symbols' strokes, or that crosses a grid line at a small angle, is not.
+    """
+    h, w = ink.shape
+    t = np.arange(h if vertical else w, dtype=np.float64)
+    a, b, c = fam[:, 0:1], fam[:, 1:2], fam[:, 2:3]
+    if vertical:
+        u, v = (c - b * t) / a, np.broadcast_to(t, (len(fam), len(t)))
+    else:
+        u, v = np.broadcast_to(t, (len(fam), len(t))), (c - a * t) / b
+    ui, vi = np.rint(u).astype(np.int64), np.rint(v).astype(np.int64)
+    inside = (ui >= 0) & (ui < w) & (vi >= 0) & (vi < h)
+    hits = np.zeros(ui.shape, bool)
+    hits[inside] = ink[vi[inside], ui[inside]] != 0
+    return hits.sum(axis=1) / len(t)
+
+
+def _choose_four(fam: np.ndarray, ink: np.ndarray, vertical: bool, min_sep: float) -> np.ndarray:
+    """Four lines of a family that are well inked and look evenly spaced in perspective."""
+    which = "vertical" if vertical else "horizontal"
+    top = fam[np.argsort(-fam[:, 4], kind="stable")[:HOUGH_LINES_PER_FAMILY]]
+    top[:, 4] = _coverage(top, ink, vertical)
+    top = top[np.argsort(-top[:, 4], kind="stable")]
+    pos = top[:, 3].tolist()
+    kept_at: list[int] = []
+    for i, p in enumerate(pos):  # best-inked first; a line near a kept one is the same line
+        if all(abs(p - pos[k]) >= min_sep for k in kept_at):
+            kept_at.append(i)
+            if len(kept_at) == CANDIDATES_PER_FAMILY:
                 break
+    kept = list(top[kept_at])
     if len(kept) < 4:
         raise GridNotFoundError(f"found {len(kept)} {which} line(s) of the field, need 4: is the whole field"
                                 " in the picture, drawn dark enough and in focus?")
-    kept.sort(key=lambda r: float(r[3]))
-    pos = [float(r[3]) for r in kept]
-    votes = [float(r[4]) for r in kept]
-    best: tuple[float, tuple[int, ...]] | None = None
-    for combo in itertools.combinations(range(len(kept)), 4):  # at most 70
-        p0, p1, p2, p3 = (pos[i] for i in combo)
-        g0, g1, g2 = p1 - p0, p2 - p1, p3 - p2
-        if min(g0, g1, g2) < 0.45 * max(g0, g1, g2):
-            continue  # no perspective of a table-top field squeezes one gap that much
-        if abs((g0 + g1) * (g1 + g2) / (g1 * (p3 - p0)) - EVEN_CROSS_RATIO) > CROSS_RATIO_TOL:
-            continue
-        score = sum(votes[i] for i in combo)
-        if best is None or score > best[0]:
-            best = (score, combo)
-    if best is None:
+    rows = np.array(kept)
+    rows = rows[np.argsort(rows[:, 3])]
+    combos = _combinations(len(rows))
+    p = rows[combos, 3]
+    g = np.diff(p, axis=1)
+    cross_ratio = (g[:, 0] + g[:, 1]) * (g[:, 1] + g[:, 2]) / (g[:, 1] * (p[:, 3] - p[:, 0]))
+    ok = ((g.min(axis=1) >= 0.45 * g.max(axis=1))  # no table-top perspective squeezes a gap more
+          & (np.abs(cross_ratio - EVEN_CROSS_RATIO) <= CROSS_RATIO_TOL))
+    if not ok.any():
         raise GridNotFoundError(f"no four {which} lines are evenly spaced like the field's (tried "
                                 f"{len(kept)} candidates): is the whole field in the picture?")
-    return np.array([kept[i] for i in best[1]])
+    score = np.where(ok, rows[combos, 4].sum(axis=1), -1.0)
+    return rows[combos[int(np.argmax(score))]]
 
 
-def _refit(line: np.ndarray, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    """The line (a, b, c) refitted to the ink pixels near it: total least squares, then once more closer."""
+@functools.cache
+def _combinations(n: int) -> np.ndarray:
+    """All 4-subsets of range(n), sorted, shape (C(n, 4), 4)."""
+    return np.array(list(itertools.combinations(range(n), 4)), np.int64).reshape(-1, 4)
+
+
+def _refit(line: np.ndarray, mask: np.ndarray, vertical: bool) -> np.ndarray:
+    """The line (a, b, c) refitted to the ink pixels of `mask` near it: total least squares, twice.
+
+    Only a band of :data:`REFIT_BAND_PX` on either side of the line is read
+    (row by row for a near-vertical line, column by column for a
+    near-horizontal one); the second fit keeps the pixels within half that
+    of the first, which drops most of a symbol that touches the line.
+    """
     a, b, c = (float(v) for v in line[:3])
+    h, w = mask.shape
+    r = int(math.ceil(REFIT_BAND_PX))
+    offsets = np.arange(-r, r + 1)
+    if vertical:
+        v = np.arange(h)
+        u = np.rint((c - b * v) / a).astype(np.int64)[:, None] + offsets
+        v = np.broadcast_to(v[:, None], u.shape)
+    else:
+        u = np.arange(w)
+        v = np.rint((c - a * u) / b).astype(np.int64)[:, None] + offsets
+        u = np.broadcast_to(u[:, None], v.shape)
+    inside = (u >= 0) & (u < w) & (v >= 0) & (v < h)
+    ui, vi = u[inside], v[inside]
+    on = mask[vi, ui] != 0
+    xs, ys = ui[on].astype(np.float64), vi[on].astype(np.float64)
     for band in (REFIT_BAND_PX, 0.5 * REFIT_BAND_PX):
         near = np.abs(xs * a + ys * b - c) <= band
         x, y = xs[near], ys[near]
@@ -202,12 +251,28 @@ def locate_grid(mask: np.ndarray) -> Grid:
     n, _, stats, _ = cv2.connectedComponentsWithStats(small, connectivity=8)
     if n <= 1:
         raise GridNotFoundError("no ink in the picture: is the field drawn, and the camera pointed at it?")
-    big = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-    x, y, w, h = (int(v) for v in stats[big, :4])
-    if 2 * min(w, h) < MIN_GRID_PX:
+    order = 1 + np.argsort(-stats[1:, cv2.CC_STAT_AREA], kind="stable")
+    big_enough = [int(k) for k in order if 2 * min(stats[k, 2], stats[k, 3]) >= MIN_GRID_PX]
+    if not big_enough:
+        w, h = (int(v) for v in stats[order[0], 2:4])
         raise GridNotFoundError(f"the largest drawing is {2 * w} x {2 * h} pixels, too small for the field "
                                 f"(at least {MIN_GRID_PX} px each way): move the camera closer, or draw the field")
-    # the whole mask over the grid piece's box: a line broken by glare still votes
+    # the grid is usually the biggest piece; dark grain on a dim table can outdo it
+    first_error: GridNotFoundError | None = None
+    for k in big_enough[:CANDIDATE_PIECES]:
+        try:
+            return _grid_from_piece(mask, small, tuple(int(v) for v in stats[k, :4]))  # type: ignore[arg-type]
+        except GridNotFoundError as exc:
+            first_error = first_error or exc
+    assert first_error is not None
+    raise first_error
+
+
+def _grid_from_piece(mask: np.ndarray, small: np.ndarray, box: tuple[int, int, int, int]) -> Grid:
+    """The grid whose lines run through one piece's bounding box (`box` in half-resolution pixels)."""
+    H, W = mask.shape
+    x, y, w, h = box
+    # the whole mask over the piece's box: a line broken by glare or a shadow still votes
     mx, my = w // 8, h // 8
     x0, y0 = max(0, x - mx), max(0, y - my)
     x1, y1 = min(W // 2, x + w + mx), min(H // 2, y + h + my)
@@ -218,21 +283,19 @@ def locate_grid(mask: np.ndarray) -> Grid:
     lines = found.reshape(-1, 3).astype(np.float64)
     centre = ((x - x0) + w / 2, (y - y0) + h / 2)
     vert_f, hori_f = _families(lines, centre)
-    vert = _choose_four(vert_f, 0.08 * w, "vertical")
-    hori = _choose_four(hori_f, 0.08 * h, "horizontal")
+    ink = cv2.dilate(crop, np.ones((3, 3), np.uint8))
+    vert = _choose_four(vert_f, ink, True, 0.04 * w)
+    hori = _choose_four(hori_f, ink, False, 0.04 * h)
     # to full-resolution pixels of the crop: u_small = (u - 0.5) / 2 - x0
     X0, Y0 = 2 * x0, 2 * y0
     full = mask[Y0:2 * y1, X0:2 * x1]
-    nz = cv2.findNonZero(full)
-    pts = nz.reshape(-1, 2).astype(np.float32) if nz is not None else np.zeros((0, 2), np.float32)
-    xs, ys = np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1])
 
     def to_full(r: np.ndarray) -> np.ndarray:
         a, b, c = r[:3]
         return np.array([a, b, 2 * c + 0.5 * (a + b)])
 
-    vert_l = np.array([_refit(to_full(r), xs, ys) for r in vert])
-    hori_l = np.array([_refit(to_full(r), xs, ys) for r in hori])
+    vert_l = np.array([_refit(to_full(r), full, True) for r in vert])
+    hori_l = np.array([_refit(to_full(r), full, False) for r in hori])
     cross = _crossings(vert_l, hori_l) + (X0, Y0)
     field = np.array([(i + 1, j + 1) for j in range(4) for i in range(4)], np.float64)
     Hm, _ = cv2.findHomography(cross.reshape(-1, 2), field, 0)

@@ -1,6 +1,6 @@
 """From cells as the image shows them to the board's (row, column).
 
-:func:`~ttt_sm.vision.detect.detect` numbers cells as the picture shows
+:func:`~ttt_sm.vision.detection.detect` numbers cells as the picture shows
 them: row 1 at the top, column 1 at the left.  The board numbers them as
 the thesis does (eqs. 3.37-3.38): cell (1, 1) at ``(x11, y11)``, the field's
 corner farthest from the robot on the +x side; rows grow towards the robot

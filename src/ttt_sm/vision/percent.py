@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from .detect import OCCUPIED_PCT, Detection
+from .detection import OCCUPIED_PCT, Detection
 from .errors import RobotCellMarkedError, SymbolVanishedError, TooManyMovesError, VisionError
 from .orientation import board_text, board_values
 

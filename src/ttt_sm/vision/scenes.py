@@ -105,3 +105,32 @@ def random_scene(params: ArmParams, seed: int, *, max_symbols: int = 14, resolut
             text[r * n_cells + c] = person_symbol
             person_cells.append((row, column))
     return Scene(board, "".join(text), robot_symbol, tuple(robot_cells), tuple(person_cells))
+
+
+def scene_from_text(params: ArmParams, text: str, robot_symbol: str = "X", seed: int = 0, *,
+                    resolution_mm: float = 0.2) -> Scene:
+    """The field and the symbols of a 25-character board (board order, ``.``/``X``/``O``).
+
+    The robot's symbol is drawn as robot ink, the other by hand.
+    """
+    n = params.board.cells
+    t = text.replace("\n", "").replace(" ", "").upper()
+    if len(t) != n * n or set(t) - {".", "X", "O"}:
+        raise ValueError(f"board text must be {n * n} characters of '.', 'X', 'O' (row 1 first), got {text!r}")
+    if robot_symbol not in ("X", "O"):
+        raise ValueError(f"robot_symbol must be 'X' or 'O', got {robot_symbol!r}")
+    board = Whiteboard(params, resolution_mm, seed=seed)
+    draw_field(board)
+    robot_cells, person_cells = [], []
+    for k, ch in enumerate(t):
+        if ch == ".":
+            continue
+        row, column = divmod(k, n)
+        cell = (row + 1, column + 1)
+        if ch == robot_symbol:
+            draw_robot_symbol(board, ch, *cell)
+            robot_cells.append(cell)
+        else:
+            board.draw_symbol(ch, *cell)
+            person_cells.append(cell)
+    return Scene(board, t, robot_symbol, tuple(robot_cells), tuple(person_cells))

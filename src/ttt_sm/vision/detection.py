@@ -42,6 +42,9 @@ BACKGROUND_PX = 11
 #: A pixel is ink when it is darker than this share of its local background, in 1/255
 #: (the thesis' "value of detecting a gray colour", made relative).
 INK_LEVEL = 205
+#: The grid's lines are looked for with a looser level: blur leaves a thin line only
+#: 15-25 % darker than the board, and the line search tolerates specks.
+GRID_INK_LEVEL = 220
 #: Side of a cell in the rectified field, pixels.
 CELL_PX = 48
 #: Share of a cell's side kept clear along each grid line when measuring it (0.12: 3.6 mm).
@@ -141,7 +144,7 @@ def ink_image(image: np.ndarray) -> np.ndarray:
     return cv2.divide(grey, background, scale=255)
 
 
-def _working(image: np.ndarray) -> tuple[np.ndarray, float]:
+def working_image(image: np.ndarray) -> tuple[np.ndarray, float]:
     """The image at the working width, and the factor back to the original's pixels."""
     h, w = image.shape[:2]
     if w <= WORK_WIDTH:
@@ -206,10 +209,9 @@ def detect(image: Any, *, occupied_pct: float = OCCUPIED_PCT, tell_symbols: bool
     """
     t0 = time.perf_counter()
     image = check_image(image)
-    work, scale = _working(image)
+    work, scale = working_image(image)
     norm = ink_image(work)
-    mask = cv2.compare(norm, INK_LEVEL, cv2.CMP_LT)
-    grid = locate_grid(mask)
+    grid = locate_grid(cv2.compare(norm, GRID_INK_LEVEL, cv2.CMP_LT))
     h, w = work.shape[:2]
     c = grid.corners
     slack = 0.02 * w

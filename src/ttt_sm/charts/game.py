@@ -52,7 +52,9 @@ class AlgorithmActivator(TickChart):
     enabled = State()
     spent = State()
 
-    trigger = armed.to(enabled) | spent.to(None, on="ignore_trigger") | enabled.to(None, on="ignore_trigger")
+    # A click in `spent` counts if the moves changed in the same tick (events come before tick transitions).
+    trigger = (armed.to(enabled) | spent.to(enabled, cond="o_pos != o_pos_used or hold")
+               | spent.to(None, on="ignore_trigger") | enabled.to(None, on="ignore_trigger"))
     enabled.to(spent, cond=after(1))  # the enable pulse lasts one chart tick
     spent.to(armed, cond="o_pos != o_pos_used or hold")
 

@@ -41,6 +41,8 @@ CROSS_RATIO_TOL = 0.12
 CANDIDATES_PER_FAMILY = 10
 #: The strongest Hough lines per direction whose ink coverage is measured.
 HOUGH_LINES_PER_FAMILY = 40
+#: A field's lines and symbols ink a small share of its box (10-20 % at half resolution).
+MAX_INK_DENSITY = 0.35
 #: The grid is looked for in this many of the biggest pieces of ink, biggest first.
 CANDIDATE_PIECES = 4
 #: Ink pixels within this distance of a Hough line refit it, pixels.
@@ -277,6 +279,10 @@ def _grid_from_piece(mask: np.ndarray, small: np.ndarray, box: tuple[int, int, i
     x0, y0 = max(0, x - mx), max(0, y - my)
     x1, y1 = min(W // 2, x + w + mx), min(H // 2, y + h + my)
     crop = small[y0:y1, x0:x1]
+    density = cv2.countNonZero(crop) / crop.size
+    if density > MAX_INK_DENSITY:
+        raise GridNotFoundError(f"{density:.0%} of the drawing's area reads as ink: that is not a field of thin"
+                                " lines (a dark or very noisy picture?)")
     found = cv2.HoughLinesWithAccumulator(crop, 1, math.pi / 180, max(15, int(0.4 * min(w, h))))
     if found is None:
         raise GridNotFoundError("no straight lines in the drawing: the field's lines are missing or too faint")

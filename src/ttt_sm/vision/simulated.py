@@ -185,6 +185,10 @@ class Lighting:
     direction_deg : float
         Direction in the image from the dim side to the bright side,
         degrees (0: bright on the right, 90: bright at the bottom).
+    spread : float
+        Width of the transition from dim to bright, as a share of the
+        picture's extent in that direction (1: across the whole picture;
+        0.5: across its middle half, a lamp close by).
     exposure : float
         Grey level of the white board where the light is brightest, / 255.
     vignette : float
@@ -199,6 +203,7 @@ class Lighting:
 
     dim: float = 1.0
     direction_deg: float = 0.0
+    spread: float = 1.0
     exposure: float = 0.92
     vignette: float = 0.1
     tint: tuple[float, float, float] = (1.0, 1.0, 1.0)
@@ -212,6 +217,7 @@ class Lighting:
         """Lighting drawn uniformly from the given ranges (and a random side dim)."""
         return cls(dim=float(rng.uniform(*dim)),
                    direction_deg=float(rng.uniform(0.0, 360.0)),
+                   spread=float(rng.uniform(0.5, 1.0)),
                    exposure=float(rng.uniform(0.78, 1.0)),
                    vignette=float(rng.uniform(0.0, 0.25)),
                    tint=tuple(float(v) for v in rng.uniform(0.9, 1.05, 3)),  # type: ignore[arg-type]
@@ -223,7 +229,7 @@ class Lighting:
         v, u = np.mgrid[0:height, 0:width].astype(np.float32)
         cu, cv = (width - 1) / 2, (height - 1) / 2
         a = math.radians(self.direction_deg)
-        half = 0.5 * (abs(math.cos(a)) * width + abs(math.sin(a)) * height)
+        half = 0.5 * self.spread * (abs(math.cos(a)) * width + abs(math.sin(a)) * height)
         s = np.clip(0.5 + ((u - cu) * math.cos(a) + (v - cv) * math.sin(a)) / (2 * half), 0.0, 1.0)
         s = s * s * (3 - 2 * s)  # smooth step: the lamp's fall-off
         light = self.dim + (1.0 - self.dim) * s

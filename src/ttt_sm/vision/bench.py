@@ -40,7 +40,7 @@ def random_shadow(params: ArmParams, rng: np.random.Generator) -> Shadow:
         except ValueError:
             continue
         if np.all(np.isfinite(q)):
-            return shadow_of(q)
+            return shadow_of([float(v) for v in q])
     raise VisionError("random_shadow: no reachable pose found")
 
 
@@ -73,7 +73,9 @@ def bench_vision(seed: int = 0, photos: int = BENCH_PHOTOS, params: ArmParams | 
     """
     params = params if params is not None else load_params()
     right = right_occ = total = all_right = failures = 0
-    wall, cpu, wrong = [], [], []
+    wall: list[float] = []
+    cpu: list[float] = []
+    wrong: list[dict[str, Any]] = []
     dims, rolls = [], []
     first = None
     for i in range(photos):

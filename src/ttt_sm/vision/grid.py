@@ -40,7 +40,7 @@ CROSS_RATIO_TOL = 0.12
 #: Four lines are chosen among this many best-inked, distinct lines per direction.
 CANDIDATES_PER_FAMILY = 10
 #: The strongest Hough lines per direction whose ink coverage is measured.
-HOUGH_LINES_PER_FAMILY = 40
+HOUGH_LINES_PER_FAMILY = 30
 #: A field's lines and symbols ink a small share of its box (10-20 % at half resolution).
 MAX_INK_DENSITY = 0.35
 #: The grid is looked for in this many of the biggest pieces of ink, biggest first.
@@ -142,7 +142,12 @@ def _coverage(fam: np.ndarray, ink: np.ndarray, vertical: bool) -> np.ndarray:
 def _choose_four(fam: np.ndarray, ink: np.ndarray, vertical: bool, min_sep: float) -> np.ndarray:
     """Four lines of a family that are well inked and look evenly spaced in perspective."""
     which = "vertical" if vertical else "horizontal"
-    top = fam[np.argsort(-fam[:, 4], kind="stable")[:HOUGH_LINES_PER_FAMILY]]
+    if len(fam) == 0:
+        raise GridNotFoundError(f"found no {which} lines of the field: is the whole field in the picture?")
+    fam = fam[np.argsort(-fam[:, 4], kind="stable")]
+    # Hough answers a line with several near-identical ones: keep the strongest per 2-px slot
+    _, first = np.unique(np.floor(fam[:, 3] / 2.0), return_index=True)
+    top = fam[np.sort(first)[:HOUGH_LINES_PER_FAMILY]]
     top[:, 4] = _coverage(top, ink, vertical)
     top = top[np.argsort(-top[:, 4], kind="stable")]
     pos = top[:, 3].tolist()
@@ -177,44 +182,38 @@ def _combinations(n: int) -> np.ndarray:
     return np.array(list(itertools.combinations(range(n), 4)), np.int64).reshape(-1, 4)
 
 
-def _refit(line: np.ndarray, mask: np.ndarray, vertical: bool) -> np.ndarray:
-    """The line (a, b, c) refitted to the ink pixels of `mask` near it: total least squares, twice.
+def _refit(lines: np.ndarray, mask: np.ndarray, vertical: bool) -> np.ndarray:
+    """Lines (rows a, b, c) refitted to the ink pixels of `mask` near them: least squares, twice.
 
-    Only a band of :data:`REFIT_BAND_PX` on either side of the line is read
-    (row by row for a near-vertical line, column by column for a
-    near-horizontal one); the second fit keeps the pixels within half that
+    Only a band of :data:`REFIT_BAND_PX` on either side of each line is read
+    (row by row for near-vertical lines, column by column for
+    near-horizontal ones); the second fit keeps the pixels within half that
     of the first, which drops most of a symbol that touches the line.
     """
-    a, b, c = (float(v) for v in line[:3])
     h, w = mask.shape
     r = int(math.ceil(REFIT_BAND_PX))
     offsets = np.arange(-r, r + 1)
-    if vertical:
-        v = np.arange(h)
-        u = np.rint((c - b * v) / a).astype(np.int64)[:, None] + offsets
-        v = np.broadcast_to(v[:, None], u.shape)
-    else:
-        u = np.arange(w)
-        v = np.rint((c - a * u) / b).astype(np.int64)[:, None] + offsets
-        u = np.broadcast_to(u[:, None], v.shape)
-    inside = (u >= 0) & (u < w) & (v >= 0) & (v < h)
-    ui, vi = u[inside], v[inside]
-    on = mask[vi, ui] != 0
-    xs, ys = ui[on].astype(np.float64), vi[on].astype(np.float64)
-    for band in (REFIT_BAND_PX, 0.5 * REFIT_BAND_PX):
-        near = np.abs(xs * a + ys * b - c) <= band
-        x, y = xs[near], ys[near]
-        if len(x) < 10:
-            break
-        mx, my = float(x.mean()), float(y.mean())
-        dx, dy = x - mx, y - my
-        sxx, syy, sxy = float(dx @ dx), float(dy @ dy), float(dx @ dy)
-        t = 0.5 * math.atan2(2 * sxy, sxx - syy)  # direction of most spread
-        na, nb = -math.sin(t), math.cos(t)
-        if na * a + nb * b < 0:
-            na, nb = -na, -nb
-        a, b, c = na, nb, na * mx + nb * my
-    return np.array([a, b, c])
+    t = np.arange(h if vertical else w)
+    size = w if vertical else h
+    out = np.array(lines[:, :3], np.float64)
+    for i, (a, b, c) in enumerate(out.tolist()):
+        along = np.rint((c - b * t) / a if vertical else (c - a * t) / b).astype(np.int64)
+        across = along[:, None] + offsets
+        inside = (across >= 0) & (across < size)
+        tt = np.broadcast_to(t[:, None], across.shape)[inside]
+        aa = across[inside]
+        on = mask[aa, tt] if not vertical else mask[tt, aa]
+        pts = (np.column_stack((aa, tt)) if vertical else np.column_stack((tt, aa)))[on != 0].astype(np.float32)
+        for band in (None, 0.5 * REFIT_BAND_PX):
+            if band is not None:
+                pts = pts[np.abs(pts[:, 0] * a + pts[:, 1] * b - c) <= band]
+            if len(pts) < 10:
+                break
+            vx, vy, x0, y0 = (float(v) for v in cv2.fitLine(pts, cv2.DIST_L2, 0, 0.01, 0.01).ravel())
+            na, nb = (-vy, vx) if -vy * a + vx * b >= 0 else (vy, -vx)  # keep the normal's side
+            a, b, c = na, nb, na * x0 + nb * y0
+        out[i] = (a, b, c)
+    return out
 
 
 def _crossings(vert: np.ndarray, hori: np.ndarray) -> np.ndarray:
@@ -249,7 +248,7 @@ def locate_grid(mask: np.ndarray) -> Grid:
     # pieces and Hough at half resolution (4x fewer pixels; a 1-px line survives the
     # "any ink" shrink), the refit at full resolution
     small = cv2.resize(mask, (W // 2, H // 2), interpolation=cv2.INTER_AREA)
-    small = cv2.compare(small, 0, cv2.CMP_GT)
+    _, small = cv2.threshold(small, 0, 255, cv2.THRESH_BINARY)
     n, _, stats, _ = cv2.connectedComponentsWithStats(small, connectivity=8)
     if n <= 1:
         raise GridNotFoundError("no ink in the picture: is the field drawn, and the camera pointed at it?")
@@ -296,12 +295,12 @@ def _grid_from_piece(mask: np.ndarray, small: np.ndarray, box: tuple[int, int, i
     X0, Y0 = 2 * x0, 2 * y0
     full = mask[Y0:2 * y1, X0:2 * x1]
 
-    def to_full(r: np.ndarray) -> np.ndarray:
-        a, b, c = r[:3]
-        return np.array([a, b, 2 * c + 0.5 * (a + b)])
+    def to_full(rows: np.ndarray) -> np.ndarray:
+        a, b, c = rows[:, 0], rows[:, 1], rows[:, 2]
+        return np.column_stack((a, b, 2 * c + 0.5 * (a + b)))
 
-    vert_l = np.array([_refit(to_full(r), full, True) for r in vert])
-    hori_l = np.array([_refit(to_full(r), full, False) for r in hori])
+    vert_l = _refit(to_full(vert), full, True)
+    hori_l = _refit(to_full(hori), full, False)
     cross = _crossings(vert_l, hori_l) + (X0, Y0)
     field = np.array([(i + 1, j + 1) for j in range(4) for i in range(4)], np.float64)
     Hm, _ = cv2.findHomography(cross.reshape(-1, 2), field, 0)

@@ -166,7 +166,8 @@ class CameraJitter:
         dp = rng.uniform(-1.0, 1.0, 3) * self.position_m
         dt = rng.uniform(-1.0, 1.0, 2) * self.target_m
         return replace(pose,
-                       position_m=tuple(float(v) for v in np.add(pose.position_m, dp)),
+                       position_m=(pose.position_m[0] + float(dp[0]), pose.position_m[1] + float(dp[1]),
+                                   pose.position_m[2] + float(dp[2])),
                        target_m=(pose.target_m[0] + float(dt[0]), pose.target_m[1] + float(dt[1]),
                                  pose.target_m[2]),
                        roll_deg=pose.roll_deg + float(rng.uniform(-1.0, 1.0)) * self.roll_deg,
@@ -353,8 +354,8 @@ class SimulatedCamera:
             a, b = np.round(uv[i] * 16).astype(np.int64), np.round(uv[i + 1] * 16).astype(np.int64)
             cv2.line(mask, (int(a[0]), int(a[1])), (int(b[0]), int(b[1])), 1.0,
                      max(1, round(width * p)), cv2.LINE_AA, shift=4)
-        mask = cv2.GaussianBlur(mask, (0, 0), SHADOW_SOFTNESS_M * p)
-        factor = 1.0 - shadow.depth * np.minimum(mask, 1.0)
+        soft = cv2.GaussianBlur(mask, (0, 0), SHADOW_SOFTNESS_M * p)
+        factor = 1.0 - shadow.depth * np.minimum(soft, 1.0)
         return (top.astype(np.float32) * factor[:, :, None]).astype(np.uint8)
 
 

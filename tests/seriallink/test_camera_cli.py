@@ -25,7 +25,7 @@ def test_serve_then_read_as_json(tmp_path, capsys):
     link = str(tmp_path / "cam")
     rc: list[int] = []
     server = threading.Thread(target=lambda: rc.append(run("camera", "serve", "--link", link, "--rate", "50",
-                                                           "--duration", "2.5", "--json")))
+                                                           "--duration", "1.5", "--json")))
     server.start()
     try:
         give_up = time.monotonic() + 15

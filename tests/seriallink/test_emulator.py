@@ -50,6 +50,8 @@ def test_it_refuses_to_replace_what_is_not_its_link(tmp_path):
     with pytest.raises(EmulatorError, match="not a symlink"):
         CameraEmulator(link=real)
     assert real.read_text() == "keep me"
+    with pytest.raises(EmulatorError, match="does not exist"):
+        CameraEmulator(link=tmp_path / "no" / "such" / "camera")
 
 
 def test_streaming_sends_consecutive_frames_from_the_source(tmp_path, open_reader, values, read_until):

@@ -226,6 +226,9 @@ class CameraEmulator:
             self._own_dir = Path(tempfile.mkdtemp(prefix="ttt-camera-"))
             link = self._own_dir / "camera"
         self._link = Path(link)
+        if not self._link.parent.is_dir():
+            raise EmulatorError(f"the folder of the link {self._link} does not exist; create it or choose"
+                                " another --link")
         if self._link.exists() and not self._link.is_symlink():
             raise EmulatorError(f"{self._link} exists and is not a symlink; the emulator only replaces its own"
                                 " link: choose another --link")

@@ -288,7 +288,7 @@ class SerialCameraReader:
         if self._closed:
             raise SerialLinkError(f"the reader of {self.port_name} is closed; make a new one")
         if self._lost is not None:
-            raise self._lost
+            raise type(self._lost)(str(self._lost))  # a fresh one: the first keeps its own traceback
 
     def _step(self, deadline: float) -> None:
         if self._ser is None:
@@ -297,14 +297,17 @@ class SerialCameraReader:
             self._read_step(deadline)
 
     def _read_step(self, deadline: float) -> None:
+        # The port's timeout stays poll_s: setting it reconfigures the port
+        # (tcsetattr), which some USB adapters do not take well many times a
+        # second.  Past the deadline, only what is already waiting is read.
         ser = self._ser
         assert ser is not None
-        wait = min(self._poll_s, max(0.0, deadline - time.monotonic()))
         try:
-            if ser.timeout != wait:
-                ser.timeout = wait
             waiting = ser.in_waiting
-            data = ser.read(min(max(waiting, 1), _CHUNK))
+            if waiting or time.monotonic() < deadline:
+                data = ser.read(min(max(waiting, 1), _CHUNK))
+            else:
+                data = b""
         except (OSError, serial.SerialException) as exc:  # SerialException, EIO from in_waiting, EOF
             self._went_down(exc)
             return
@@ -342,7 +345,8 @@ class SerialCameraReader:
             ser = spec()
             if not ser.is_open:
                 ser.open()
-        ser.timeout = self._poll_s
+        if ser.timeout != self._poll_s:
+            ser.timeout = self._poll_s
         return ser
 
     def _open_failed(self, exc: BaseException) -> None:

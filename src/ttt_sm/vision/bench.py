@@ -2,9 +2,10 @@
 
 Each photo is a fresh :func:`~ttt_sm.vision.scenes.random_scene` (the field,
 0-14 symbols: the robot's thin ones and the person's hand-drawn ones) seen
-by a fresh :class:`~ttt_sm.vision.simulated.SimulatedCamera` (pose jitter,
-a lighting gradient down to 25 %, blur, noise), every third one with the
-arm's shadow across the board.
+by a fresh :class:`~ttt_sm.vision.simulated.SimulatedCamera` (position
++-4 cm, aim +-2 cm, roll +-8 deg, focal length +-8 %; a lighting gradient
+down to 25 %, blur, noise), every third one with the arm's shadow across
+the board.
 """
 
 from __future__ import annotations
@@ -23,10 +24,12 @@ from .detection import detect
 from .errors import VisionError
 from .orientation import board_text
 from .scenes import Scene, random_scene
-from .simulated import Shadow, SimulatedCamera, shadow_of
+from .simulated import CameraJitter, Shadow, SimulatedCamera, shadow_of
 
 #: Photos in the benchmark.
 BENCH_PHOTOS = 200
+#: How far the benchmark's cameras stray from the nominal pose: twice the default jitter.
+BENCH_JITTER = CameraJitter(position_m=0.04, target_m=0.02, roll_deg=8.0, focal_rel=0.08)
 
 
 def random_shadow(params: ArmParams, rng: np.random.Generator) -> Shadow:
@@ -49,7 +52,7 @@ def photo(params: ArmParams, seed: int, *, shadow: bool | None = None) -> tuple[
     scene = random_scene(params, seed)
     rng = np.random.default_rng(seed + 7_000_000)
     with_shadow = (seed % 3 == 0) if shadow is None else shadow
-    cam = SimulatedCamera(scene.board, params, seed=seed,
+    cam = SimulatedCamera(scene.board, params, seed=seed, jitter=BENCH_JITTER,
                           shadow=random_shadow(params, rng) if with_shadow else None)
     return scene, cam
 

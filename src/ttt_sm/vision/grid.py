@@ -39,8 +39,10 @@ EVEN_CROSS_RATIO = 4.0 / 3.0
 CROSS_RATIO_TOL = 0.12
 #: Four lines are chosen among this many best-inked, distinct lines per direction.
 CANDIDATES_PER_FAMILY = 10
+#: Angle step of the Hough transform, rad (the lines are refitted afterwards).
+HOUGH_THETA_RAD = math.radians(1.5)
 #: The strongest Hough lines per direction whose ink coverage is measured.
-HOUGH_LINES_PER_FAMILY = 30
+HOUGH_LINES_PER_FAMILY = 20
 #: A field's lines and symbols ink a small share of its box (10-20 % at half resolution).
 MAX_INK_DENSITY = 0.35
 #: The grid is looked for in this many of the biggest pieces of ink, biggest first.
@@ -183,36 +185,42 @@ def _combinations(n: int) -> np.ndarray:
 
 
 def _refit(lines: np.ndarray, mask: np.ndarray, vertical: bool) -> np.ndarray:
-    """Lines (rows a, b, c) refitted to the ink pixels of `mask` near them: least squares, twice.
+    """Lines (rows a, b, c) refitted to the ink pixels of `mask` near them (robust least squares).
 
     Only a band of :data:`REFIT_BAND_PX` on either side of each line is read
     (row by row for near-vertical lines, column by column for
-    near-horizontal ones); the second fit keeps the pixels within half that
-    of the first, which drops most of a symbol that touches the line.
+    near-horizontal ones); a second fit to the pixels within half the band
+    of the first keeps a symbol that touches the line from pulling it.
+    (``cv2.DIST_HUBER`` would do that too, at ten times the cost.)
     """
     h, w = mask.shape
     r = int(math.ceil(REFIT_BAND_PX))
     offsets = np.arange(-r, r + 1)
+    a, b, c = lines[:, 0:1], lines[:, 1:2], lines[:, 2:3]
     t = np.arange(h if vertical else w)
-    size = w if vertical else h
+    along = np.rint((c - b * t) / a if vertical else (c - a * t) / b).astype(np.int64)
+    across = along[:, :, None] + offsets  # (lines, t, offsets)
+    tt = np.broadcast_to(t[None, :, None], across.shape)
+    inside = (across >= 0) & (across < (w if vertical else h))
+    on = np.zeros(across.shape, bool)
+    on[inside] = (mask[tt[inside], across[inside]] if vertical else mask[across[inside], tt[inside]]) != 0
     out = np.array(lines[:, :3], np.float64)
-    for i, (a, b, c) in enumerate(out.tolist()):
-        along = np.rint((c - b * t) / a if vertical else (c - a * t) / b).astype(np.int64)
-        across = along[:, None] + offsets
-        inside = (across >= 0) & (across < size)
-        tt = np.broadcast_to(t[:, None], across.shape)[inside]
-        aa = across[inside]
-        on = mask[aa, tt] if not vertical else mask[tt, aa]
-        pts = (np.column_stack((aa, tt)) if vertical else np.column_stack((tt, aa)))[on != 0].astype(np.float32)
+    for i in range(len(out)):
+        sel = on[i]
+        if np.count_nonzero(sel) < 10:
+            continue
+        u, v = (across[i][sel], tt[i][sel]) if vertical else (tt[i][sel], across[i][sel])
+        pts = np.column_stack((u, v)).astype(np.float32)
+        la, lb, lc = out[i]
         for band in (None, 0.5 * REFIT_BAND_PX):
-            if band is not None:
-                pts = pts[np.abs(pts[:, 0] * a + pts[:, 1] * b - c) <= band]
-            if len(pts) < 10:
-                break
-            vx, vy, x0, y0 = (float(v) for v in cv2.fitLine(pts, cv2.DIST_L2, 0, 0.01, 0.01).ravel())
-            na, nb = (-vy, vx) if -vy * a + vx * b >= 0 else (vy, -vx)  # keep the normal's side
-            a, b, c = na, nb, na * x0 + nb * y0
-        out[i] = (a, b, c)
+            if band is not None:  # again, closer: most of a touching symbol drops out
+                pts = pts[np.abs(pts[:, 0] * la + pts[:, 1] * lb - lc) <= band]
+                if len(pts) < 10:
+                    break
+            vx, vy, x0, y0 = (float(k) for k in cv2.fitLine(pts, cv2.DIST_L2, 0, 0.01, 0.01).ravel())
+            la, lb = (-vy, vx) if -vy * la + vx * lb >= 0 else (vy, -vx)  # keep the normal's side
+            lc = la * x0 + lb * y0
+        out[i] = (la, lb, lc)
     return out
 
 
@@ -252,13 +260,16 @@ def locate_grid(mask: np.ndarray) -> Grid:
     n, _, stats, _ = cv2.connectedComponentsWithStats(small, connectivity=8)
     if n <= 1:
         raise GridNotFoundError("no ink in the picture: is the field drawn, and the camera pointed at it?")
-    order = 1 + np.argsort(-stats[1:, cv2.CC_STAT_AREA], kind="stable")
+    # the field lies inside the picture, so its piece does not reach the picture's edge (dark
+    # grain on a dim table does, and can outdo it in size): inner pieces first, biggest first
+    x, y, w, h, area = (stats[1:, k] for k in range(5))
+    edge = (x == 0) | (y == 0) | (x + w == small.shape[1]) | (y + h == small.shape[0])
+    order = 1 + np.lexsort((-area, edge))
     big_enough = [int(k) for k in order if 2 * min(stats[k, 2], stats[k, 3]) >= MIN_GRID_PX]
     if not big_enough:
         w, h = (int(v) for v in stats[order[0], 2:4])
         raise GridNotFoundError(f"the largest drawing is {2 * w} x {2 * h} pixels, too small for the field "
                                 f"(at least {MIN_GRID_PX} px each way): move the camera closer, or draw the field")
-    # the grid is usually the biggest piece; dark grain on a dim table can outdo it
     first_error: GridNotFoundError | None = None
     for k in big_enough[:CANDIDATE_PIECES]:
         try:
@@ -282,7 +293,7 @@ def _grid_from_piece(mask: np.ndarray, small: np.ndarray, box: tuple[int, int, i
     if density > MAX_INK_DENSITY:
         raise GridNotFoundError(f"{density:.0%} of the drawing's area reads as ink: that is not a field of thin"
                                 " lines (a dark or very noisy picture?)")
-    found = cv2.HoughLinesWithAccumulator(crop, 1, math.pi / 180, max(15, int(0.4 * min(w, h))))
+    found = cv2.HoughLinesWithAccumulator(crop, 1, HOUGH_THETA_RAD, max(15, int(0.4 * min(w, h))))
     if found is None:
         raise GridNotFoundError("no straight lines in the drawing: the field's lines are missing or too faint")
     lines = found.reshape(-1, 3).astype(np.float64)
@@ -312,4 +323,10 @@ def _grid_from_piece(mask: np.ndarray, small: np.ndarray, box: tuple[int, int, i
         raise GridNotFoundError(f"the lines' crossings fit a flat field only to {rms:.2f} cells RMS "
                                 f"(at most {MAX_RMS_CELLS}): bent lines, or not the field")
     corners = g.field_to_image(np.array([(0.0, 0.0), (5.0, 0.0), (5.0, 5.0), (0.0, 5.0)]))
+    slack = 0.02 * W
+    if (corners[:, 0].min() < -slack or corners[:, 1].min() < -slack or corners[:, 0].max() > W + slack
+            or corners[:, 1].max() > H + slack):
+        raise GridNotFoundError(f"the field's edge lies outside the picture (corners at "
+                                f"{np.round(corners).astype(int).tolist()} in a {W} x {H} image): aim the"
+                                " camera at the field's centre or move it back")
     return Grid(Hm, corners, cross, rms)

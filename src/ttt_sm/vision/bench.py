@@ -26,6 +26,8 @@ from .orientation import board_text
 from .scenes import Scene, random_scene
 from .simulated import CameraJitter, Shadow, SimulatedCamera, shadow_of
 
+#: Each photo is detected this many times; its time is the fastest run.
+REPEATS = 3
 #: Photos in the benchmark.
 BENCH_PHOTOS = 200
 #: How far the benchmark's cameras stray from the nominal pose: twice the default jitter.
@@ -67,16 +69,21 @@ def bench_vision(seed: int = 0, photos: int = BENCH_PHOTOS, params: ArmParams | 
         ``vision_photos``; ``vision_accuracy`` (share of all cells read
         right, X and O told apart), ``vision_occupancy_accuracy`` (empty vs
         occupied only), ``vision_photos_all_right``, ``vision_grid_failures``;
-        ``vision_detect_ms_median`` / ``_p95`` / ``_max`` (wall time of
-        :func:`detect` per 640 x 480 frame, grid location included) and
-        ``vision_detect_cpu_ms_median`` (process CPU time: the same without
+        ``vision_detect_ms_median``: wall time of :func:`detect` per
+        640 x 480 frame, grid location included, the fastest of
+        :data:`REPEATS` runs per photo, median over the photos (other
+        programs on the machine only ever add time);
+        ``vision_detect_ms_single_median`` / ``_p95`` / ``_max``: the first
+        run of each photo alone, as it came; ``vision_detect_cpu_ms_median``:
+        process CPU time of that run (both OpenCV threads, without
         other programs' share of the machine); ``vision_min_dim`` and
         ``vision_max_roll_deg`` (the harshest lighting and tilt met);
         ``vision_wrong`` (up to 10 photos that were not read right).
     """
     params = params if params is not None else load_params()
     right = right_occ = total = all_right = failures = 0
-    wall: list[float] = []
+    single: list[float] = []
+    best: list[float] = []
     cpu: list[float] = []
     wrong: list[dict[str, Any]] = []
     dims, rolls = [], []
@@ -98,8 +105,14 @@ def bench_vision(seed: int = 0, photos: int = BENCH_PHOTOS, params: ArmParams | 
             if len(wrong) < 10:
                 wrong.append({"seed": s, "error": str(exc)})
             continue
-        wall.append((time.perf_counter() - t0) * 1e3)
+        single.append((time.perf_counter() - t0) * 1e3)
         cpu.append((time.process_time() - c0) * 1e3)
+        runs = [single[-1]]
+        for _ in range(REPEATS - 1):  # other programs on the machine only ever add time
+            t0 = time.perf_counter()
+            detect(image)
+            runs.append((time.perf_counter() - t0) * 1e3)
+        best.append(min(runs))
         seen = board_text(d.cells, cam.view())
         ok = sum(a == b for a, b in zip(seen, scene.text, strict=True))
         ok_occ = sum((a == ".") == (b == ".") for a, b in zip(seen, scene.text, strict=True))
@@ -111,16 +124,17 @@ def bench_vision(seed: int = 0, photos: int = BENCH_PHOTOS, params: ArmParams | 
             wrong.append({"seed": s, "truth": scene.text, "seen": seen})
         if progress is not None and (i + 1) % 50 == 0:
             progress(f"vision: {i + 1}/{photos} photos, {right}/{total} cells right")
-    w = np.array(wall) if wall else np.array([math.nan])
+    one = np.array(single) if single else np.array([math.nan])
     return {
         "vision_photos": photos,
         "vision_accuracy": right / total if total else math.nan,
         "vision_occupancy_accuracy": right_occ / total if total else math.nan,
         "vision_photos_all_right": all_right,
         "vision_grid_failures": failures,
-        "vision_detect_ms_median": float(np.median(w)),
-        "vision_detect_ms_p95": float(np.percentile(w, 95)),
-        "vision_detect_ms_max": float(np.max(w)),
+        "vision_detect_ms_median": float(np.median(best)) if best else math.nan,
+        "vision_detect_ms_single_median": float(np.median(one)),
+        "vision_detect_ms_single_p95": float(np.percentile(one, 95)),
+        "vision_detect_ms_single_max": float(np.max(one)),
         "vision_detect_cpu_ms_median": float(np.median(cpu)) if cpu else math.nan,
         "vision_min_dim": float(min(dims)),
         "vision_max_roll_deg": float(max(rolls)),

@@ -23,6 +23,7 @@ board's (row, column) for a camera placement.
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -167,17 +168,22 @@ def cell_shares(ink: np.ndarray, cell_px: int = CELL_PX, margin: float = CELL_MA
     return cells.mean(axis=(1, 3))
 
 
+@functools.cache
+def _pixel_grid(h: int, w: int) -> tuple[np.ndarray, np.ndarray]:
+    v, u = np.indices((h, w), dtype=np.float32)
+    return u, v
+
+
 def centre_share(cell_ink: np.ndarray, radius_px: float) -> float:
     """Share of the disc of `radius_px` around the ink's centroid that is inked (0 without ink)."""
     mom = cv2.moments(cell_ink.view(np.uint8), binaryImage=True)
     if mom["m00"] == 0:
         return 0.0
     cx, cy = mom["m10"] / mom["m00"], mom["m01"] / mom["m00"]
-    h, w = cell_ink.shape
-    v, u = np.ogrid[0:h, 0:w]
-    disc = (u - cx) ** 2 + (v - cy) ** 2 <= radius_px ** 2
-    n = int(disc.sum())
-    return float(cell_ink[disc].sum()) / n if n else 0.0
+    u, v = _pixel_grid(*cell_ink.shape)
+    disc = (u - np.float32(cx)) ** 2 + (v - np.float32(cy)) ** 2 <= np.float32(radius_px ** 2)
+    n = int(np.count_nonzero(disc))
+    return float(np.count_nonzero(cell_ink & disc)) / n if n else 0.0
 
 
 def detect(image: Any, *, occupied_pct: float = OCCUPIED_PCT, tell_symbols: bool = True) -> Detection:

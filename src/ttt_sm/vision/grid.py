@@ -262,12 +262,12 @@ def locate_grid(mask: np.ndarray) -> Grid:
         raise GridNotFoundError("no ink in the picture: is the field drawn, and the camera pointed at it?")
     # the field lies inside the picture, so its piece does not reach the picture's edge (dark
     # grain on a dim table does, and can outdo it in size): inner pieces first, biggest first
-    x, y, w, h, area = (stats[1:, k] for k in range(5))
-    edge = (x == 0) | (y == 0) | (x + w == small.shape[1]) | (y + h == small.shape[0])
+    px, py, pw, ph, area = (stats[1:, k] for k in range(5))
+    edge = (px == 0) | (py == 0) | (px + pw == small.shape[1]) | (py + ph == small.shape[0])
     order = 1 + np.lexsort((-area, edge))
-    big_enough = [int(k) for k in order if 2 * min(stats[k, 2], stats[k, 3]) >= MIN_GRID_PX]
+    big_enough = order[2 * np.minimum(pw, ph)[order - 1] >= MIN_GRID_PX].tolist()
     if not big_enough:
-        w, h = (int(v) for v in stats[order[0], 2:4])
+        w, h = (int(v) for v in stats[1 + int(np.argmax(area)), 2:4])
         raise GridNotFoundError(f"the largest drawing is {2 * w} x {2 * h} pixels, too small for the field "
                                 f"(at least {MIN_GRID_PX} px each way): move the camera closer, or draw the field")
     first_error: GridNotFoundError | None = None

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import cv2
 import numpy as np
+
+from ttt_sm.params import ArmParams
 
 from .detection import CELL_MARGIN, CELL_PX, INK_LEVEL, Detection, ink_image, rectify, working_image
 
@@ -65,5 +69,84 @@ def cells_picture(image: np.ndarray, detection: Detection, cell_px: int = CELL_P
         colour = OCCUPIED_BGR if occupied else (200, 200, 200)
         cv2.rectangle(out, (x0, y0), (x1, y1), colour, 1)
         label = f"{detection.cells[k]} {detection.percentages[k]:.1f}%"
-        cv2.putText(out, label, (x0 + 2, y1 - 3), cv2.FONT_HERSHEY_SIMPLEX, 0.32, (0, 0, 200), 1, cv2.LINE_AA)
+        (tw, th), _ = cv2.getTextSize(label, cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1)
+        cv2.rectangle(out, (x0 + 1, y0 + 1), (x0 + tw + 4, y0 + th + 5), (255, 255, 255), -1)
+        cv2.putText(out, label, (x0 + 3, y0 + th + 3), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 200), 1,
+                    cv2.LINE_AA)
     return out
+
+
+def fixed_level_picture(image: np.ndarray, detection: Detection, level: int = 80) -> np.ndarray:
+    """Side by side: what a fixed grey level calls ink (left) and what the relative level does (right).
+
+    Both are the rectified field, ink black; under a lighting gradient the
+    fixed level blackens the dim cells.
+    """
+    grey = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY) if image.ndim == 3 else image
+    fixed = np.where(rectify(grey, detection.grid) < level, 0, 255).astype(np.uint8)
+    work, scale = working_image(image)
+    rel = np.where(rectify(ink_image(work), detection.grid.scaled(1.0 / scale)) < INK_LEVEL, 0, 255)
+    gap = np.full((fixed.shape[0], 8), 255, np.uint8)
+    both = np.hstack((fixed, gap, rel.astype(np.uint8)))
+    out = cv2.cvtColor(both, cv2.COLOR_GRAY2BGR)
+    cv2.rectangle(out, (0, 0), (fixed.shape[1] - 1, fixed.shape[0] - 1), (0, 0, 200), 1)
+    cv2.rectangle(out, (fixed.shape[1] + 8, 0), (out.shape[1] - 1, fixed.shape[0] - 1), OCCUPIED_BGR, 1)
+    return out
+
+
+def doc_pictures(out_dir: str | Path, params: ArmParams | None = None) -> list[Path]:
+    """Write the pictures of docs/vision.md to `out_dir`; returns their paths.
+
+    A simulated photo (robot X in blue, the person's O in black, the lamp
+    on the right, the arm's shadow), the located field over it, the
+    rectified cells with their percentages, and the fixed grey level 80 next
+    to the relative level on a photo lit at 25 % on its left.
+    """
+    from ttt_sm.params import load_params
+    from ttt_sm.twin.kinematics import ik_closed_form
+
+    from .detection import detect
+    from .scenes import scene_from_text
+    from .simulated import Lighting, SimulatedCamera, shadow_of
+
+    params = params if params is not None else load_params()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    scene = scene_from_text(params, DOC_BOARD, "X", seed=12)
+    light = Lighting(dim=0.45, direction_deg=20.0, spread=0.8, exposure=0.9, vignette=0.12, noise_sigma=1.2,
+                     blur_sigma_px=0.7)
+    hover = ik_closed_form([0.04, 0.21, 0.06, 0.0], params.geometry)  # the arm waiting over the field
+    cam = SimulatedCamera(scene.board, params, seed=12, lighting=light, shadow=shadow_of(list(hover)))
+    photo = cam.frame()
+    det = detect(photo)
+    dim_cam = SimulatedCamera(scene_from_text(params, DIM_BOARD, "X", seed=4).board, params, seed=4, jitter=None,
+                              lighting=Lighting(dim=0.25, direction_deg=0.0, spread=0.5, exposure=0.85,
+                                                vignette=0.05, noise_sigma=2.0, blur_sigma_px=0.7))
+    dim_photo = dim_cam.frame()
+    # the photos at half size (sensor noise does not compress), the overlay cropped to the field
+    x0, y0 = np.floor(det.grid.corners.min(axis=0)).astype(int) - 12
+    x1, y1 = np.ceil(det.grid.corners.max(axis=0)).astype(int) + 12
+    h, w = photo.shape[:2]
+
+    def small(img: np.ndarray) -> np.ndarray:
+        return cv2.resize(img, None, fx=0.5, fy=0.5, interpolation=cv2.INTER_AREA)
+
+    pictures = {
+        "vision_photo.png": small(photo),
+        "vision_overlay.png": overlay(photo, det)[max(0, y0):min(h, y1), max(0, x0):min(w, x1)],
+        "vision_cells.png": cells_picture(photo, det),
+        "vision_dim_photo.png": small(dim_photo),
+        "vision_fixed_level.png": fixed_level_picture(dim_photo, detect(dim_photo)),
+    }
+    paths = []
+    for name, img in pictures.items():
+        p = out / name
+        if not cv2.imwrite(str(p), img, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
+            raise OSError(f"{p}: could not write the picture")
+        paths.append(p)
+    return paths
+
+
+#: The boards of the docs' pictures (board order): the robot plays X.
+DOC_BOARD = "X...O" ".O.X." "..XO." ".X..O" "O...X"
+DIM_BOARD = "..XO." "...XO" "..O.X" "..X.O" "...OX"

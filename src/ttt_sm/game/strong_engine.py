@@ -1,0 +1,129 @@
+"""An engine that never loses: an opening book for the first marks, an exact search after.
+
+5x5 four-in-a-row is a draw with perfect play, so the engine can always keep
+the opponent from forcing a win if it starts from a position that is not
+lost.  Each move it
+
+1. completes its own four if it can;
+2. reads the answer from the opening book (:mod:`ttt_sm.game.book`) while
+   the field holds few marks: every position up to ``book.max_stones``
+   marks, solved exactly by :func:`choose` offline, because there the
+   search costs seconds;
+3. otherwise searches the candidates (the single cell that blocks an
+   opponent's threat, else every empty cell, best first):
+
+   a. for a forced win, within a node budget, so a move stays fast; the
+      budget search has a table of its own, emptied each move, so the
+      chosen move depends on the position only, not on earlier games;
+   b. for the first candidate after which the opponent cannot force a win:
+      an exact answer (no budget), which is what makes the engine never lose.
+
+The answer says what the engine has proved (:class:`Analysis`): ``win``
+(a forced win), ``draw`` (the opponent cannot force a win; the engine may
+still win if the opponent errs) or ``loss`` (the opponent can force a win:
+only from a position given to the engine already lost).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Literal
+
+from .bitboard import INVERSE, SYMMETRIES, canonical, cell_of
+from .book import Book, load_book
+from .engine import GameOver, Move, prepare
+from .rules import Board, Symbol, other
+from .solver import OutOfBudget, Solver, ordered_moves, threat_cells
+
+Outcome = Literal["win", "draw", "loss"]
+WIN_BUDGET_NODES = 3000
+"""Nodes the forced-win search may visit per move (about 25 ms); the no-loss search has no budget."""
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """The strong engine's move and why: what it proved and where the answer came from."""
+
+    move: Move
+    outcome: Outcome
+    source: Literal["win-now", "book", "search"]
+    nodes: int
+    """Positions the searches visited for this move (0 for the book and an immediate win)."""
+
+
+def choose(solver: Solver, mine: int, theirs: int, win_budget: int | None) -> tuple[int, Outcome, int]:
+    """The move (a bit index) for the side holding ``mine`` to move, its outcome, and the nodes searched.
+
+    ``win_budget`` ``None`` searches for a forced win exactly (what the book
+    is built with); a number caps that search, and a fresh :class:`Solver`
+    does it so the answer does not depend on ``solver``'s table.
+    """
+    wins = threat_cells(mine, theirs)
+    if wins:
+        return (wins & -wins).bit_length() - 1, "win", 0
+    threats = threat_cells(theirs, mine)
+    if threats & (threats - 1):  # two cells to block: lost whatever we do; block one
+        return (threats & -threats).bit_length() - 1, "loss", 0
+    candidates = [threats] if threats else ordered_moves(mine, theirs)
+    nodes = 0
+    win_search = solver if win_budget is None else Solver()
+    win_search.nodes, win_search.budget = 0, win_budget
+    try:
+        for b in candidates:
+            if win_search.attacker_wins(mine | b, theirs, attacker_to_move=False):
+                return b.bit_length() - 1, "win", win_search.nodes
+    except OutOfBudget:
+        pass
+    nodes += win_search.nodes
+    solver.nodes, solver.budget = 0, None
+    for b in candidates:
+        if not solver.attacker_wins(theirs, mine | b, attacker_to_move=True):
+            return b.bit_length() - 1, "draw", nodes + solver.nodes
+    return candidates[0].bit_length() - 1, "loss", nodes + solver.nodes
+
+
+class StrongEngine:
+    """The engine that never loses (see the module docstring); one instance keeps its search table.
+
+    ``book=None`` loads the packaged opening book; pass ``Book.empty()`` to
+    search every move (slow for the first few marks).
+    """
+
+    name = "strong"
+
+    def __init__(self, book: Book | None = None, win_budget: int = WIN_BUDGET_NODES,
+                 max_table_entries: int = 1_500_000) -> None:
+        self.book = load_book() if book is None else book
+        self.win_budget = win_budget
+        self.solver = Solver(max_entries=max_table_entries)
+
+    def move(self, board: Board | str, symbol: Symbol) -> Move | GameOver:
+        """The engine's cell for ``symbol`` on ``board``, or why the game is over."""
+        result = self.analyse(board, symbol)
+        return result.move if isinstance(result, Analysis) else result
+
+    def analyse(self, board: Board | str, symbol: Symbol) -> Analysis | GameOver:
+        """Like :meth:`move`, with what the engine proved about the position."""
+        b, me, over = prepare(board, symbol)
+        if over is not None:
+            return over
+        mine, theirs = b.marks(me), b.marks(other(me))
+        wins = threat_cells(mine, theirs)
+        if wins:
+            return Analysis(Move(*cell_of((wins & -wins).bit_length() - 1)), "win", "win-now", 0)
+        if (mine | theirs).bit_count() <= self.book.max_stones:
+            key, sym = canonical(mine, theirs)
+            entry = self.book.get(key)
+            if entry is not None:
+                cell, outcome = entry
+                return Analysis(Move(*cell_of(SYMMETRIES[INVERSE[sym]][cell])), outcome, "book", 0)
+        cell, outcome, nodes = choose(self.solver, mine, theirs, self.win_budget)
+        return Analysis(Move(*cell_of(cell)), outcome, "search", nodes)
+
+
+def timed_move(engine: StrongEngine, board: Board | str, symbol: Symbol) -> tuple[Analysis | GameOver, float]:
+    """:meth:`StrongEngine.analyse` and its wall time in milliseconds."""
+    t0 = time.perf_counter()
+    result = engine.analyse(board, symbol)
+    return result, (time.perf_counter() - t0) * 1000.0

@@ -1,4 +1,4 @@
-"""docs/scenarios.md stays true: its worked example is the scenario file, its YAML loads,
+"""docs/scenarios.md stays true: its worked example is the scenario file, every YAML example loads,
 its Python runs, and it lists every scenario file of tests/scenarios."""
 
 from __future__ import annotations
@@ -14,10 +14,13 @@ DOC = (ROOT / "docs" / "scenarios.md").read_text(encoding="utf-8")
 SCENARIOS = ROOT / "tests" / "scenarios"
 
 
-def test_the_worked_example_is_the_scenario_file() -> None:
-    (example,) = re.findall(r"```yaml\n(.*?)```", DOC, re.S)
+def test_the_worked_example_is_the_scenario_file_and_every_example_loads() -> None:
+    example, *others = re.findall(r"```yaml\n(.*?)```", DOC, re.S)
     assert example == (SCENARIOS / "drive_1_turns_back_at_a_hard_stop.yaml").read_text(encoding="utf-8")
     assert load_scenario_text(example, "docs/scenarios.md").name == "drive 1 turns back at a hard stop"
+    assert others, "the bare-chart example"
+    for text in others:
+        load_scenario_text(text, "docs/scenarios.md")
 
 
 def test_every_step_kind_and_scenario_file_is_documented() -> None:

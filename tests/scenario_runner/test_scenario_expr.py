@@ -103,7 +103,10 @@ def test_and_or_short_circuit() -> None:
     ("5 furlongs", "unknown unit 'furlongs'", 3),
     ("DriveInit1.", "expected a datum or state name", 12),
     ("and 1", "'and' needs something before it", 1),
-    ("__import__('os')", "unexpected character", 12),
+    ("__import__('os')", "unknown function '__import__'", 1),
+    ("C.message == 'You win.", "unexpected character \"'\" (text in quotes ends with the quote it starts"
+                               " with)", 14),
+    ('"a\' == 1', "text in quotes ends with the quote it starts with", 1),
 ])
 def test_syntax_errors_name_the_column(text: str, message: str, column: int) -> None:
     with pytest.raises(ExprError) as info:
@@ -113,10 +116,27 @@ def test_syntax_errors_name_the_column(text: str, message: str, column: int) -> 
 
 
 def test_nothing_is_executed() -> None:
-    # Attribute access beyond Chart.name, calls of anything but the listed functions, strings: refused.
-    for text in ("C.x.y", "open(1)", "C.__class__()", "'a' == 'a'", "[1][0]"):
+    # Attribute access beyond Chart.name, calls of anything but the listed functions, indexing text: refused.
+    for text in ("C.x.y", "open(1)", "C.__class__()", "'a'.upper()", "'a'[0]", "[1][0]", "'os'()"):
         with pytest.raises(ExprError):
             parse(text)
+
+
+def test_text_in_quotes_is_a_constant_compared_with_text_data() -> None:
+    message = "The manipulator is drawing."
+
+    def ev_text(text: str) -> object:
+        return parse(text).evaluate(lambda ref: {"Game.message": message}[str(ref)])
+    assert ev_text('Game.message == "The manipulator is drawing."') is True
+    assert ev_text("Game.message == 'The manipulator is drawing.'") is True
+    assert ev_text('Game.message != "The manipulator is drawing"') is True  # exact: the full stop counts
+    assert ev_text("'Draw: the board is full.' == \"Draw: the board is full.\"") is True
+    assert ev_text("'' == \"\"") is True
+    assert parse("Game.message == 'and or not 1 + C.x'").refs == (Ref("Game", "message", None, 1),)
+    with pytest.raises(ExprError, match="cannot compare"):
+        ev_text("Game.message < 1")
+    with pytest.raises(ExprError, match="cannot compute '-'"):
+        ev_text("-Game.message")
 
 
 def test_runtime_errors_are_expr_errors() -> None:

@@ -14,14 +14,16 @@ Grammar (lowest precedence first)::
     sum     := product (("+" | "-") product)*
     product := unary (("*" | "/") unary)*
     unary   := "-" unary | atom
-    atom    := NUMBER [UNIT] | "true" | "false" | "(" expr ")"
+    atom    := NUMBER [UNIT] | TEXT | "true" | "false" | "(" expr ")"
              | FUNCTION "(" expr ("," expr)* ")"  # abs, min, max
              | NAME "." NAME                      # a chart datum or state: DriveInit1.stop
              | NAME ["[" INTEGER "]"]             # a signal: t, q_true[1]
 
 Values are in SI units, as the charts and signals hold them; a number may
 carry a unit that converts it: ``170deg`` (or ``170 deg``), ``20mm``, ``5ms``
-(``rad``, ``m``, ``s`` change nothing).  Vector signals are numbered from 1,
+(``rad``, ``m``, ``s`` change nothing).  Text in quotes (``"You win."`` or
+``'You win.'``, no escapes) is compared with a chart's text data, such as the
+game's GUI message.  Vector signals are numbered from 1,
 as the thesis numbers joints and drives: ``q_true[1]`` is q1.
 
 It is the language of the debugger's ``break when`` conditions
@@ -44,7 +46,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["FUNCTIONS", "UNITS", "Expression", "ExprError", "Ref", "parse"]
+__all__ = ["FUNCTIONS", "KEYWORDS", "UNITS", "Expression", "ExprError", "Ref", "parse"]
 
 
 class ExprError(ValueError):
@@ -87,19 +89,23 @@ UNITS: dict[str, float] = {"deg": math.pi / 180, "rad": 1.0, "mm": 1e-3, "m": 1.
 _COMPARE = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
             ">": operator.gt, ">=": operator.ge}
 _ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv}
-_KEYWORDS = {"and", "or", "not", "true", "false", "True", "False"}
+#: Words of the language itself: no chart may be named so.
+KEYWORDS = frozenset({"and", "or", "not", "true", "false", "True", "False"})
 _TOKEN = re.compile(r"""
     (?P<space>\s+)
+  | (?P<text>"[^"]*"|'[^']*')
   | (?P<number>(?:\d+\.\d*|\.\d+|\d+)(?:[eE][+-]?\d+)?)
   | (?P<name>[A-Za-z_][A-Za-z_0-9]*)
   | (?P<op>==|!=|<=|>=|<|>|\+|-|\*|/|\(|\)|\[|\]|\.|,)
 """, re.VERBOSE)
-_HINTS = {"=": "use == to compare", "&": "use 'and'", "|": "use 'or'", "!": "use 'not' (or != to compare)"}
+_UNCLOSED = "text in quotes ends with the quote it starts with"
+_HINTS = {"=": "use == to compare", "&": "use 'and'", "|": "use 'or'", "!": "use 'not' (or != to compare)",
+          '"': _UNCLOSED, "'": _UNCLOSED}
 
 
 @dataclass(frozen=True)
 class _Tok:
-    kind: str  # number, name, op, end
+    kind: str  # number, text, name, op, end
     text: str
     column: int  # 1-based
 
@@ -218,9 +224,12 @@ class _Parser:
             if unit.kind == "name" and unit.text in UNITS:
                 self.pos += 1
                 value = value * UNITS[unit.text]
-            elif unit.kind == "name" and unit.text not in _KEYWORDS:
+            elif unit.kind == "name" and unit.text not in KEYWORDS:
                 raise self.error(f"unknown unit {unit.text!r}; units: {', '.join(UNITS)}", unit)
             return ("const", value)
+        if tok.kind == "text":
+            self.pos += 1
+            return ("const", tok.text[1:-1])
         if self.take("("):
             node = self.parse_or()
             self.expect(")", "')'")
@@ -233,7 +242,7 @@ class _Parser:
             return ("const", True)
         if tok.text in ("false", "False"):
             return ("const", False)
-        if tok.text in _KEYWORDS:
+        if tok.text in KEYWORDS:
             raise self.error(f"{tok.text!r} needs something before it", tok)
         if self.tok.text == "(" and self.tok.kind == "op":
             return self.parse_call(tok)
@@ -281,7 +290,13 @@ def _compile(node: Node, get: Callable[[Ref], Callable[[], Any]], text: str) -> 
         return get(node[1])
     if kind == "neg":
         f = _compile(node[1], get, text)
-        return lambda: -f()
+
+        def neg() -> Any:
+            try:
+                return -f()
+            except TypeError as exc:
+                raise ExprError(f"cannot compute '-': {exc}", text) from None
+        return neg
     if kind == "not":
         f = _compile(node[1], get, text)
         return lambda: not f()

@@ -5,19 +5,27 @@ an unknown step kind, chart, state, datum, event or signal (with the names
 there are, and a guess at what was meant), a value of the wrong type, a missing
 ``timeout_s``, a condition that does not parse.  Nothing runs before the whole
 file is known to be right.
+
+A scenario with ``chart: Name`` or ``charts: [A, B]`` (or ``charts: {a: A, b: A}``,
+instances named by the scenario) runs those charts alone
+(bare-chart mode): its steps may name only them, read only ``t`` of the
+signals, and neither pose an arm (``start``) nor force inputs (nothing feeds
+them).
 """
 
 from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from ..runtime import TickChart
 from .errors import ScenarioError
-from .expr import ExprError, Expression, parse
+from .expr import KEYWORDS, ExprError, Expression, parse
 from .model import (
+    BareCharts,
     Catalog,
     ChartRef,
     ExpectStatesStep,
@@ -37,7 +45,7 @@ from .model import (
 )
 from .source import MarkedDict, MarkedList, load_yaml, load_yaml_file
 
-TOP_KEYS = ("name", "description", "seed", "start", "steps")
+TOP_KEYS = ("name", "description", "chart", "charts", "seed", "start", "steps")
 #: Step kinds, and the extra keys each allows beside its own.
 STEP_OPTIONS: dict[str, tuple[str, ...]] = {
     "set": ("force",),
@@ -50,6 +58,8 @@ STEP_OPTIONS: dict[str, tuple[str, ...]] = {
     "mark": (),
 }
 MATCH_MODES = ("subsequence", "exact")
+#: The signals a bare-chart scenario may read: the chart time, s.
+BARE_SIGNALS: Mapping[str, int | None] = {"t": None}
 
 
 def _guess(word: object, options: Iterable[str]) -> str:
@@ -60,6 +70,8 @@ def _guess(word: object, options: Iterable[str]) -> str:
 def _type_name(value: Any) -> str:
     if value is None:
         return "nothing"
+    if isinstance(value, (list, dict)) and not value:
+        return f"an empty {'list' if isinstance(value, list) else 'mapping'}"
     if isinstance(value, bool):
         return f"boolean {str(value).lower()}"
     if isinstance(value, (int, float)):
@@ -83,6 +95,22 @@ class _Checker:
     def __init__(self, file: str, catalog: Catalog) -> None:
         self.file = file
         self.catalog = catalog
+        self.bare: BareCharts | None = None
+        #: The charts the steps may name: the robot's, or the bare ones.
+        robot = catalog.robot_charts
+        self.charts: Mapping[str, type[TickChart]] = {
+            name: cls for name, cls in catalog.charts.items() if robot is None or name in robot}
+
+    @property
+    def signals(self) -> Mapping[str, int | None]:
+        """The signals a condition may read: the robot's, or in bare-chart mode only ``t``."""
+        return BARE_SIGNALS if self.bare is not None else self.catalog.signals
+
+    @property
+    def bare_mode(self) -> str:
+        """How messages name the mode: ``this bare-chart scenario (line 2) runs only Game``."""
+        assert self.bare is not None
+        return f"this bare-chart scenario (line {self.bare.where.line}) runs only {self.bare}"
 
     def error(self, line: int, message: str) -> ScenarioError:
         return ScenarioError(self.file, line, message)
@@ -104,6 +132,12 @@ class _Checker:
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise self.error(doc.line_of("seed"),
                              f"seed: expected a whole number >= 0, got {_type_name(seed)}")
+        self.bare = self.bare_charts(doc)
+        if self.bare is not None:
+            self.charts = self.bare.charts
+            if "start" in doc:
+                raise self.error(doc.line_of("start"), f"start: {self.bare_mode}, without the arm: there is"
+                                                       " no pose to start from")
         start = self.start(doc["start"], doc.line_of("start")) if "start" in doc else Start()
         steps_data = doc["steps"]
         if not isinstance(steps_data, MarkedList) or not steps_data:
@@ -111,7 +145,48 @@ class _Checker:
         steps = tuple(self.step(item, line) for item, line in zip(steps_data, steps_data.item_lines,
                                                                       strict=True))
         return Scenario(name=name, file=self.file, steps=steps, description=description, seed=seed,
-                        start=start, where=Where(self.file, doc.line))
+                        start=start, where=Where(self.file, doc.line), bare=self.bare)
+
+    def bare_charts(self, doc: MarkedDict) -> BareCharts | None:
+        """The charts to run alone, or None for the robot.
+
+        ``chart: Game``; ``charts: [AlgorithmActivator, Game]``; or, for several
+        instances of one chart, names of one's own: ``charts: {early: Game, late: Game}``.
+        """
+        given = [k for k in ("chart", "charts") if k in doc]
+        if not given:
+            return None
+        if len(given) == 2:
+            raise self.error(doc.line_of("charts"), "chart: and charts: exclude each other: one chart is"
+                                                    " chart: Name, several are charts: [A, B]")
+        key = given[0]
+        value, line = doc[key], doc.line_of(key)
+        pairs: list[tuple[Any, Any, int]]  # (name in the steps, chart class name, line)
+        if key == "chart" and isinstance(value, str):
+            pairs = [(value, value, line)]
+        elif key == "charts" and isinstance(value, MarkedList) and value:
+            pairs = [(n, n, n_line) for n, n_line in zip(value, value.item_lines, strict=True)]
+        elif key == "charts" and isinstance(value, MarkedDict) and value:
+            pairs = [(n, c, value.line_of(n)) for n, c in value.items()]
+        else:
+            raise self.error(line, f"{key}: expected a chart name like chart: Game, a list like charts:"
+                                   " [AlgorithmActivator, Game], or names of one's own like charts:"
+                                   f" {{early: Game, late: Game}}; got {_type_name(value)}")
+        known = self.catalog.charts
+        charts: dict[str, type[TickChart]] = {}
+        for name, chart, n_line in pairs:
+            if not isinstance(chart, str) or chart not in known:
+                raise self.error(n_line, f"{key}: unknown chart {chart!r}{_guess(chart, known)};"
+                                         f" charts: {', '.join(known)}")
+            if not isinstance(name, str) or not name.isidentifier() or name in KEYWORDS:
+                raise self.error(n_line, f"charts: {name!r} cannot name a chart in a condition: use letters,"
+                                         " digits and _")
+            if name in known and name != chart:
+                raise self.error(n_line, f"charts: {name} is the name of a chart: name the {chart} otherwise")
+            if name in charts:
+                raise self.error(n_line, f"charts: {name} is listed twice")
+            charts[name] = known[chart]
+        return BareCharts(charts, Where(self.file, line))
 
     def keys(self, mapping: MarkedDict, allowed: Iterable[str], what: str) -> None:
         allowed = tuple(allowed)
@@ -177,12 +252,15 @@ class _Checker:
             raise self.error(line, "set: expected a mapping like {DriveInit1.stop: true}, got "
                                    f"{_type_name(value)}")
         force = item.get("force", False)
+        if self.bare is not None and "force" in item:
+            raise self.error(item.line_of("force"), f"force: {self.bare_mode}: nothing feeds the charts' inputs,"
+                                                    " so a set value stays until the next set; remove force:")
         if not isinstance(force, bool):
             raise self.error(item.line_of("force"), f"force: expected true or false, got {_type_name(force)}")
         values = []
         for key, v in value.items():
             ref = self.chart_ref(key, value.key_lines[key], "set", want="input")
-            decl = next(d for d in self.catalog.charts[ref.chart].declarations() if d.name == ref.name)
+            decl = next(d for d in self.charts[ref.chart].declarations() if d.name == ref.name)
             default = decl.default
             if isinstance(default, bool) and not isinstance(v, bool):
                 raise self.error(value.line_of(key), f"set: {ref} is a flag: expected true or false,"
@@ -194,6 +272,9 @@ class _Checker:
         return SetStep(where, tuple(values), force)
 
     def step_release(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        if self.bare is not None:
+            raise self.error(where.line, f"release: {self.bare_mode}: nothing feeds the charts' inputs, so none is"
+                                         " forced and there is nothing to release")
         names = value if isinstance(value, list) else [value]
         lines = value.item_lines if isinstance(value, MarkedList) else [line]
         if not names:
@@ -212,7 +293,7 @@ class _Checker:
                 raise self.error(value.line, f"post: missing {key}:")
         chart = self.chart_name(value["chart"], value.line_of("chart"), "post")
         event = value["event"]
-        events = self.catalog.charts[chart].structure().user_events
+        events = self.charts[chart].structure().user_events
         if event not in events:
             listed = ", ".join(events) or "(none: all its transitions are tick transitions)"
             raise self.error(value.line_of("event"), f"post: {chart} handles no event {event!r}"
@@ -292,7 +373,7 @@ class _Checker:
         if not isinstance(seq, MarkedList) or not seq:
             raise self.error(value.line_of("sequence"), "expect_states: sequence expected a list of state"
                                                         f" names, got {_type_name(seq)}")
-        states = chart_states(self.catalog.charts[chart])
+        states = chart_states(self.charts[chart])
         for name, n_line in zip(seq, seq.item_lines, strict=True):
             self.state_name(chart, name, n_line, "expect_states", states)
             if match == "exact" and states[name] == "compound":
@@ -309,7 +390,13 @@ class _Checker:
     # -- names -------------------------------------------------------------------------
 
     def chart_name(self, name: Any, line: int, what: str) -> str:
-        charts = self.catalog.charts
+        charts = self.charts
+        if isinstance(name, str) and name in self.catalog.charts and name not in charts:
+            if self.bare is not None:
+                raise self.error(line, f"{what}: {name} is not run: {self.bare_mode}")
+            raise self.error(line, f"{what}: {name} is not part of the simulated robot (its charts:"
+                                   f" {', '.join(charts)}); run it alone: put 'chart: {name}' at the top"
+                                   " of the file")
         if not isinstance(name, str) or name not in charts:
             raise self.error(line, f"{what}: unknown chart {name!r}{_guess(name, charts)};"
                                    f" charts: {', '.join(charts)}")
@@ -317,7 +404,7 @@ class _Checker:
 
     def state_name(self, chart: str, name: Any, line: int, what: str,
                    states: dict[str, str] | None = None) -> str:
-        states = states if states is not None else chart_states(self.catalog.charts[chart])
+        states = states if states is not None else chart_states(self.charts[chart])
         if not isinstance(name, str) or name not in states:
             real = [s for s, k in states.items() if k != "history"]
             raise self.error(line, f"{what}: {chart} has no state {name!r}{_guess(name, real)};"
@@ -334,7 +421,7 @@ class _Checker:
             raise self.error(line, f"{what}: expected Chart.{want} like {example}, got {_type_name(text)}")
         chart, name = text.split(".")
         self.chart_name(chart, line, what)
-        cls = self.catalog.charts[chart]
+        cls = self.charts[chart]
         if want == "state":
             self.state_name(chart, name, line, what)
             return ChartRef(chart, name)
@@ -361,7 +448,7 @@ class _Checker:
         at = f" in {expr.text!r}"
         if ref.chart is not None:
             self.chart_name(ref.chart, line, what)
-            cls = self.catalog.charts[ref.chart]
+            cls = self.charts[ref.chart]
             data, states = chart_data(cls), chart_states(cls)
             if ref.name in states and states[ref.name] == "history":
                 raise self.error(line, f"{what}: {ref.chart}.{ref.name} is a history pseudo-state, never"
@@ -373,7 +460,11 @@ class _Checker:
             if ref.index is not None:
                 raise self.error(line, f"{what}: {ref.chart}.{ref.name} is not a list: no [{ref.index}]{at}")
             return
-        signals = self.catalog.signals
+        signals = self.signals
+        if self.bare is not None and ref.name not in signals and ref.name in self.catalog.signals:
+            raise self.error(line, f"{what}: {ref.name} is a signal of the simulated arm; {self.bare_mode},"
+                                   f" without the arm: a condition reads the charts' data and states, and"
+                                   f" t (chart time){at}")
         if ref.name not in signals:
             raise self.error(line, f"{what}: unknown name {ref.name!r}{_guess(ref.name, signals)}{at};"
                                    f" a chart datum is Chart.name; signals: {', '.join(signals)}")

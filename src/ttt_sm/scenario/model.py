@@ -2,7 +2,9 @@
 
 A :class:`Catalog` says what a scenario may name: the charts (by the name the
 robot knows them by), their states, data and events, and the robot's signals.
-The loader checks every name against it before anything runs.
+The loader checks every name against it before anything runs.  A scenario in
+bare-chart mode (:class:`BareCharts`) may name only its own charts, and of the
+signals only ``t``, the chart time.
 """
 
 from __future__ import annotations
@@ -158,8 +160,24 @@ class Start:
 
 
 @dataclass(frozen=True)
+class BareCharts:
+    """Bare-chart mode (``chart:`` or ``charts:``): only these charts, ticked together, no robot.
+
+    ``charts`` maps the names the steps use (a chart's class name, or one the
+    scenario chose for one of several instances) to the chart classes it was
+    checked against; ``where`` is the line of ``chart:`` / ``charts:``.
+    """
+
+    charts: Mapping[str, type[TickChart]]
+    where: Where
+
+    def __str__(self) -> str:
+        return ", ".join(n if n == c.__name__ else f"{n} ({c.__name__})" for n, c in self.charts.items())
+
+
+@dataclass(frozen=True)
 class Scenario:
-    """A loaded, checked scenario file."""
+    """A loaded, checked scenario file; ``bare`` is set for a bare-chart scenario."""
 
     name: str
     file: str
@@ -168,21 +186,33 @@ class Scenario:
     seed: int = 0
     start: Start = Start()
     where: Where | None = None
+    bare: BareCharts | None = None
 
 
 @dataclass(frozen=True)
 class Catalog:
-    """What scenarios may name: charts by name, and the robot's signals."""
+    """What scenarios may name: charts by name, and the robot's signals.
+
+    ``robot_charts`` names the charts the robot holds (None: all of them); the
+    others can only run bare (``chart: Game``).
+    """
 
     charts: Mapping[str, type[TickChart]]
     signals: Mapping[str, int | None]
+    robot_charts: tuple[str, ...] | None = None
 
     @classmethod
     def default(cls) -> Catalog:
-        """The project's charts (named by class, as :class:`~ttt_sm.app.robot.Robot` names them)."""
-        from ..charts import ALL_CHARTS
+        """The project's charts (named by class, as :class:`~ttt_sm.app.robot.Robot` names them).
 
-        return cls({c.__name__: c for c in ALL_CHARTS}, SIGNALS)
+        The robot holds the drive-initialisation charts and Control; the game's
+        charts (AlgorithmActivator, Game) are added by the game session, so a
+        scenario runs them bare.
+        """
+        from ..charts import ALL_CHARTS, INIT_CHARTS, Control
+
+        robot = tuple(c.__name__ for c in (*INIT_CHARTS, Control))
+        return cls({c.__name__: c for c in ALL_CHARTS}, SIGNALS, robot)
 
     def chart(self, name: str) -> type[TickChart] | None:
         return self.charts.get(name)

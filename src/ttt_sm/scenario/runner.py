@@ -10,6 +10,10 @@ A failed expectation is recorded and the scenario goes on, so one run shows
 every wrong expectation.  A step that leaves the robot somewhere the next steps
 do not expect stops the scenario: a ``run_until`` that times out, an input set
 without ``force`` that the wiring overwrote, an error raised by a chart.
+
+A bare-chart scenario (``chart: Game``) runs on :class:`ChartsOnly` instead:
+its charts alone, ticked together at the arm's chart rate; nothing feeds their
+inputs, so a value set stays until the scenario sets another.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ from ..runtime import TickChart, states_entered_by
 from ..runtime.listeners import Coverage
 from .expr import ExprError, Expression, Ref
 from .model import (
+    BareCharts,
     ChartRef,
     ExpectStatesStep,
     ExpectStep,
@@ -65,8 +70,65 @@ class RobotLike(Protocol):
 RobotFactory = Callable[[Scenario, ArmParams, Sequence[object]], RobotLike]
 
 
+class ChartsOnly:
+    """The charts of a bare-chart scenario, ticked together: what the runner needs of a robot, no arm.
+
+    Each chart is built with the arm's chart period (``params.control.chart_dt``)
+    and ticked once per chart step, in the order the scenario lists them; ``t``
+    is the chart time.  Nothing feeds their inputs: a value set stays.
+    """
+
+    def __init__(self, bare: BareCharts, params: ArmParams, listeners: Sequence[object]) -> None:
+        self.params = params
+        self.chart_dt = params.control.chart_dt
+        self.charts: dict[str, TickChart] = {
+            name: cls(tick_period_s=self.chart_dt, chart_name=name, listeners=list(listeners))
+            for name, cls in bare.charts.items()
+        }
+        self.ticks = 0
+
+    @property
+    def t(self) -> float:
+        """Chart time, s."""
+        return self.ticks * self.chart_dt
+
+    def chart(self, name: str) -> TickChart:
+        return self.charts[name]
+
+    def run_until(self, predicate: Callable[[], bool], timeout_s: float) -> bool:
+        """Tick every chart until `predicate()` holds (checked after each step); False on timeout."""
+        charts = tuple(self.charts.values())
+        for _ in range(int(round(timeout_s / self.chart_dt))):
+            for chart in charts:
+                chart.tick()
+            self.ticks += 1
+            if predicate():
+                return True
+        return False
+
+    def set_input(self, chart: str, name: str, value: Any, force: bool = False) -> None:
+        self.charts[chart].set_inputs(**{name: value})
+
+    def release(self, chart: str, name: str) -> None:
+        """Nothing is forced: nothing feeds the inputs (the loader refuses ``release``)."""
+
+    def post(self, chart: str, event: str, **data: Any) -> None:
+        self.charts[chart].post(event, **data)
+
+    def value(self, chart: str, name: str) -> Any:
+        return getattr(self.charts[chart], name)
+
+    def active(self, chart: str) -> set[str]:
+        return set(self.charts[chart].configuration_values)
+
+    def signal_values(self) -> dict[str, Any]:
+        return {"t": self.t}
+
+
 def default_robot(scenario: Scenario, params: ArmParams, listeners: Sequence[object]) -> RobotLike:
-    """The simulated robot at the scenario's power-on pose."""
+    """The simulated robot at the scenario's power-on pose; the charts alone in bare-chart mode."""
+    if scenario.bare is not None:
+        return ChartsOnly(scenario.bare, params, listeners)
     from ..app.robot import Robot
 
     q = [math.radians(v) for v in scenario.start.q_deg] if scenario.start.q_deg is not None else None
@@ -187,6 +249,7 @@ class _Run:
         self.mark: dict[str, int] = {name: 0 for name in robot.charts}  # the initial states count
         self.mark_label = "the start"
         self.pending_sets: list[tuple[SetStep, ChartRef, Any]] = []
+        self.inputs_fed = scenario.bare is None  # the wiring feeds some inputs; bare charts' only the steps
         self.steps_run = 0
 
     # -- running -----------------------------------------------------------------------
@@ -272,7 +335,7 @@ class _Run:
     def do_set(self, step: SetStep) -> None:
         for ref, value in step.values:
             self.robot.set_input(ref.chart, ref.name, value, force=step.force)
-            if not step.force:
+            if self.inputs_fed and not step.force:
                 self.pending_sets.append((step, ref, value))
 
     def do_release(self, step: ReleaseStep) -> None:
@@ -400,7 +463,8 @@ def run_scenario(scenario: Scenario, params: ArmParams, *, coverage: Coverage | 
     listeners : sequence
         More python-statemachine listeners for the charts (a :class:`Trace` ...).
     robot_factory : callable, optional
-        Builds the robot (tests use a stand-in); the simulated arm by default.
+        Builds the robot (tests use a stand-in); by default the simulated arm, or
+        for a bare-chart scenario its charts alone (:class:`ChartsOnly`).
     """
     wall0 = time.perf_counter()
     start_where = scenario.start.where or scenario.where or Where(scenario.file, 0)

@@ -41,10 +41,10 @@ def overlay(image: np.ndarray, detection: Detection) -> np.ndarray:
         ch, pct = detection.cells[k], detection.percentages[k]
         colour = EMPTY_BGR if ch == "." else OCCUPIED_BGR
         label = f"{ch} {pct:.0f}"
-        (w, h), _ = cv2.getTextSize(label, cv2.FONT_HERSHEY_SIMPLEX, 0.35, 1)
+        (w, h), _ = cv2.getTextSize(label, cv2.FONT_HERSHEY_SIMPLEX, 0.42, 1)
         org = (int(u - w / 2), int(v + h / 2))
-        cv2.putText(out, label, org, cv2.FONT_HERSHEY_SIMPLEX, 0.35, (255, 255, 255), 3, cv2.LINE_AA)
-        cv2.putText(out, label, org, cv2.FONT_HERSHEY_SIMPLEX, 0.35, colour, 1, cv2.LINE_AA)
+        cv2.putText(out, label, org, cv2.FONT_HERSHEY_SIMPLEX, 0.42, (255, 255, 255), 3, cv2.LINE_AA)
+        cv2.putText(out, label, org, cv2.FONT_HERSHEY_SIMPLEX, 0.42, colour, 1, cv2.LINE_AA)
     return out
 
 

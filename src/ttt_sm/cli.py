@@ -18,8 +18,11 @@ from typing import Any
 import numpy as np
 
 from .debug.cli import register as register_debug
+from .game.cli import register as register_ai
 from .params import ParameterError, load_params
 from .scenario.cli import register as register_scenario
+from .seriallink.cli import register as register_camera
+from .vision.cli import register as register_vision
 
 
 class CliError(Exception):
@@ -52,13 +55,41 @@ def _jsonable(obj: Any) -> Any:
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
 
 
-def cmd_play(args: argparse.Namespace) -> int:
+def cmd_demo(args: argparse.Namespace) -> int:
     from .app.play import run_play
 
     params = load_params(args.params)
     result = run_play(params, seed=args.seed, out_dir=Path(args.out), progress=_progress(True))
     lines = [f"  {k}: {v}" for k, v in result.items() if k != "drawings"]
-    _emit(result, args.json, "play:\n" + "\n".join(lines))
+    _emit(result, args.json, "demo:\n" + "\n".join(lines))
+    return 0
+
+
+def cmd_play(args: argparse.Namespace) -> int:
+    from .app.game import GameError, GameSession, SimulatedPerson, TerminalPerson
+
+    params = load_params(args.params)
+    say = _progress(True)
+    opponent = args.opponent
+    if opponent == "auto":
+        opponent = "terminal" if sys.stdin.isatty() and not args.json else "simulated"
+    person = TerminalPerson() if opponent == "terminal" else SimulatedPerson(args.seed, say)
+    say(f"ttt-sm play: the robot plays {args.robot_symbol} ({args.engine} engine) against a "
+        f"{'person at this terminal' if opponent == 'terminal' else 'simulated person'}; "
+        f"camera {'behind a serial port' if args.camera == 'serial' else 'read directly'}")
+    session = GameSession(params, seed=args.seed, robot_symbol=args.robot_symbol, person=person,
+                          engine=args.engine, camera=args.camera, progress=say)
+    try:
+        report = session.play()
+        files = session.save(Path(args.out))
+    except GameError as exc:
+        raise CliError(str(exc)) from exc
+    finally:
+        session.close()
+    report.update(files)
+    report["opponent"] = opponent
+    lines = [f"  {k}: {v}" for k, v in report.items() if k not in ("moves", "camera_link")]
+    _emit(report, args.json, "play:\n" + "\n".join(lines))
     return 0
 
 
@@ -182,8 +213,16 @@ def build_parser() -> argparse.ArgumentParser:
         sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
         return sp
 
-    sp = add("play", cmd_play, "run the main job: initialise, draw the field, an X and an O, erase, finish")
-    sp.add_argument("--out", default="out/play", help="folder for the board PNGs (default out/play)")
+    sp = add("play", cmd_play, "the main job: the robot initialises, draws the field and plays a game against you")
+    sp.add_argument("--opponent", choices=["auto", "terminal", "simulated"], default="auto",
+                    help="auto (default): the terminal when standard input is one, else a simulated person")
+    sp.add_argument("--robot-symbol", choices=["X", "O"], default="O", help="the robot's symbol; X starts")
+    sp.add_argument("--engine", choices=["strong", "thesis"], default="strong", help="the game algorithm")
+    sp.add_argument("--camera", choices=["serial", "direct"], default="serial",
+                    help="serial (default): the smart camera emulated on a pseudo-terminal; direct: in-process")
+    sp.add_argument("--out", default="out/play", help="folder for the game record and the board PNG")
+    sp = add("demo", cmd_demo, "initialise, draw the field, an X and an O, erase, finish (no game)")
+    sp.add_argument("--out", default="out/demo", help="folder for the board PNGs (default out/demo)")
     sp = add("draw", cmd_draw, "draw one thing with the Control chart and measure its precision (thesis 3.5)")
     sp.add_argument("kind", choices=["field", "X", "O", "sine"])
     sp.add_argument("--row", type=int, default=3, help="cell row 1..5 for X and O (default 3)")
@@ -212,6 +251,9 @@ def build_parser() -> argparse.ArgumentParser:
     add("params", cmd_params, "print the parameters in force (SI units)")
     register_scenario(sub)
     register_debug(sub)
+    register_camera(sub)
+    register_vision(sub)
+    register_ai(sub)
     return p
 
 

@@ -1,0 +1,116 @@
+"""The game's eyes: the simulated camera, the detector, and (optionally) the serial link.
+
+Two ways to get the 25 per-cell percentages of the board (thesis 3.6.3):
+
+- ``direct``: photograph the simulated whiteboard and detect in-process;
+- ``serial``: the smart camera is emulated on a real pseudo-terminal
+  (:class:`ttt_sm.seriallink.CameraEmulator`), photographing and detecting
+  in its own thread, and the game reads the frames through pyserial
+  (:class:`ttt_sm.seriallink.SerialCameraReader`), as the thesis' PC did.
+
+The simulation and the camera thread share the whiteboard: the camera only
+photographs while the simulation is paused (a lock), and a reading taken for
+a decision is always a frame photographed after the last change.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from ..params import ArmParams
+from ..twin.whiteboard import Whiteboard
+from ..vision import Detection, board_text, board_values, detect
+from ..vision.simulated import SimulatedCamera
+
+
+class CameraLink:
+    """Per-cell percentages of the board, in board order, from a photo taken now."""
+
+    def __init__(self, params: ArmParams, board: Whiteboard, seed: int = 0, mode: str = "serial",
+                 rate_hz: float = 50.0) -> None:
+        if mode not in ("direct", "serial"):
+            raise ValueError(f"camera mode must be 'direct' or 'serial', got {mode!r}")
+        self.mode = mode
+        self.camera = SimulatedCamera(board, params, seed=seed)
+        self.view = self.camera.view()
+        self.lock = threading.Lock()
+        self.lock.acquire()  # held by the simulation; released only while reading
+        self.last_symbols: str | None = None
+        self.read_wall_s = 0.0  # wall time spent waiting for photos
+        self._closing = False
+        self._last_percentages: list[float] = [0.0] * 25
+        self._emulator: Any = None
+        self._reader: Any = None
+        self._tmp: tempfile.TemporaryDirectory[str] | None = None
+        if mode == "serial":
+            self._start_serial(rate_hz)
+
+    def _start_serial(self, rate_hz: float) -> None:
+        from ..seriallink import CameraEmulator, SerialCameraReader
+
+        def source() -> list[float]:
+            with self.lock:  # never photograph a board the simulation is writing
+                if self._closing:
+                    return list(self._last_percentages)
+                d = detect(self.camera.frame())
+            self.last_symbols = d.cells
+            self._last_percentages = [float(p) for p in d.percentages]
+            return self._last_percentages
+
+        self._tmp = tempfile.TemporaryDirectory(prefix="ttt_sm_camera_")
+        self._emulator = CameraEmulator(source, rate_hz=rate_hz, link=Path(self._tmp.name) / "camera").start()
+        self._reader = SerialCameraReader(self._emulator.port, 5.0)
+
+    @property
+    def port(self) -> str | None:
+        """The serial port the camera is read from (None in direct mode)."""
+        return self._emulator.port if self._emulator is not None else None
+
+    def read(self) -> tuple[tuple[float, ...], str | None]:
+        """(percentages in board order, symbols in board order or None) from a photo of the board as it is now."""
+        t0 = time.perf_counter()
+        try:
+            return self._read()
+        finally:
+            self.read_wall_s += time.perf_counter() - t0
+
+    def _read(self) -> tuple[tuple[float, ...], str | None]:
+        if self.mode == "direct":
+            d: Detection = detect(self.camera.frame())
+            return tuple(board_values(list(d.percentages), self.view)), board_text(d.cells, self.view)
+        self.lock.release()
+        try:
+            # The frame in flight may show the board before the last change: take the second.
+            self._reader.read_frame(5.0)
+            frame = self._reader.read_frame(5.0)
+            if frame is None:
+                raise TimeoutError("the camera sent no frame for 5 s")
+        finally:
+            self.lock.acquire()
+        symbols = board_text(self.last_symbols, self.view) if self.last_symbols else None
+        return tuple(board_values(list(frame.percentages), self.view)), symbols
+
+    def stats(self) -> dict[str, Any]:
+        """The serial link's counters (frames read, rejected, reconnects), or {} in direct mode."""
+        if self._reader is None:
+            return {}
+        from dataclasses import asdict, is_dataclass
+
+        s = self._reader.stats
+        return asdict(s) if is_dataclass(s) and not isinstance(s, type) else {}
+
+    def close(self) -> None:
+        """Stop the emulator and close the port."""
+        if self._reader is not None:
+            self._reader.close()
+        if self._emulator is not None:
+            self._closing = True  # the camera thread stops photographing ...
+            if self.lock.locked():
+                self.lock.release()  # ... and may finish the frame it was waiting to take
+            self._emulator.stop()
+        if self._tmp is not None:
+            self._tmp.cleanup()

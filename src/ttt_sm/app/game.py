@@ -1,0 +1,387 @@
+"""A whole game, person against robot (thesis section 3.6 and its Tic-tac-toe GUI, 3.7).
+
+The robot initialises, draws the field and plays: the person draws a
+symbol on the board (at the terminal: types a cell and the simulated hand
+draws it; or a simulated person), clicks Play (the AlgorithmActivator's
+trigger), the camera reports the 25 per-cell percentages (through the
+emulated smart camera on a pseudo-terminal by default), percent-process
+turns them into the person's moves, the game algorithm answers, and the
+Control chart draws the answer.  The Game chart shows the GUI's messages,
+announces the result, erases the board and turns the arm off.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from ..charts.game import AlgorithmActivator, Game
+from ..game.bitboard import FULL, bits, cell_index, cell_of, win_cells
+from ..game.rules import is_full, parse_board, winner
+from ..params import ArmParams
+from ..runtime.listeners import Trace
+from ..sched.scheduler import Signals
+from ..vision import MoveError, percent_process
+from .camera_link import CameraLink
+from .robot import Robot
+
+Cell = tuple[int, int]
+
+
+class GameError(RuntimeError):
+    """The game cannot go on (a chart did not finish its job in time, the camera went silent)."""
+
+
+class Person(Protocol):
+    """Who plays against the robot."""
+
+    def choose(self, board: str, symbol: str) -> Cell | None:
+        """A free cell to draw `symbol` in (1-based), or None to give up."""
+
+    def tell(self, message: str) -> None:
+        """Show the person a message (the Tic-tac-toe GUI's text box)."""
+
+
+def _masks(board: str) -> tuple[int, int]:
+    b = parse_board(board)
+    return b.marks("X"), b.marks("O")
+
+
+def result_of(board: str) -> str | None:
+    """'X' or 'O' for a win, 'draw' for a full board, None while the game is on."""
+    b = parse_board(board)
+    won = winner(b)
+    if won is not None:
+        return won
+    return "draw" if is_full(b) else None
+
+
+class SimulatedPerson:
+    """A person at the board: wins when one move wins, blocks when one move loses, else random."""
+
+    def __init__(self, seed: int = 0, say: Callable[[str], None] | None = None) -> None:
+        self.rng = np.random.default_rng(seed)
+        self.say = say
+
+    def choose(self, board: str, symbol: str) -> Cell | None:
+        x, o = _masks(board)
+        mine, theirs = (x, o) if symbol == "X" else (o, x)
+        empty = FULL & ~(x | o)
+        for mask in (win_cells(mine, theirs), win_cells(theirs, mine)):
+            if mask & empty:
+                return cell_of(bits(mask & empty)[0])
+        free = bits(empty)
+        return cell_of(int(self.rng.choice(free))) if free else None
+
+    def tell(self, message: str) -> None:
+        if self.say:
+            self.say(f"  [person] {message}")
+
+
+class TerminalPerson:
+    """The person at the terminal: types a cell ("2 3" = row 2, column 3); q gives up."""
+
+    def __init__(self, stdin: Any = None, stdout: Any = None) -> None:
+        self.stdin = stdin or sys.stdin
+        self.stdout = stdout or sys.stdout
+
+    def choose(self, board: str, symbol: str) -> Cell | None:
+        self.stdout.write(_board_picture(board) + "\n")
+        while True:
+            self.stdout.write(f"Your move ({symbol}): row column, e.g. 2 3 (q to give up): ")
+            self.stdout.flush()
+            line = self.stdin.readline()
+            if not line or line.strip().lower() in ("q", "quit"):
+                return None
+            parts = line.replace(",", " ").split()
+            if len(parts) == 2 and all(p.isdigit() for p in parts):
+                r, c = int(parts[0]), int(parts[1])
+                if 1 <= r <= 5 and 1 <= c <= 5 and board[cell_index(r, c)] == ".":
+                    return r, c
+                self.stdout.write(f"cell ({r}, {c}) is not a free cell of the 5x5 field\n")
+            else:
+                self.stdout.write(f"not a cell: {line.strip()!r}\n")
+
+    def tell(self, message: str) -> None:
+        self.stdout.write(message + "\n")
+        self.stdout.flush()
+
+
+def _board_picture(board: str) -> str:
+    rows = ["    1 2 3 4 5"]
+    for r in range(5):
+        rows.append(f"  {r + 1} " + " ".join(board[5 * r:5 * r + 5]))
+    return "\n".join(rows)
+
+
+@dataclass
+class GameRecord:
+    """What happened, for the JSON Lines record."""
+
+    events: list[dict[str, Any]] = field(default_factory=list)
+
+    def add(self, t: float, kind: str, **data: Any) -> None:
+        self.events.append({"t": round(t, 4), "event": kind, **data})
+
+
+class GameStage:
+    """Task stage before the Control chart: the Game and AlgorithmActivator charts and the engine."""
+
+    def __init__(self, session: GameSession) -> None:
+        self.s = session
+
+    def tick(self, signals: Signals) -> None:
+        s = self.s
+        r, c = s.robot, s.robot.control
+        active = c.configuration_values
+        ready = "wait_1" in active and bool(c.Pl_fld)
+        g = s.game
+        vars(g).update(initialised=r.initialised, ready=ready, busy="wait_1" not in active,
+                       result=s.result_code, erased=s.erased_seen, play_again=False,
+                       finished="finished" in active)
+        g.tick()
+        if g.erase and not r.control_stage.erase_requested and not s.erase_started:
+            r.control_stage.erase_requested = True
+            s.erase_started = True
+        if s.erase_started and not s.erased_seen and "Erase" not in active and not c.Pl_fld:
+            s.erased_seen = True
+        if g.finish:
+            c.finish = True
+        a = s.activator
+        a.o_pos = s.o_pos
+        a.tick()
+        if a.enable:
+            s.robot_turn_now()
+
+
+class GameSession:
+    """One game on the simulated robot."""
+
+    def __init__(self, params: ArmParams, seed: int = 0, robot_symbol: str = "O", person: Person | None = None,
+                 engine: str = "strong", camera: str = "serial", record_trace: bool = True,
+                 progress: Callable[[str], None] | None = None) -> None:
+        if robot_symbol not in ("X", "O"):
+            raise ValueError(f"robot symbol must be X or O, got {robot_symbol!r}")
+        setup0 = time.perf_counter()
+        self.params = params
+        self.say = progress or (lambda _m: None)
+        self.trace = Trace() if record_trace else None
+        listeners: list[object] = [self.trace] if self.trace else []
+        self.robot = Robot(params, seed=seed, listeners=listeners)
+        self.activator = AlgorithmActivator(tick_period_s=params.control.chart_dt, listeners=listeners)
+        self.game = Game(tick_period_s=params.control.chart_dt, listeners=listeners)
+        self.robot.charts.update({"AlgorithmActivator": self.activator, "Game": self.game})
+        self.robot.sched.task_stages.insert(0, GameStage(self))
+        self.robot_symbol = robot_symbol
+        self.person_symbol = "X" if robot_symbol == "O" else "O"
+        self.person = person or SimulatedPerson(seed, self.say)
+        self.engine = engine_for(engine)
+        self.camera = CameraLink(params, self.robot.board, seed=seed, mode=camera)
+        self.board = "." * 25  # what the robot believes: its moves and the person's detected moves
+        self.truth = "." * 25  # what is really drawn (the simulated person's hand is known)
+        self.robot_cells: list[Cell] = []
+        self.person_cells: list[Cell] = []
+        self.robot_ink: dict[Cell, float] = {}
+        self.o_pos = 0
+        self.result_code = 0
+        self.erase_started = False
+        self.erased_seen = False
+        self.pending_move: Cell | None = None
+        self.detections_correct = 0
+        self.detections_wrong = 0
+        self.record = GameRecord()
+        self.moves: list[dict[str, Any]] = []
+        self._last_message = ""
+        #: Building the twin (controller design, compiled kernels loaded), the charts and the camera.
+        self.setup_wall_s = time.perf_counter() - setup0
+
+    # -- the robot's move, from the AlgorithmActivator's enable pulse ---------------
+
+    def robot_turn_now(self) -> None:
+        """Ask the engine for a move and tell the Control chart to draw it."""
+        if result_of(self.board) is not None:
+            return
+        t0 = time.perf_counter()
+        row, column = self.engine(self.board, self.robot_symbol)
+        ms = (time.perf_counter() - t0) * 1e3
+        c = self.robot.control
+        c.row, c.column, c.symbol = row, column, 1 if self.robot_symbol == "X" else 0
+        self.robot.post("Control", "button")
+        self.pending_move = (row, column)
+        self.record.add(self.robot.t, "robot_move", row=row, column=column, think_ms=round(ms, 2))
+
+    # -- running -----------------------------------------------------------------------
+
+    def _run_until(self, predicate: Callable[[], bool], timeout_s: float, what: str) -> None:
+        def watch() -> bool:
+            msg = self.game.message
+            if msg != self._last_message:
+                self._last_message = msg
+                self.person.tell(msg)
+                self.record.add(self.robot.t, "message", text=msg)
+            return predicate()
+
+        if not self.robot.run_until(watch, timeout_s):
+            control, game = sorted(self.robot.active("Control")), sorted(self.robot.active("Game"))
+            raise GameError(f"{what} did not happen within {timeout_s:.0f} s of simulated time "
+                            f"(Control: {control}, Game: {game})")
+
+    def _waiting(self) -> bool:
+        c = self.robot.control
+        return "wait_1" in c.configuration_values and bool(c.Pl_fld)
+
+    def _place(self, cell: Cell, symbol: str, which: str) -> None:
+        i = cell_index(*cell)
+        self.truth = self.truth[:i] + symbol + self.truth[i + 1:]
+        if which == "board":
+            self.board = self.board[:i] + symbol + self.board[i + 1:]
+
+    def _set_board(self, cell: Cell, symbol: str) -> None:
+        i = cell_index(*cell)
+        self.board = self.board[:i] + symbol + self.board[i + 1:]
+
+    def _look(self) -> tuple[tuple[float, ...], str | None]:
+        return self.camera.read()
+
+    def play(self, max_moves: int = 25) -> dict[str, Any]:
+        """Play one game to its end (or until the person gives up); return the report."""
+        wall0 = time.perf_counter()
+        robot = self.robot
+        self.say("initialising, then drawing the field")
+        self._run_until(self._waiting, 300.0, "initialising and drawing the field")
+        self.record.add(robot.t, "field_drawn")
+        to_move = "X"
+        while result_of(self.board) is None and len(self.moves) < max_moves:
+            if to_move == self.person_symbol:
+                if not self._person_turn():
+                    break
+            else:
+                self._robot_turn()
+            to_move = "O" if to_move == "X" else "X"
+        outcome = result_of(self.board) or "abandoned"
+        self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3}.get(outcome, 3)
+        self.record.add(robot.t, "result", outcome=outcome)
+        self.say(f"result: {outcome}; erasing and turning off")
+        self._run_until(lambda: "off" in self.game.configuration_values, 600.0, "erasing and turning off")
+        wall = time.perf_counter() - wall0
+        ink_left = robot.board.ink_area_mm2()
+        winner = {self.robot_symbol: "robot", self.person_symbol: "person"}.get(outcome, outcome)
+        return {
+            "winner": winner,
+            "outcome": outcome,
+            "moves": self.moves,
+            "robot_symbol": self.robot_symbol,
+            "detections_correct": self.detections_correct,
+            "detections_wrong": self.detections_wrong,
+            "sim_time_s": round(robot.t, 3),
+            "wall_time_s": round(wall, 3),
+            "realtime_factor": round(robot.t / wall, 1),
+            "setup_wall_s": round(self.setup_wall_s, 3),
+            "erased": ink_left == 0.0,
+            "ink_left_mm2": round(ink_left, 3),
+            "camera": self.camera.mode,
+            "camera_link": self.camera.stats(),
+            "camera_wall_s": round(self.camera.read_wall_s, 3),
+            "ignored_play_clicks": self.activator.ignored_triggers,
+        }
+
+    def _click_play(self) -> None:
+        self.robot.post("AlgorithmActivator", "trigger")
+
+    def _person_turn(self) -> bool:
+        robot = self.robot
+        cell = self.person.choose(self.truth, self.person_symbol)
+        if cell is None:
+            self.record.add(robot.t, "person_gave_up")
+            return False
+        robot.board.draw_symbol(self.person_symbol, *cell)
+        self._place(cell, self.person_symbol, "truth")
+        self.record.add(robot.t, "person_drew", row=cell[0], column=cell[1])
+        percentages, symbols = self._look()
+        try:
+            seen = percent_process(percentages, self.robot_cells, self.person_cells, robot_ink=self.robot_ink,
+                                   symbols=symbols, robot_symbol=self.robot_symbol)
+        except MoveError as exc:
+            self.detections_wrong += 1
+            message = getattr(exc, "message_for_person", str(exc))
+            self.person.tell(message)
+            self.record.add(robot.t, "detection_rejected", message=message)
+            raise GameError(f"the camera's view was refused: {message}") from exc
+        ok = seen.new == cell
+        self.detections_correct += ok
+        self.detections_wrong += not ok
+        self.record.add(robot.t, "detected", row=seen.new[0] if seen.new else None,
+                        column=seen.new[1] if seen.new else None, correct=ok,
+                        percentages=[round(p, 1) for p in percentages])
+        if seen.new is not None:
+            self.person_cells.append(seen.new)
+            self._set_board(seen.new, self.person_symbol)
+            self.o_pos |= 1 << cell_index(*seen.new)
+        self.moves.append({"by": "person", "symbol": self.person_symbol, "row": cell[0], "column": cell[1],
+                           "t": round(robot.t, 3), "detected": list(seen.new) if seen.new else None})
+        if result_of(self.board) is None:
+            self._click_play()  # the person's Play click: the robot's turn
+        return True
+
+    def _robot_turn(self) -> None:
+        robot = self.robot
+        if not self.moves:
+            self._click_play()  # the robot opens: Play without a drawing first
+        self.pending_move = None
+        self._run_until(lambda: self.pending_move is not None, 10.0, "the algorithm's answer")
+        cell = self.pending_move
+        assert cell is not None
+        robot.chart_step()
+        robot.chart_step()
+        self._run_until(self._waiting, 120.0, f"drawing the robot's move {cell}")
+        self.robot_cells.append(cell)
+        self._set_board(cell, self.robot_symbol)
+        self._place(cell, self.robot_symbol, "truth")
+        percentages, _ = self._look()
+        self.robot_ink[cell] = percentages[cell_index(*cell)]
+        self.moves.append({"by": "robot", "symbol": self.robot_symbol, "row": cell[0], "column": cell[1],
+                           "t": round(robot.t, 3)})
+
+    def save(self, out_dir: Path) -> dict[str, str]:
+        """Write the game record (JSON Lines: events, then the chart trace) and the final board PNG."""
+        out_dir.mkdir(parents=True, exist_ok=True)
+        record = out_dir / "game.jsonl"
+        with record.open("w") as f:
+            for e in self.record.events:
+                f.write(json.dumps(e) + "\n")
+            if self.trace is not None:
+                for rec in self.trace.records:
+                    f.write(json.dumps({"event": "transition", **asdict(rec)}, default=str) + "\n")
+        png = self.robot.board.save_png(out_dir / "board_final.png", grid_mm=True)
+        return {"record": str(record), "board_png": str(png)}
+
+    def close(self) -> None:
+        """Stop the camera emulator."""
+        self.camera.close()
+
+
+def engine_for(name: str) -> Callable[[str, str], Cell]:
+    """The game algorithm called `name` ("strong" or "thesis") as a function (board text, symbol) -> cell."""
+    from ..game.engine import GameOver
+    from ..game.strong_engine import StrongEngine
+    from ..game.thesis_engine import ThesisEngine
+
+    engines = {"strong": StrongEngine, "thesis": ThesisEngine}
+    if name not in engines:
+        raise ValueError(f"unknown engine {name!r}; choose from {', '.join(engines)}")
+    engine = engines[name]()
+
+    def move(board: str, symbol: str) -> Cell:
+        answer = engine.move(board, symbol)
+        if isinstance(answer, GameOver):
+            raise GameError(f"the {name} engine was asked to move after the end: {answer.reason}")
+        return answer.row, answer.column
+
+    return move

@@ -1,0 +1,108 @@
+"""Whole games on the simulated robot: camera behind a real pseudo-terminal, charts, engine, erasing."""
+
+import io
+import json
+
+import cv2
+import pytest
+
+from ttt_sm.app.game import GameSession, SimulatedPerson, TerminalPerson, result_of
+from ttt_sm.charts.game import MSG_DRAWING, MSG_ERASING, MSG_TURNING_OFF, MSG_YOUR_TURN
+from ttt_sm.cli import main
+from ttt_sm.params import load_params
+
+P = load_params()
+
+
+def test_result_of_reads_wins_draws_and_games_on():
+    assert result_of("XXXX.OOO.................") == "X"
+    assert result_of("O....O....O....O....XXX..") == "O"
+    assert result_of("." * 25) is None
+    assert result_of("XXOOX" "OOXXO" "XXOOX" "OOXXO" "XXOOX") == "draw"
+
+
+def test_the_simulated_person_wins_when_it_can_and_blocks_when_it_must():
+    p = SimulatedPerson(seed=0)
+    assert p.choose("XXX.." "OO..." + "." * 15, "X") == (1, 4)  # wins
+    assert p.choose("XXX.." "OO..." + "." * 15, "O") == (1, 4)  # blocks
+
+
+@pytest.fixture(scope="module")
+def serial_game(tmp_path_factory):
+    """One whole game: simulated person (X) against the strong engine (O), camera on a pty."""
+    out = tmp_path_factory.mktemp("game")
+    session = GameSession(P, seed=4, robot_symbol="O", engine="strong", camera="serial")
+    try:
+        report = session.play()
+        files = session.save(out)
+    finally:
+        session.close()
+    return session, report, files
+
+
+def test_a_whole_game_reads_every_move_right_through_the_serial_camera(serial_game):
+    session, report, _ = serial_game
+    person_moves = [m for m in report["moves"] if m["by"] == "person"]
+    assert person_moves and report["detections_wrong"] == 0
+    assert report["detections_correct"] == len(person_moves)
+    assert all(m["detected"] == [m["row"], m["column"]] for m in person_moves)
+    link = report["camera_link"]
+    assert link["frames_ok"] >= 2 * len(report["moves"]) and not link["rejected"]
+
+
+def test_the_strong_engine_does_not_lose_and_the_board_is_erased(serial_game):
+    session, report, _ = serial_game
+    assert report["winner"] in ("robot", "draw")
+    assert report["erased"] is True and session.robot.board.ink_area_mm2() == 0.0
+    assert "finished" in session.robot.active("Control")
+    # the robot drew every move it announced, in the cells it chose, with its own symbol
+    robot_cells = [(m["row"], m["column"]) for m in report["moves"] if m["by"] == "robot"]
+    assert robot_cells == session.robot_cells
+
+
+def test_the_game_chart_showed_the_thesis_messages_in_order(serial_game):
+    session, _, _ = serial_game
+    texts = [e["text"] for e in session.record.events if e["event"] == "message"]
+    firsts = [texts.index(m) for m in (MSG_YOUR_TURN, MSG_DRAWING, MSG_ERASING, MSG_TURNING_OFF)]
+    assert firsts == sorted(firsts)
+    assert any(t in ("The manipulator wins.", "Draw: the board is full.") for t in texts)
+
+
+def test_the_record_and_the_board_picture_are_written(serial_game):
+    _, report, files = serial_game
+    lines = [json.loads(line) for line in open(files["record"])]
+    kinds = {e["event"] for e in lines}
+    assert {"field_drawn", "person_drew", "detected", "robot_move", "result", "transition"} <= kinds
+    robot_moves = [e for e in lines if e["event"] == "robot_move"]
+    assert len(robot_moves) == sum(m["by"] == "robot" for m in report["moves"])
+    assert cv2.imread(files["board_png"]) is not None
+
+
+def test_a_person_at_the_terminal_is_asked_again_after_a_bad_cell():
+    typed = io.StringIO("7 7\nnonsense\n3 3\n2 2\nq\n")
+    shown = io.StringIO()
+    person = TerminalPerson(stdin=typed, stdout=shown)
+    session = GameSession(P, seed=2, robot_symbol="O", person=person, engine="thesis", camera="direct",
+                          record_trace=False)
+    try:
+        report = session.play()
+    finally:
+        session.close()
+    text = shown.getvalue()
+    assert "cell (7, 7) is not a free cell of the 5x5 field" in text
+    assert "not a cell: 'nonsense'" in text
+    person_moves = [(m["row"], m["column"]) for m in report["moves"] if m["by"] == "person"]
+    assert person_moves[:1] == [(3, 3)]
+    assert report["winner"] == "abandoned" and report["erased"] is True
+    assert MSG_YOUR_TURN in text
+
+
+def test_play_json_reports_the_promised_keys(capsys, tmp_path):
+    code = main(["play", "--opponent", "simulated", "--camera", "direct", "--seed", "5", "--json",
+                 "--out", str(tmp_path)])
+    assert code == 0
+    data = json.loads(capsys.readouterr().out)
+    for key in ("winner", "moves", "robot_symbol", "detections_correct", "detections_wrong", "sim_time_s",
+                "wall_time_s", "realtime_factor", "erased"):
+        assert key in data
+    assert data["detections_wrong"] == 0 and data["erased"] is True

@@ -61,7 +61,7 @@ THESIS_GREY_LEVEL = 80
 N = 5
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # eq on arrays is ambiguous
 class Detection:
     """What the camera saw on the field.
 

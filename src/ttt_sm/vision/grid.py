@@ -53,7 +53,7 @@ REFIT_BAND_PX = 4.0
 MAX_RMS_CELLS = 0.06
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # eq on arrays is ambiguous
 class Grid:
     """The located field in a photo.
 

@@ -158,6 +158,8 @@ class Scheduler:
         self._hold = np.asarray(sim.q_encoder.tolist() + [sim.q_true[3]], dtype=float)
         self._clock_started = False
         self._period0 = 0
+        self._ik_pose: list[float] = []  # the last pose solved, and its answer
+        self._ik_q: np.ndarray = np.full(4, np.nan)
 
     @property
     def t(self) -> float:
@@ -183,7 +185,13 @@ class Scheduler:
         for stage in self.task_stages:
             stage.tick(s)
         task = s.task
-        if math.isfinite(task[0] + task[1] + task[2] + task[3]):
+        pose = as_floats(task)
+        if pose == self._ik_pose:
+            # The same pose as last step (the arm waits): IK is a function of
+            # the pose and its warm start, so the answer is the last one.
+            s.q_des = self._ik_q
+            s.ik_iterations = 0
+        elif math.isfinite(pose[0] + pose[1] + pose[2] + pose[3]):
             try:
                 result = self.ik.solve(task)
             except IKError as exc:
@@ -195,6 +203,7 @@ class Scheduler:
             else:
                 s.q_des = result.q
                 s.ik_iterations = result.iterations
+                self._ik_pose, self._ik_q = pose, result.q
         else:
             s.q_des = self._hold.copy()
         s.q_set = s.q_des

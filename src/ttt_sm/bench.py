@@ -122,6 +122,34 @@ def bench_game_motion(params: ArmParams, seed: int = 0) -> dict[str, Any]:
     return game_motion(params, seed=seed)
 
 
+def bench_vision_section(params: ArmParams, seed: int = 0) -> dict[str, Any]:
+    """Camera vision: accuracy on 200 simulated photos and the detection time per frame."""
+    from .vision.bench import bench_vision
+
+    return bench_vision(seed)
+
+
+def bench_ai_section(params: ArmParams, seed: int = 0) -> dict[str, Any]:
+    """The game engines' move times and the strong engine's start-up."""
+    from .game.bench import bench_ai
+
+    return bench_ai(seed)
+
+
+def bench_game(params: ArmParams, seed: int = 0) -> dict[str, Any]:
+    """A whole simulated game, the camera behind the pty serial emulator."""
+    from .app.game import GameSession
+
+    session = GameSession(params, seed=seed, camera="serial", record_trace=False)
+    try:
+        report = session.play()
+    finally:
+        session.close()
+    return {f"game_{k}": report[k] for k in ("winner", "detections_correct", "detections_wrong", "sim_time_s",
+                                             "wall_time_s", "realtime_factor", "setup_wall_s", "camera_wall_s",
+                                             "erased")}
+
+
 SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "steps": lambda p, a: bench_steps(p, a["out"]),
     "ik": lambda p, a: bench_ik_section(p, a["seed"]),
@@ -130,6 +158,9 @@ SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "charts": lambda p, a: bench_charts(p),
     "init": lambda p, a: bench_init(p, a["init_starts"], a["seed"]),
     "motion": lambda p, a: bench_game_motion(p, a["seed"]),
+    "vision": lambda p, a: bench_vision_section(p, a["seed"]),
+    "ai": lambda p, a: bench_ai_section(p, a["seed"]),
+    "game": lambda p, a: bench_game(p, a["seed"]),
 }
 
 

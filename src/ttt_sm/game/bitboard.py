@@ -49,18 +49,13 @@ def has_four(stones: int) -> bool:
     return any(stones & m == m for m in LINE_MASKS)
 
 
-def open_lines(stones: int, blocker: int) -> int:
-    """Number of winning lines that ``blocker`` has not entered (still open for the other side)."""
-    return sum(1 for m in LINE_MASKS if not blocker & m)
-
-
 def win_cells(mine: int, theirs: int) -> int:
-    """Empty cells where ``mine`` would complete a line: a mask."""
+    """Empty cells where ``mine`` would complete four in a row (lines with three of ``mine``, none of ``theirs``)."""
     cells = 0
     for m in LINE_MASKS:
         if not theirs & m:
             x = mine & m
-            if x != m and (x ^ m) & ((x ^ m) - 1) == 0:  # exactly one cell of the line missing
+            if x.bit_count() == K - 1:
                 cells |= x ^ m
     return cells
 

@@ -7,10 +7,9 @@ from __future__ import annotations
 
 import random
 
-from .bitboard import bits, cell_of
+from .bitboard import bits, cell_of, win_cells
 from .engine import Engine, GameOver, Move, prepare
 from .rules import Board, Symbol, other
-from .solver import threat_cells
 
 
 class RandomEngine:
@@ -43,7 +42,7 @@ class GreedyEngine:
         if over is not None:
             return over
         mine, theirs = b.marks(me), b.marks(other(me))
-        for cells in (threat_cells(mine, theirs), threat_cells(theirs, mine), b.empty_cells):
+        for cells in (win_cells(mine, theirs), win_cells(theirs, mine), b.empty_cells):
             if cells:
                 return Move(*cell_of(self.rng.choice(bits(cells))))
         raise AssertionError("prepare() returned a full field as not over")  # pragma: no cover

@@ -43,17 +43,6 @@ class OutOfBudget(Exception):
     """A search with a node budget ran out before it had an answer."""
 
 
-def threat_cells(mine: int, theirs: int) -> int:
-    """Empty cells where ``mine`` would complete four in a row, as a mask."""
-    cells = 0
-    for m in LINE_MASKS:
-        if not theirs & m:
-            x = mine & m
-            if x.bit_count() == 3:
-                cells |= x ^ m
-    return cells
-
-
 def ordered_moves(mover: int, other: int) -> list[int]:
     """The empty cells as single-bit masks, most promising first for ``mover``.
 

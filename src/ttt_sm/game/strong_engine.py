@@ -5,7 +5,9 @@ the opponent from forcing a win if it starts from a position that is not
 lost.  Each move it
 
 1. completes its own four if it can;
-2. reads the answer from the opening book (:mod:`ttt_sm.game.book`) while
+2. folds the position under the eight symmetries of the square (answering
+   for one image and mapping the cell back) and reads the answer from the
+   opening book (:mod:`ttt_sm.game.book`) while
    the field holds few marks: every position up to ``book.max_stones``
    marks, solved exactly by :func:`choose` offline, because there the
    search costs seconds;
@@ -30,11 +32,11 @@ import time
 from dataclasses import dataclass
 from typing import Literal
 
-from .bitboard import INVERSE, SYMMETRIES, canonical, cell_of
+from .bitboard import FULL, INVERSE, N_CELLS, SYMMETRIES, canonical, cell_of, win_cells
 from .book import Book, load_book
 from .engine import GameOver, Move, prepare
 from .rules import Board, Symbol, other
-from .solver import OutOfBudget, Solver, ordered_moves, threat_cells
+from .solver import OutOfBudget, Solver, ordered_moves
 
 Outcome = Literal["win", "draw", "loss"]
 WIN_BUDGET_NODES = 3000
@@ -59,10 +61,10 @@ def choose(solver: Solver, mine: int, theirs: int, win_budget: int | None) -> tu
     is built with); a number caps that search, and a fresh :class:`Solver`
     does it so the answer does not depend on ``solver``'s table.
     """
-    wins = threat_cells(mine, theirs)
+    wins = win_cells(mine, theirs)
     if wins:
         return (wins & -wins).bit_length() - 1, "win", 0
-    threats = threat_cells(theirs, mine)
+    threats = win_cells(theirs, mine)
     if threats & (threats - 1):  # two cells to block: lost whatever we do; block one
         return (threats & -threats).bit_length() - 1, "loss", 0
     candidates = [threats] if threats else ordered_moves(mine, theirs)
@@ -109,17 +111,19 @@ class StrongEngine:
         if over is not None:
             return over
         mine, theirs = b.marks(me), b.marks(other(me))
-        wins = threat_cells(mine, theirs)
+        wins = win_cells(mine, theirs)
         if wins:
             return Analysis(Move(*cell_of((wins & -wins).bit_length() - 1)), "win", "win-now", 0)
-        if (mine | theirs).bit_count() <= self.book.max_stones:
-            key, sym = canonical(mine, theirs)
-            entry = self.book.get(key)
-            if entry is not None:
-                cell, outcome = entry
-                return Analysis(Move(*cell_of(SYMMETRIES[INVERSE[sym]][cell])), outcome, "book", 0)
-        cell, outcome, nodes = choose(self.solver, mine, theirs, self.win_budget)
-        return Analysis(Move(*cell_of(cell)), outcome, "search", nodes)
+        # Decide on the position's canonical image and map the cell back, so symmetric
+        # positions get symmetric answers (what lets a proof check one per symmetry class).
+        key, sym = canonical(mine, theirs)
+        back = SYMMETRIES[INVERSE[sym]]
+        entry = self.book.get(key) if (mine | theirs).bit_count() <= self.book.max_stones else None
+        if entry is not None:
+            cell, outcome = entry
+            return Analysis(Move(*cell_of(back[cell])), outcome, "book", 0)
+        cell, outcome, nodes = choose(self.solver, key & FULL, key >> N_CELLS, self.win_budget)
+        return Analysis(Move(*cell_of(back[cell])), outcome, "search", nodes)
 
 
 def timed_move(engine: StrongEngine, board: Board | str, symbol: Symbol) -> tuple[Analysis | GameOver, float]:

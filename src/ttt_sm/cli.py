@@ -233,7 +233,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
     sp = add("bench", cmd_bench, "measure the speed and quality targets")
-    sp.add_argument("--only", default=None, help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game")
+    sp.add_argument("--only", default=None,
+                    help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
     sp = add("ik", cmd_ik, "solve inverse kinematics for one tool pose")

@@ -47,7 +47,8 @@ def test_a_whole_game_reads_every_move_right_through_the_serial_camera(serial_ga
     assert report["detections_correct"] == len(person_moves)
     assert all(m["detected"] == [m["row"], m["column"]] for m in person_moves)
     link = report["camera_link"]
-    assert link["frames_ok"] >= 2 * len(report["moves"]) and not link["rejected"]
+    # one fresh frame at least per move (after each drawing, the person's and the robot's)
+    assert link["frames_ok"] >= len(report["moves"]) and not link["rejected"]
 
 
 def test_the_strong_engine_does_not_lose_and_the_board_is_erased(serial_game):

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ..params import ArmParams
+from ..seriallink.protocol import SEQ_MODULUS
 from ..twin.whiteboard import Whiteboard
 from ..vision import Detection, board_text, board_values, detect
 from ..vision.simulated import SimulatedCamera
@@ -39,10 +40,11 @@ class CameraLink:
         self.view = self.camera.view()
         self.lock = threading.Lock()
         self.lock.acquire()  # held by the simulation; released only while reading
-        self.last_symbols: str | None = None
         self.read_wall_s = 0.0  # wall time spent waiting for photos
         self._closing = False
         self._last_percentages: list[float] = [0.0] * 25
+        self._made = 0  # frames photographed so far = the next frame's sequence number
+        self._symbols_by_seq: dict[int, str] = {}
         self._emulator: Any = None
         self._reader: Any = None
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
@@ -56,8 +58,10 @@ class CameraLink:
             with self.lock:  # never photograph a board the simulation is writing
                 if self._closing:
                     return list(self._last_percentages)
-                d = detect(self.camera.frame())
-            self.last_symbols = d.cells
+                d = detect(self.camera.frame())  # no frame (and no sequence number) if this raises
+                # The emulator numbers frames 0, 1, 2 ... in the order they are made.
+                self._symbols_by_seq[self._made % SEQ_MODULUS] = d.cells
+                self._made += 1
             self._last_percentages = [float(p) for p in d.percentages]
             return self._last_percentages
 
@@ -82,16 +86,23 @@ class CameraLink:
         if self.mode == "direct":
             d: Detection = detect(self.camera.frame())
             return tuple(board_values(list(d.percentages), self.view)), board_text(d.cells, self.view)
+        # Frames photographed before now may still wait in the port: only a
+        # frame numbered from `fresh` on shows the board as it is now.
+        fresh = self._made
         self.lock.release()
         try:
-            # The frame in flight may show the board before the last change: take the second.
-            self._reader.read_frame(5.0)
-            frame = self._reader.read_frame(5.0)
-            if frame is None:
-                raise TimeoutError("the camera sent no frame for 5 s")
+            deadline = time.monotonic() + 10.0
+            while True:
+                frame = self._reader.read_frame(max(0.0, deadline - time.monotonic()))
+                if frame is None:
+                    raise TimeoutError("the camera sent no fresh frame for 10 s")
+                if (frame.seq - fresh) % SEQ_MODULUS < SEQ_MODULUS // 2:
+                    break
         finally:
             self.lock.acquire()
-        symbols = board_text(self.last_symbols, self.view) if self.last_symbols else None
+        cells = self._symbols_by_seq.pop(frame.seq, None)
+        self._symbols_by_seq.clear()
+        symbols = board_text(cells, self.view) if cells else None
         return tuple(board_values(list(frame.percentages), self.view)), symbols
 
     def stats(self) -> dict[str, Any]:

@@ -63,5 +63,5 @@ class GearPlayCompensation:
         c2, k2, c3, k3 = self._play
         q[1] -= self.gain * _offset(tau2, c2, k2)
         q[2] -= self.gain * _offset(tau23, c3, k3)
-        signals.q_set = np.array(q)
+        signals.q_set = q
 

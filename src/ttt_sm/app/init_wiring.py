@@ -108,7 +108,8 @@ class DriveInitStage:
         if moved:
             self._update_status()
         servo = pos_in[3] if self.done else self.servo_init
-        signals.q_set = np.array([c1.pos_out, c2.pos_out, c3.pos_out, servo])
+        # a list: the next stages and the scheduler read it as floats (no array round trip)
+        signals.q_set = [c1.pos_out, c2.pos_out, c3.pos_out, servo]
 
 
 class InitMonitor:

@@ -36,7 +36,7 @@ class BoardStage:
 
     def tick(self, signals: Signals) -> None:
         """Ink or wipe where the true tool touches the board now."""
-        self.board.update(signals.t, self.sim.q_true)
+        self.board.update(signals.t, self.sim.true_angles())
 
 
 class RobotError(ValueError):

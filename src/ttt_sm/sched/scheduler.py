@@ -42,7 +42,7 @@ class Signals:
         self.task: np.ndarray = np.full(4, np.nan)  # X, Y, Z, phi; NaN: no task pose
         self.fr_sw = False
         self.q_des: np.ndarray = np.full(4, np.nan)  # IK output
-        self.q_set: np.ndarray = np.full(4, np.nan)  # to the controllers
+        self.q_set: np.ndarray | list[float] = np.full(4, np.nan)  # to the controllers
         self.ik_iterations = 0
         self.ik_error: str | None = None
         self._read_sensors = read_sensors

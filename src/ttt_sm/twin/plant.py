@@ -330,6 +330,11 @@ class ArmSim:
         """What the controllers see: counts * rad_per_count + offset estimate (rad)."""
         return np.array(self.encoder_angles())
 
+    def true_angles(self) -> tuple[float, float, float, float]:
+        """:attr:`q_true` as plain floats, for code that runs every chart step."""
+        q1, q2, q3 = self._ds[:, K.S_Q].tolist()
+        return q1, q2, q3, float(self._gs[K.GS_SV_Q])
+
     def encoder_angles(self) -> tuple[float, float, float]:
         """:attr:`q_encoder` as plain floats, for code that runs every chart step."""
         c1, c2, c3 = self._di[:, K.I_COUNTS].tolist()

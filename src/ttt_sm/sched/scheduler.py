@@ -63,8 +63,8 @@ class Signals:
 
 
 def as_floats(values: np.ndarray | Sequence[float]) -> list[float]:
-    """A short vector as a list of Python floats (cheap for an array: `tolist`)."""
-    return values.tolist() if isinstance(values, np.ndarray) else [float(v) for v in values]
+    """A short vector as a new list of numbers (cheap: `tolist` for an array, a copy for a list)."""
+    return values.tolist() if isinstance(values, np.ndarray) else list(values)
 
 
 class Stage(Protocol):

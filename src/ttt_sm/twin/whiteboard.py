@@ -345,6 +345,8 @@ class Whiteboard:
         """
         if type(q) is np.ndarray:
             q1, q2, q3, q4 = q.tolist()
+        elif type(q) is tuple:
+            q1, q2, q3, q4 = q
         else:
             q1, q2, q3, q4 = (float(v) for v in q)
         a23 = q2 + q3

@@ -105,7 +105,7 @@ def test_it_wins_against_weak_play():
 
 def test_it_reports_the_game_over(strong):
     won = parse_board("XXXX." "OOO.." "....." "....." ".....")
-    assert strong.move(won, "O") == GameOver("X", "X (the opponent) already has four in a row")
+    assert strong.move(won, "O") == GameOver("X", "X has four in a row: the opponent has won")
     full = parse_board("XXOOX" "OOXXO" "XXOOX" "OOXXO" "XXOOX")
     result = strong.move(full, "X")
     assert isinstance(result, GameOver) and result.winner is None

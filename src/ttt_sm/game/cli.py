@@ -5,7 +5,7 @@ prints the cell (``row``, ``column``) and the engine's thinking time
 (``time_ms``), or ``game_over`` with the winner when the game had already
 ended.  A malformed or impossible board is one line naming the problem and
 exit status 2.  :func:`register` adds the command to the ``ttt-sm`` parser;
-until it is wired there, ``python -m ttt_sm.game.cli ai move ...`` runs it.
+``python -m ttt_sm.game.cli ai move ...`` runs it on its own.
 """
 
 from __future__ import annotations
@@ -75,9 +75,8 @@ def ai_move(board: str, symbol: str, engine: str = "strong") -> dict[str, Any]:
 
 def _text(out: dict[str, Any]) -> str:
     if out["game_over"]:
-        who = f"{out['winner']} has won" if out["winner"] else "draw"
         extra = f"; the thesis block would output {tuple(out['thesis_output'])}" if "thesis_output" in out else ""
-        return f"game over: {who} ({out['reason']}){extra}"
+        return f"game over: {out['reason']}{extra}"
     proof = f", {out['outcome']} ({out['source']})" if "outcome" in out else ""
     return (f"{out['engine']} plays {out['symbol']} at row {out['row']}, column {out['column']}"
             f"{proof} in {out['time_ms']:.1f} ms")
@@ -86,11 +85,12 @@ def _text(out: dict[str, Any]) -> str:
 def cmd_ai_move(args: argparse.Namespace) -> int:
     """Run ``ttt-sm ai move``: a game error becomes the CLI's one-line error (exit status 2)."""
     from ..cli import CliError
+    from .book import BookError
     from .rules import GameError
 
     try:
         out = ai_move(args.board, args.symbol, args.engine)
-    except GameError as exc:
+    except (GameError, BookError) as exc:
         raise CliError(str(exc)) from exc
     print(json.dumps(out, indent=2) if args.json else _text(out))
     return 0

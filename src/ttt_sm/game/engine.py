@@ -56,7 +56,7 @@ def prepare(board: Board | str, symbol: str) -> tuple[Board, Symbol, GameOver | 
     won = winner(b)
     if won is not None:
         who = "the engine" if won == me else "the opponent"
-        return b, me, GameOver(won, f"{won} ({who}) already has four in a row")
+        return b, me, GameOver(won, f"{won} has four in a row: {who} has won")
     if is_full(b):
         return b, me, GameOver(None, "the field is full: a draw")
     if b.count(me) > b.count(other(me)):

@@ -1,0 +1,93 @@
+"""The shipped opening book: it covers every early position, and its answers are re-proved on samples."""
+
+from __future__ import annotations
+
+import random
+
+import pytest
+
+from ttt_sm.game.bitboard import FULL, N_CELLS
+from ttt_sm.game.book import Book, BookError, build_book, decode, encode, load_book, positions
+from ttt_sm.game.solver import Solver
+
+
+@pytest.fixture(scope="module")
+def book() -> Book:
+    return load_book()
+
+
+def holds(solver: Solver, key: int, cell: int, outcome: str) -> bool:
+    """Re-prove one entry from scratch: the cell is empty and the outcome exact for the player to move."""
+    mover, other = key & FULL, key >> N_CELLS
+    b = 1 << cell
+    if (mover | other) & b:
+        return False
+    if outcome == "win":
+        return solver.attacker_wins(mover | b, other, attacker_to_move=False)
+    if outcome == "draw":  # the cell holds the draw, and nothing better exists
+        return (not solver.attacker_wins(other, mover | b, attacker_to_move=True)
+                and not solver.attacker_wins(mover, other, attacker_to_move=True))
+    return solver.attacker_wins(other, mover, attacker_to_move=False)  # loss: nothing holds
+
+
+def sample(book: Book, per_level: int, seed: int, levels: range) -> list[tuple[int, tuple[int, str]]]:
+    rng = random.Random(seed)
+    chosen = []
+    for stones in levels:
+        keys = sorted(k for k in book.entries if k.bit_count() == stones)
+        chosen += [(k, book.entries[k]) for k in rng.sample(keys, min(per_level, len(keys)))]
+    return chosen
+
+
+def test_the_book_covers_every_position_up_to_its_depth(book):
+    assert book.max_stones >= 3
+    keys = {mover | other << N_CELLS for _, mover, other in positions(book.max_stones)}
+    assert set(book.entries) == keys
+    assert len(book) == {3: 996, 4: 10_660}.get(book.max_stones, len(keys))
+
+
+def test_entries_re_prove_from_scratch(book):
+    solver = Solver()
+    for key, (cell, outcome) in sample(book, per_level=3, seed=1, levels=range(3, book.max_stones + 1)):
+        assert holds(solver, key, cell, outcome), (bin(key), cell, outcome)
+
+
+def test_the_book_knows_the_opening_theory(book):
+    # X's best first move is the centre and the game is a draw; after it only a diagonal neighbour holds.
+    assert book.get(0) == (12, "draw")
+    centre = 1 << 12
+    reply = book.get(0 | centre << N_CELLS)
+    assert reply is not None and reply[0] in {6, 8, 16, 18} and reply[1] == "draw"
+    outcomes = {o for _, o in book.entries.values()}
+    assert outcomes == {"win", "draw", "loss"}
+
+
+def test_the_file_round_trips_and_damage_is_named(book, tmp_path):
+    small = Book(2, {k: v for k, v in book.entries.items() if k.bit_count() <= 2})
+    assert decode(encode(small)) == small
+    with pytest.raises(BookError, match="not an opening book"):
+        decode(b"PNG....")
+    data = bytearray(encode(small))
+    data[4] = 9
+    with pytest.raises(BookError, match="version 9"):
+        decode(bytes(data))
+    with pytest.raises(BookError, match="damaged"):
+        decode(encode(small)[:-5])
+    with pytest.raises(BookError, match="cannot read"):
+        load_book(tmp_path / "missing.bin")
+    (tmp_path / "b.bin").write_bytes(encode(small))
+    assert load_book(tmp_path / "b.bin") == small
+
+
+@pytest.mark.soak
+def test_the_book_rebuilds_to_the_same_answers(book):
+    """Regenerating the first three levels (the search behind build_book) gives the shipped entries."""
+    rebuilt = build_book(2)
+    assert rebuilt.entries == {k: v for k, v in book.entries.items() if k.bit_count() <= 2}
+
+
+@pytest.mark.soak
+def test_more_entries_re_prove_from_scratch(book):
+    solver = Solver(max_entries=5_000_000)
+    for key, (cell, outcome) in sample(book, per_level=60, seed=2, levels=range(0, book.max_stones + 1)):
+        assert holds(solver, key, cell, outcome), (bin(key), cell, outcome)

@@ -266,6 +266,8 @@ class GameSession:
                 self._robot_turn()
             to_move = "O" if to_move == "X" else "X"
         outcome = result_of(self.board) or "abandoned"
+        if outcome == "abandoned":
+            self.person.tell("You gave up: the manipulator erases the board.")
         self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3}.get(outcome, 3)
         self.record.add(robot.t, "result", outcome=outcome)
         self.say(f"result: {outcome}; erasing and turning off")
@@ -297,6 +299,8 @@ class GameSession:
 
     def _person_turn(self) -> bool:
         robot = self.robot
+        robot.chart_step()  # the Game chart shows whose turn it is before the person is asked
+        self._run_until(lambda: True, 0.002, "showing the message")
         cell = self.person.choose(self.truth, self.person_symbol)
         if cell is None:
             self.record.add(robot.t, "person_gave_up")
@@ -348,6 +352,7 @@ class GameSession:
         self.robot_ink[cell] = percentages[cell_index(*cell)]
         self.moves.append({"by": "robot", "symbol": self.robot_symbol, "row": cell[0], "column": cell[1],
                            "t": round(robot.t, 3)})
+        self.person.tell(f"The manipulator drew {self.robot_symbol} in row {cell[0]}, column {cell[1]}.")
 
     def save(self, out_dir: Path) -> dict[str, str]:
         """Write the game record (JSON Lines: events, then the chart trace) and the final board PNG."""

@@ -77,7 +77,7 @@ class ControlStage:
             vars(c).update(self.overrides)
         c.tick()
         if math.isfinite(c.X_out):
-            signals.task = np.array([c.X_out, c.Y_out, c.Z_out, c.phi])
+            signals.task = [c.X_out, c.Y_out, c.Z_out, c.phi]
         else:
             signals.task = self._no_task
         signals.fr_sw = bool(c.fr_sw)

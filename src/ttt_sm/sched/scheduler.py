@@ -39,7 +39,7 @@ class Signals:
 
     def __init__(self, read_sensors: Callable[[], Sensors] | None = None) -> None:
         self.t = 0.0
-        self.task: np.ndarray = np.full(4, np.nan)  # X, Y, Z, phi; NaN: no task pose
+        self.task: np.ndarray | list[float] = np.full(4, np.nan)  # X, Y, Z, phi; NaN: no task pose
         self.fr_sw = False
         self.q_des: np.ndarray = np.full(4, np.nan)  # IK output
         self.q_set: np.ndarray | list[float] = np.full(4, np.nan)  # to the controllers

@@ -7,7 +7,16 @@ import random
 import pytest
 
 from ttt_sm.game.bitboard import FULL, N_CELLS
-from ttt_sm.game.book import Book, BookError, build_book, decode, encode, load_book, positions
+from ttt_sm.game.book import (
+    Book,
+    BookError,
+    build_book,
+    decode,
+    encode,
+    load_book,
+    positions,
+    second_player_lines,
+)
 from ttt_sm.game.solver import Solver
 
 
@@ -39,16 +48,17 @@ def sample(book: Book, per_level: int, seed: int, levels: range) -> list[tuple[i
     return chosen
 
 
-def test_the_book_covers_every_position_up_to_its_depth(book):
-    assert book.max_stones >= 3
-    keys = {mover | other << N_CELLS for _, mover, other in positions(book.max_stones)}
-    assert set(book.entries) == keys
-    assert len(book) == {3: 996, 4: 10_660}.get(book.max_stones, len(keys))
+def test_the_book_covers_every_early_position_and_the_second_players_lines(book):
+    assert (book.max_stones, book.line_stones) == (4, 5)
+    every = {mover | other << N_CELLS for _, mover, other in positions(book.max_stones)}
+    lines = second_player_lines(book.entries, book.line_stones)
+    assert len(every) == 10_660 and len(lines) == 869
+    assert set(book.entries) == every | lines
 
 
 def test_entries_re_prove_from_scratch(book):
     solver = Solver()
-    for key, (cell, outcome) in sample(book, per_level=3, seed=1, levels=range(3, book.max_stones + 1)):
+    for key, (cell, outcome) in sample(book, per_level=3, seed=1, levels=range(3, book.line_stones + 1)):
         assert holds(solver, key, cell, outcome), (bin(key), cell, outcome)
 
 
@@ -63,7 +73,7 @@ def test_the_book_knows_the_opening_theory(book):
 
 
 def test_the_file_round_trips_and_damage_is_named(book, tmp_path):
-    small = Book(2, {k: v for k, v in book.entries.items() if k.bit_count() <= 2})
+    small = Book(2, 2, {k: v for k, v in book.entries.items() if k.bit_count() <= 2})
     assert decode(encode(small)) == small
     with pytest.raises(BookError, match="not an opening book"):
         decode(b"PNG....")
@@ -82,12 +92,14 @@ def test_the_file_round_trips_and_damage_is_named(book, tmp_path):
 @pytest.mark.soak
 def test_the_book_rebuilds_to_the_same_answers(book):
     """Regenerating the first three levels (the search behind build_book) gives the shipped entries."""
-    rebuilt = build_book(2)
-    assert rebuilt.entries == {k: v for k, v in book.entries.items() if k.bit_count() <= 2}
+    rebuilt = build_book(2, 3)  # levels 0-2, and the second player's positions at 3 marks
+    lines = second_player_lines(rebuilt.entries, 3)
+    assert len(rebuilt) == 92 + len(lines)
+    assert rebuilt.entries == {k: v for k, v in book.entries.items() if k.bit_count() <= 2 or k in lines}
 
 
 @pytest.mark.soak
 def test_more_entries_re_prove_from_scratch(book):
     solver = Solver(max_entries=5_000_000)
-    for key, (cell, outcome) in sample(book, per_level=60, seed=2, levels=range(0, book.max_stones + 1)):
+    for key, (cell, outcome) in sample(book, per_level=60, seed=2, levels=range(0, book.line_stones + 1)):
         assert holds(solver, key, cell, outcome), (bin(key), cell, outcome)

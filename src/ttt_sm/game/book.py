@@ -1,20 +1,25 @@
-"""The strong engine's opening book: every position with few marks, solved offline.
+"""The strong engine's opening book: the early positions, solved offline.
 
 In the first few moves an exact search costs seconds in Python (the reply
-to the opening move most of all), so the book holds the answer for every
-position with up to ``max_stones`` marks that a game can reach, up to the
-eight symmetries: the cell to play and the exact outcome for the player to
-move.  It is built by :func:`build_book` (``python -m ttt_sm.game.book``)
-with the same :func:`~ttt_sm.game.strong_engine.choose` the engine uses,
-searching for wins without a budget, and shipped as ``book.bin`` in this
-package.  The tests re-solve a sample of its entries.
+to the opening move most of all), so the book holds, up to the eight
+symmetries, the cell to play and the exact outcome for the player to move in
+
+* every position with up to ``max_stones`` marks that a game can reach, and
+* every position with ``line_stones`` marks that the *second* player meets
+  when it follows the book and the first player plays anything (the second
+  player's third move is the next most expensive search).
+
+It is built by :func:`build_book` (``python -m ttt_sm.game.book``) with the
+same :func:`~ttt_sm.game.strong_engine.choose` the engine uses, searching
+for wins without a budget, and shipped as ``book.bin`` in this package.  The
+tests re-solve a sample of its entries and check what it covers.
 
 File format (little-endian): ``b"TTTB"``, version (1 byte), ``max_stones``
-(1 byte), entry count (4 bytes), then zlib-compressed: the sorted position
-keys as 8-byte ints (:func:`~ttt_sm.game.bitboard.canonical`: the mover's
-cells in the low 25 bits, the other side's above), then one byte per entry:
-the cell in the canonical frame (bits 0-4) and the outcome (bits 5-6:
-0 win, 1 draw, 2 loss).
+(1 byte), ``line_stones`` (1 byte), entry count (4 bytes), then
+zlib-compressed: the sorted position keys as 8-byte ints
+(:func:`~ttt_sm.game.bitboard.canonical`: the mover's cells in the low 25
+bits, the other side's above), then one byte per entry: the cell in the
+canonical frame (bits 0-4) and the outcome (bits 5-6: 0 win, 1 draw, 2 loss).
 """
 
 from __future__ import annotations
@@ -35,9 +40,11 @@ from .bitboard import FULL, N_CELLS, bits, canonical, has_four
 Outcome = Literal["win", "draw", "loss"]
 OUTCOMES: tuple[Outcome, Outcome, Outcome] = ("win", "draw", "loss")
 MAGIC = b"TTTB"
-VERSION = 1
+VERSION = 2
 BOOK_FILE = "book.bin"
 DEFAULT_MAX_STONES = 4
+DEFAULT_LINE_STONES = 5
+_HEADER = "<BBBI"
 
 
 class BookError(ValueError):
@@ -46,15 +53,19 @@ class BookError(ValueError):
 
 @dataclass(frozen=True)
 class Book:
-    """Solved positions: canonical key -> (cell in the canonical frame, outcome for the mover)."""
+    """Solved positions: canonical key -> (cell in the canonical frame, outcome for the mover).
+
+    Complete up to ``max_stones`` marks; entries up to ``line_stones`` marks.
+    """
 
     max_stones: int
+    line_stones: int
     entries: dict[int, tuple[int, Outcome]] = field(default_factory=dict)
 
     @classmethod
     def empty(cls) -> Book:
         """A book that knows nothing (the engine then searches every move)."""
-        return cls(-1, {})
+        return cls(-1, -1, {})
 
     def get(self, key: int) -> tuple[int, Outcome] | None:
         """The entry for a canonical key, if the book has it."""
@@ -84,23 +95,63 @@ def positions(max_stones: int) -> Iterator[tuple[int, int, int]]:
         level = nxt
 
 
-def build_book(max_stones: int = DEFAULT_MAX_STONES,
-               progress: Callable[[str], None] | None = None) -> Book:
-    """Solve every position of :func:`positions` exactly with one shared search table."""
+def second_player_lines(entries: dict[int, tuple[int, Outcome]], line_stones: int) -> set[int]:
+    """Canonical keys of the positions with ``line_stones`` (odd) marks that the second player meets.
+
+    The first player tries every cell; the second answers from ``entries``
+    (which must hold its positions with fewer marks).  Lines that end in a
+    four before ``line_stones`` marks are dropped.
+    """
+    to_move_first = {canonical(0, 0)[0]}
+    for stones in range(0, line_stones, 2):
+        second: set[int] = set()
+        for key in to_move_first:
+            mover, other = key & FULL, key >> N_CELLS
+            for c in bits(FULL & ~(mover | other)):
+                if not has_four(mover | 1 << c):
+                    second.add(canonical(other, mover | 1 << c)[0])
+        if stones + 1 == line_stones:
+            return second
+        to_move_first = set()
+        for key in second:
+            mover, other = key & FULL, key >> N_CELLS
+            placed = mover | 1 << entries[key][0]
+            if not has_four(placed):
+                to_move_first.add(canonical(other, placed)[0])
+    return set()
+
+
+def build_book(max_stones: int = DEFAULT_MAX_STONES, line_stones: int = DEFAULT_LINE_STONES,
+               progress: Callable[[str], None] | None = None, known: Book | None = None) -> Book:
+    """Solve every position of :func:`positions` and :func:`second_player_lines` with one shared table.
+
+    ``known`` entries are taken as they are instead of solved again (to extend
+    a book; :func:`choose` is deterministic, so the result is the same).
+    """
     from .solver import Solver
     from .strong_engine import choose
 
     solver = Solver(max_entries=20_000_000)
     entries: dict[int, tuple[int, Outcome]] = {}
+    old = known.entries if known is not None else {}
     t0 = time.perf_counter()
-    last = -1
-    for stones, mover, other in positions(max_stones):
-        if progress and stones != last:
+
+    def solve(stones: int, mover: int, other: int) -> None:
+        key = mover | other << N_CELLS
+        if progress and len(entries) % 1000 == 0:
             progress(f"{stones} marks: {len(entries)} entries so far, {time.perf_counter() - t0:.0f} s")
-            last = stones
-        cell, outcome, _ = choose(solver, mover, other, win_budget=None)
-        entries[mover | other << N_CELLS] = (cell, outcome)
-    return Book(max_stones, entries)
+        if key in old:
+            entries[key] = old[key]
+        else:
+            cell, outcome, _ = choose(solver, mover, other, win_budget=None)
+            entries[key] = (cell, outcome)
+
+    for stones, mover, other in positions(max_stones):
+        solve(stones, mover, other)
+    if line_stones > max_stones:
+        for key in sorted(second_player_lines(entries, line_stones)):
+            solve(line_stones, key & FULL, key >> N_CELLS)
+    return Book(max_stones, max(line_stones, max_stones), entries)
 
 
 def encode(book: Book) -> bytes:
@@ -109,19 +160,22 @@ def encode(book: Book) -> bytes:
     payload = b"".join(struct.pack("<Q", k) for k in keys)
     payload += bytes(cell | OUTCOMES.index(book.entries[k][1]) << 5 for k in keys
                      for cell in (book.entries[k][0],))
-    return MAGIC + struct.pack("<BBI", VERSION, book.max_stones, len(keys)) + zlib.compress(payload, 9)
+    return MAGIC + struct.pack(_HEADER, VERSION, book.max_stones, book.line_stones, len(keys)) \
+        + zlib.compress(payload, 9)
 
 
 def decode(data: bytes, source: str = "book") -> Book:
     """Read the bytes of a ``book.bin`` file; :class:`BookError` if they are not one."""
-    if data[:4] != MAGIC or len(data) < 10:
+    start = 4 + struct.calcsize(_HEADER)
+    if data[:4] != MAGIC or len(data) < start:
         raise BookError(f"{source} is not an opening book (no {MAGIC!r} header)")
-    version, max_stones, count = struct.unpack("<BBI", data[4:10])
+    version = data[4]
     if version != VERSION:
         raise BookError(f"{source} is book version {version}; this code reads version {VERSION}: "
                         f"rebuild it with python -m ttt_sm.game.book")
+    _, max_stones, line_stones, count = struct.unpack(_HEADER, data[4:start])
     try:
-        payload = zlib.decompress(data[10:])
+        payload = zlib.decompress(data[start:])
     except zlib.error as exc:
         raise BookError(f"{source} is damaged: {exc}") from None
     if len(payload) != 9 * count:
@@ -129,7 +183,7 @@ def decode(data: bytes, source: str = "book") -> Book:
     keys = struct.unpack(f"<{count}Q", payload[:8 * count])
     values = payload[8 * count:]
     entries = {k: (v & 31, OUTCOMES[v >> 5]) for k, v in zip(keys, values, strict=True)}
-    return Book(max_stones, entries)
+    return Book(max_stones, line_stones, entries)
 
 
 def load_book(path: Path | str | None = None) -> Book:
@@ -145,19 +199,28 @@ def load_book(path: Path | str | None = None) -> Book:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m ttt_sm.game.book [--max-stones N] [--out FILE]``: build the book."""
-    p = argparse.ArgumentParser(prog="python -m ttt_sm.game.book", description=main.__doc__)
+    """``python -m ttt_sm.game.book [--max-stones N] [--line-stones M] [--known FILE] [--out FILE]``."""
+    p = argparse.ArgumentParser(prog="python -m ttt_sm.game.book",
+                                description="Build the strong engine's opening book (about half an hour).")
     p.add_argument("--max-stones", type=int, default=DEFAULT_MAX_STONES,
                    help=f"solve every position with up to this many marks (default {DEFAULT_MAX_STONES})")
+    p.add_argument("--line-stones", type=int, default=DEFAULT_LINE_STONES,
+                   help="and the second player's positions with this many marks when it follows the book "
+                        f"(odd; default {DEFAULT_LINE_STONES})")
+    p.add_argument("--known", default=None, help="reuse the entries of this book instead of solving them again")
     p.add_argument("--out", default=str(Path(__file__).with_name(BOOK_FILE)),
                    help="file to write (default: the packaged book.bin)")
     args = p.parse_args(argv)
+    if args.line_stones > args.max_stones and args.line_stones % 2 == 0:
+        p.error("--line-stones must be odd: the second player moves with an odd number of marks on the field")
     t0 = time.perf_counter()
-    book = build_book(args.max_stones, progress=lambda msg: print(msg, file=sys.stderr, flush=True))
+    known = load_book(args.known) if args.known else None
+    book = build_book(args.max_stones, args.line_stones, known=known,
+                      progress=lambda msg: print(msg, file=sys.stderr, flush=True))
     data = encode(book)
     Path(args.out).write_bytes(data)
-    print(f"{len(book)} positions up to {args.max_stones} marks, {len(data)} bytes, "
-          f"{time.perf_counter() - t0:.0f} s -> {args.out}")
+    print(f"{len(book)} positions (all up to {book.max_stones} marks, the second player's at "
+          f"{book.line_stones}), {len(data)} bytes, {time.perf_counter() - t0:.0f} s -> {args.out}")
     return 0
 
 

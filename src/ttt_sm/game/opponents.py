@@ -1,15 +1,17 @@
-"""Weak opponents for testing and benchmarking the engines: random and greedy players.
+"""Opponents for testing and benchmarking the engines: random, greedy and perfect-but-aimless players.
 
-Both are seeded, so a game against them is reproducible from the seed.
+All are seeded, so a game against them is reproducible from the seed.
 """
 
 from __future__ import annotations
 
 import random
 
-from .bitboard import bits, cell_of, win_cells
+from .bitboard import bits, canonical, cell_of, win_cells
+from .book import Book, load_book
 from .engine import Engine, GameOver, Move, prepare
 from .rules import Board, Symbol, other
+from .solver import Solver
 
 
 class RandomEngine:
@@ -63,3 +65,38 @@ class RandomOpening:
         if over is None and b.count(me) < self.plies:
             return self.random.move(b, me)
         return self.engine.move(b, me)
+
+
+class PerfectEngine:
+    """Plays a random move among those that do not lose: a perfect but aimless player.
+
+    A move loses if it leaves the other side a forced win: the opening book
+    says so for the first few marks, the solver after.
+    """
+
+    name = "perfect"
+
+    def __init__(self, seed: int = 0, book: Book | None = None) -> None:
+        self.rng = random.Random(seed)
+        self.book = load_book() if book is None else book
+        self.solver = Solver()
+
+    def move(self, board: Board | str, symbol: Symbol) -> Move | GameOver:
+        """A random cell after which the opponent cannot force a win (any cell if all lose)."""
+        b, me, over = prepare(board, symbol)
+        if over is not None:
+            return over
+        mine, theirs = b.marks(me), b.marks(other(me))
+        for cells in (win_cells(mine, theirs), win_cells(theirs, mine)):
+            if cells:
+                return Move(*cell_of(self.rng.choice(bits(cells))))
+        candidates = bits(b.empty_cells)
+        self.rng.shuffle(candidates)
+        for c in candidates:
+            after = mine | 1 << c
+            entry = self.book.get(canonical(theirs, after)[0])
+            opponent_wins = entry[1] == "win" if entry is not None else \
+                self.solver.attacker_wins(theirs, after, attacker_to_move=True)
+            if not opponent_wins:
+                return Move(*cell_of(c))
+        return Move(*cell_of(candidates[0]))

@@ -118,7 +118,7 @@ class StrongEngine:
         # positions get symmetric answers (what lets a proof check one per symmetry class).
         key, sym = canonical(mine, theirs)
         back = SYMMETRIES[INVERSE[sym]]
-        entry = self.book.get(key) if (mine | theirs).bit_count() <= self.book.max_stones else None
+        entry = self.book.get(key) if (mine | theirs).bit_count() <= self.book.line_stones else None
         if entry is not None:
             cell, outcome = entry
             return Analysis(Move(*cell_of(back[cell])), outcome, "book", 0)

@@ -13,9 +13,9 @@ from ttt_sm.game.book import (
     build_book,
     decode,
     encode,
+    engine_lines,
     load_book,
     positions,
-    second_player_lines,
 )
 from ttt_sm.game.solver import Solver
 
@@ -48,12 +48,12 @@ def sample(book: Book, per_level: int, seed: int, levels: range) -> list[tuple[i
     return chosen
 
 
-def test_the_book_covers_every_early_position_and_the_second_players_lines(book):
-    assert (book.max_stones, book.line_stones) == (4, 5)
+def test_the_book_covers_every_early_position_and_its_own_lines(book):
+    assert (book.max_stones, book.line_stones) == (4, 8)
     every = {mover | other << N_CELLS for _, mover, other in positions(book.max_stones)}
-    lines = second_player_lines(book.entries, book.line_stones)
-    assert len(every) == 10_660 and len(lines) == 869
-    assert set(book.entries) == every | lines
+    lines = {stones: engine_lines(book.entries, stones) for stones in range(5, 9)}
+    assert len(every) == 10_660 and [len(v) for v in lines.values()] == [869, 904, 6314, 2478]
+    assert set(book.entries) == every.union(*lines.values())
 
 
 def test_entries_re_prove_from_scratch(book):
@@ -93,7 +93,7 @@ def test_the_file_round_trips_and_damage_is_named(book, tmp_path):
 def test_the_book_rebuilds_to_the_same_answers(book):
     """Regenerating the first three levels (the search behind build_book) gives the shipped entries."""
     rebuilt = build_book(2, 3)  # levels 0-2, and the second player's positions at 3 marks
-    lines = second_player_lines(rebuilt.entries, 3)
+    lines = engine_lines(rebuilt.entries, 3)
     assert len(rebuilt) == 92 + len(lines)
     assert rebuilt.entries == {k: v for k, v in book.entries.items() if k.bit_count() <= 2 or k in lines}
 

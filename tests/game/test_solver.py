@@ -81,3 +81,9 @@ def test_the_empty_field_is_a_draw():
     """(5,5,4) is a draw: neither side can force four in a row from the empty field."""
     assert not Solver().attacker_wins(0, 0, attacker_to_move=True)
     assert not Solver().attacker_wins(0, 0, attacker_to_move=False)
+
+
+def test_a_finished_game_is_answered_directly():
+    four, three = 0b1111, 0b111 << 5
+    assert Solver().attacker_wins(four, three, attacker_to_move=False)
+    assert not Solver().attacker_wins(three, four, attacker_to_move=True)

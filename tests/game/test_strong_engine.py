@@ -86,7 +86,7 @@ def test_it_never_loses_in_40_games():
     assert len(results) == 41
     for kind, record in results:
         assert record.loser_engine() != "strong" or kind == "strong", (kind, str(record.final))
-    assert {kind for kind, _ in results} == {"random", "greedy", "thesis", "strong"}
+    assert {kind for kind, _ in results} == {"random", "greedy", "thesis", "perfect", "strong"}
 
 
 @pytest.mark.parametrize("first", ["X", "O"])

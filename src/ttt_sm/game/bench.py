@@ -2,7 +2,8 @@
 
 The strong engine plays both symbols against random players, greedy players
 (win if possible, block if needed), the thesis engine (its first move at
-random, so the games differ) and itself; the numbers are the targets of the
+random, so the games differ), perfect-but-aimless players (never a losing
+move) and itself; the numbers are the targets of the
 issue: the strong engine's start-up time and its 95th-percentile move time,
 the thesis engine's move time, and the strong engine's losses (always 0).
 """
@@ -16,24 +17,37 @@ from typing import Any
 
 import numpy as np
 
+from .book import Book, load_book
 from .engine import Engine
 from .match import GameRecord, play_game
-from .opponents import GreedyEngine, RandomEngine, RandomOpening
+from .opponents import GreedyEngine, PerfectEngine, RandomEngine, RandomOpening
 from .rules import Board
 from .strong_engine import StrongEngine
 from .thesis_engine import ThesisEngine
 
+KINDS = ("random", "greedy", "thesis", "perfect", "random", "greedy", "thesis", "perfect", "random", "greedy")
+"""The opponents in turn: 30 % random, 30 % greedy, 20 % thesis, 20 % perfect."""
 
-def opponents(games: int, seed: int) -> Iterator[tuple[str, Engine]]:
-    """``games`` seeded opponents for the strong engine: 40 % random, 40 % greedy, 20 % thesis."""
+
+def opponents(games: int, seed: int, book: Book | None = None) -> Iterator[tuple[str, Engine]]:
+    """``games`` seeded opponents for the strong engine, of the :data:`KINDS` in turn.
+
+    ``thesis`` plays its first move at random (else every game against it
+    would be the same); ``perfect`` never makes a losing move but aims at
+    nothing (the longest games); ``book`` is the one it reads (default: the
+    packaged one, loaded once).
+    """
     rng = random.Random(seed)
+    book = load_book() if book is None else book
     for i in range(games):
         s = rng.randrange(1 << 30)
-        kind = ("random", "greedy", "random", "greedy", "thesis")[i % 5]
+        kind = KINDS[i % len(KINDS)]
         if kind == "random":
             yield kind, RandomEngine(s)
         elif kind == "greedy":
             yield kind, GreedyEngine(s)
+        elif kind == "perfect":
+            yield kind, PerfectEngine(s, book)
         else:
             yield kind, RandomOpening(ThesisEngine(), plies=1, seed=s)
 
@@ -67,7 +81,7 @@ def bench_ai(seed: int = 0, games: int = 100, progress: Callable[[str], None] | 
     strong_ms: list[float] = []
     thesis_ms: list[float] = []
     wins = draws = losses = 0
-    losses_by: dict[str, int] = {"random": 0, "greedy": 0, "thesis": 0}
+    losses_by: dict[str, int] = {"random": 0, "greedy": 0, "thesis": 0, "perfect": 0}
     n = 0
     self_play = "not played"
     for kind, record in strength_games(strong, games, seed, progress):

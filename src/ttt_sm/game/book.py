@@ -5,9 +5,9 @@ to the opening move most of all), so the book holds, up to the eight
 symmetries, the cell to play and the exact outcome for the player to move in
 
 * every position with up to ``max_stones`` marks that a game can reach, and
-* every position with ``line_stones`` marks that the *second* player meets
-  when it follows the book and the first player plays anything (the second
-  player's third move is the next most expensive search).
+* every position with more marks, up to ``line_stones``, that a player
+  meets when it follows the book and the other plays anything (its *lines*;
+  they are few, and there the search still costs up to a few hundred ms).
 
 It is built by :func:`build_book` (``python -m ttt_sm.game.book``) with the
 same :func:`~ttt_sm.game.strong_engine.choose` the engine uses, searching
@@ -43,7 +43,7 @@ MAGIC = b"TTTB"
 VERSION = 2
 BOOK_FILE = "book.bin"
 DEFAULT_MAX_STONES = 4
-DEFAULT_LINE_STONES = 5
+DEFAULT_LINE_STONES = 8
 _HEADER = "<BBBI"
 
 
@@ -55,7 +55,7 @@ class BookError(ValueError):
 class Book:
     """Solved positions: canonical key -> (cell in the canonical frame, outcome for the mover).
 
-    Complete up to ``max_stones`` marks; entries up to ``line_stones`` marks.
+    Complete up to ``max_stones`` marks; a book-following player's lines up to ``line_stones`` marks.
     """
 
     max_stones: int
@@ -95,35 +95,30 @@ def positions(max_stones: int) -> Iterator[tuple[int, int, int]]:
         level = nxt
 
 
-def second_player_lines(entries: dict[int, tuple[int, Outcome]], line_stones: int) -> set[int]:
-    """Canonical keys of the positions with ``line_stones`` (odd) marks that the second player meets.
+def engine_lines(entries: dict[int, tuple[int, Outcome]], stones: int) -> set[int]:
+    """Canonical keys of the positions with ``stones`` marks met by a player that follows the book.
 
-    The first player tries every cell; the second answers from ``entries``
-    (which must hold its positions with fewer marks).  Lines that end in a
-    four before ``line_stones`` marks are dropped.
+    That player moves when the field holds as many marks as ``stones`` modulo
+    two (first player: even, second: odd) and answers from ``entries``
+    (which must hold its positions with fewer marks); the other player tries
+    every cell.  Lines that end in a four are dropped.
     """
-    to_move_first = {canonical(0, 0)[0]}
-    for stones in range(0, line_stones, 2):
-        second: set[int] = set()
-        for key in to_move_first:
+    level = {canonical(0, 0)[0]}
+    for k in range(stones):
+        nxt: set[int] = set()
+        for key in level:
             mover, other = key & FULL, key >> N_CELLS
-            for c in bits(FULL & ~(mover | other)):
+            cells = [entries[key][0]] if k % 2 == stones % 2 else bits(FULL & ~(mover | other))
+            for c in cells:
                 if not has_four(mover | 1 << c):
-                    second.add(canonical(other, mover | 1 << c)[0])
-        if stones + 1 == line_stones:
-            return second
-        to_move_first = set()
-        for key in second:
-            mover, other = key & FULL, key >> N_CELLS
-            placed = mover | 1 << entries[key][0]
-            if not has_four(placed):
-                to_move_first.add(canonical(other, placed)[0])
-    return set()
+                    nxt.add(canonical(other, mover | 1 << c)[0])
+        level = nxt
+    return level
 
 
 def build_book(max_stones: int = DEFAULT_MAX_STONES, line_stones: int = DEFAULT_LINE_STONES,
                progress: Callable[[str], None] | None = None, known: Book | None = None) -> Book:
-    """Solve every position of :func:`positions` and :func:`second_player_lines` with one shared table.
+    """Solve every position of :func:`positions` and :func:`engine_lines` with one shared table.
 
     ``known`` entries are taken as they are instead of solved again (to extend
     a book; :func:`choose` is deterministic, so the result is the same).
@@ -148,9 +143,9 @@ def build_book(max_stones: int = DEFAULT_MAX_STONES, line_stones: int = DEFAULT_
 
     for stones, mover, other in positions(max_stones):
         solve(stones, mover, other)
-    if line_stones > max_stones:
-        for key in sorted(second_player_lines(entries, line_stones)):
-            solve(line_stones, key & FULL, key >> N_CELLS)
+    for stones in range(max_stones + 1, line_stones + 1):
+        for key in sorted(engine_lines(entries, stones)):
+            solve(stones, key & FULL, key >> N_CELLS)
     return Book(max_stones, max(line_stones, max_stones), entries)
 
 
@@ -205,21 +200,19 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--max-stones", type=int, default=DEFAULT_MAX_STONES,
                    help=f"solve every position with up to this many marks (default {DEFAULT_MAX_STONES})")
     p.add_argument("--line-stones", type=int, default=DEFAULT_LINE_STONES,
-                   help="and the second player's positions with this many marks when it follows the book "
-                        f"(odd; default {DEFAULT_LINE_STONES})")
+                   help="and the positions up to this many marks a player meets when it follows the book "
+                        f"(default {DEFAULT_LINE_STONES})")
     p.add_argument("--known", default=None, help="reuse the entries of this book instead of solving them again")
     p.add_argument("--out", default=str(Path(__file__).with_name(BOOK_FILE)),
                    help="file to write (default: the packaged book.bin)")
     args = p.parse_args(argv)
-    if args.line_stones > args.max_stones and args.line_stones % 2 == 0:
-        p.error("--line-stones must be odd: the second player moves with an odd number of marks on the field")
     t0 = time.perf_counter()
     known = load_book(args.known) if args.known else None
     book = build_book(args.max_stones, args.line_stones, known=known,
                       progress=lambda msg: print(msg, file=sys.stderr, flush=True))
     data = encode(book)
     Path(args.out).write_bytes(data)
-    print(f"{len(book)} positions (all up to {book.max_stones} marks, the second player's at "
+    print(f"{len(book)} positions (all up to {book.max_stones} marks, the book's lines up to "
           f"{book.line_stones}), {len(data)} bytes, {time.perf_counter() - t0:.0f} s -> {args.out}")
     return 0
 

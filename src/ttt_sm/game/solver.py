@@ -26,7 +26,7 @@ field is about 0.6 million nodes, a few seconds):
 
 from __future__ import annotations
 
-from .bitboard import CELL_LINES, FULL, LINE_MASKS, LINES, N_CELLS, canonical
+from .bitboard import CELL_LINES, FULL, LINE_MASKS, LINES, N_CELLS, canonical, has_four
 
 CANON_UPTO = 12
 """Fold positions with this many marks or fewer under the symmetries (deeper, the look-up costs more than it saves)."""
@@ -84,6 +84,8 @@ class Solver:
 
     def attacker_wins(self, attacker: int, defender: int, attacker_to_move: bool) -> bool:
         """True if ``attacker`` can force four in a row from this position, whatever ``defender`` plays."""
+        if has_four(attacker) or has_four(defender):  # the search below assumes nobody has won yet
+            return has_four(attacker)
         if len(self.table) >= self.max_entries:
             self.table.clear()
         return self._search(attacker, defender, attacker_to_move, (attacker | defender).bit_count())

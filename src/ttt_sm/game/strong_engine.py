@@ -5,13 +5,14 @@ the opponent from forcing a win if it starts from a position that is not
 lost.  Each move it
 
 1. completes its own four if it can;
-2. folds the position under the eight symmetries of the square (answering
-   for one image and mapping the cell back) and reads the answer from the
-   opening book (:mod:`ttt_sm.game.book`) while
-   the field holds few marks: every position up to ``book.max_stones``
-   marks, solved exactly by :func:`choose` offline, because there the
-   search costs seconds;
-3. otherwise searches the candidates (the single cell that blocks an
+2. folds the position under the eight symmetries of the square, decides for
+   the canonical image and maps the cell back (so symmetric positions get
+   symmetric answers);
+3. reads the answer from the opening book (:mod:`ttt_sm.game.book`) if it
+   has it: every position up to 4 marks, and the positions up to 8 marks
+   that a player following the book meets, solved exactly offline by
+   :func:`choose`, because there the search costs up to seconds;
+4. otherwise searches the candidates (the single cell that blocks an
    opponent's threat, else every empty cell, best first):
 
    a. for a forced win, within a node budget, so a move stays fast; the
@@ -28,7 +29,6 @@ only from a position given to the engine already lost).
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 from typing import Literal
 
@@ -125,9 +125,3 @@ class StrongEngine:
         cell, outcome, nodes = choose(self.solver, key & FULL, key >> N_CELLS, self.win_budget)
         return Analysis(Move(*cell_of(back[cell])), outcome, "search", nodes)
 
-
-def timed_move(engine: StrongEngine, board: Board | str, symbol: Symbol) -> tuple[Analysis | GameOver, float]:
-    """:meth:`StrongEngine.analyse` and its wall time in milliseconds."""
-    t0 = time.perf_counter()
-    result = engine.analyse(board, symbol)
-    return result, (time.perf_counter() - t0) * 1000.0

@@ -51,6 +51,32 @@ def test_a_whole_game_reads_every_move_right_through_the_serial_camera(serial_ga
     assert link["frames_ok"] >= len(report["moves"]) and not link["rejected"]
 
 
+def test_the_camera_link_photographs_once_per_reading_and_asks_again_for_a_lost_photo():
+    from ttt_sm.app.camera_link import CameraLink
+    from ttt_sm.seriallink import Fault
+    from ttt_sm.twin.whiteboard import Whiteboard
+    from ttt_sm.vision.scenes import draw_field
+
+    board = Whiteboard(P, seed=2)
+    draw_field(board)
+    link = CameraLink(P, board, seed=2, mode="serial")
+    try:
+        first, _ = link.read()
+        # the photo for the second or the third reading is garbled on the line
+        link._emulator.inject(Fault.corrupt_checksum())
+        link.read()
+        board.draw_symbol("X", 2, 3)
+        percentages, symbols = link.read()
+        stats = link.stats()
+        assert link._emulator.faults_pending == 0
+    finally:
+        link.close()
+    # one photo per reading (none while the simulation had the board), one more for the lost one
+    assert sum(stats["rejected"].values()) == 1 and stats["frames_ok"] == 3
+    cell = 1 * 5 + 2  # row 2, column 3 in board order
+    assert percentages[cell] > first[cell] + 5 and symbols is not None and symbols[cell] == "X"
+
+
 def test_the_strong_engine_does_not_lose_and_the_board_is_erased(serial_game):
     session, report, _ = serial_game
     assert report["winner"] in ("robot", "draw")

@@ -9,8 +9,11 @@ Two ways to get the 25 per-cell percentages of the board (thesis 3.6.3):
   (:class:`ttt_sm.seriallink.SerialCameraReader`), as the thesis' PC did.
 
 The simulation and the camera thread share the whiteboard: the camera only
-photographs while the simulation is paused (a lock), and a reading taken for
-a decision is always a frame photographed after the last change.
+photographs while the simulation is paused for a reading (a lock, and an event
+that says a reading is wanted), and a reading taken for a decision is always a
+frame photographed after the last change.  Between readings the camera waits:
+a frame photographed while the game thread takes the board back would only
+cost it time.
 """
 
 from __future__ import annotations
@@ -27,6 +30,9 @@ from ..twin.whiteboard import Whiteboard
 from ..vision import Detection, board_text, board_values, detect
 from ..vision.simulated import SimulatedCamera
 
+#: A reading asks the camera for another photo when none arrived for this long, s.
+REASK_S = 0.5
+
 
 class CameraLink:
     """Per-cell percentages of the board, in board order, from a photo taken now."""
@@ -40,6 +46,7 @@ class CameraLink:
         self.view = self.camera.view()
         self.lock = threading.Lock()
         self.lock.acquire()  # held by the simulation; released only while reading
+        self._wanted = threading.Event()  # set while a reading waits for its fresh frame
         self.read_wall_s = 0.0  # wall time spent waiting for photos
         self._closing = False
         self._last_percentages: list[float] = [0.0] * 25
@@ -55,13 +62,19 @@ class CameraLink:
         from ..seriallink import CameraEmulator, SerialCameraReader
 
         def source() -> list[float]:
-            with self.lock:  # never photograph a board the simulation is writing
-                if self._closing:
-                    return list(self._last_percentages)
-                d = detect(self.camera.frame())  # no frame (and no sequence number) if this raises
-                # The emulator numbers frames 0, 1, 2 ... in the order they are made.
-                self._symbols_by_seq[self._made % SEQ_MODULUS] = d.cells
-                self._made += 1
+            while True:
+                self._wanted.wait()
+                with self.lock:  # never photograph a board the simulation is writing
+                    if self._closing:
+                        return list(self._last_percentages)
+                    if not self._wanted.is_set():
+                        continue  # the reading got its frame while this one waited for the board
+                    self._wanted.clear()  # one photo per request: the reading asks again if it is lost
+                    d = detect(self.camera.frame())  # no frame (and no sequence number) if this raises
+                    # The emulator numbers frames 0, 1, 2 ... in the order they are made.
+                    self._symbols_by_seq[self._made % SEQ_MODULUS] = d.cells
+                    self._made += 1
+                break
             self._last_percentages = [float(p) for p in d.percentages]
             return self._last_percentages
 
@@ -89,16 +102,22 @@ class CameraLink:
         # Frames photographed before now may still wait in the port: only a
         # frame numbered from `fresh` on shows the board as it is now.
         fresh = self._made
+        self._wanted.set()
         self.lock.release()
         try:
             deadline = time.monotonic() + 10.0
             while True:
-                frame = self._reader.read_frame(max(0.0, deadline - time.monotonic()))
+                left = deadline - time.monotonic()
+                frame = self._reader.read_frame(max(0.0, min(left, REASK_S)))
                 if frame is None:
-                    raise TimeoutError("the camera sent no fresh frame for 10 s")
+                    if left <= REASK_S:
+                        raise TimeoutError("the camera sent no fresh frame for 10 s")
+                    self._wanted.set()  # the photo may have been lost on the line: ask again
+                    continue
                 if (frame.seq - fresh) % SEQ_MODULUS < SEQ_MODULUS // 2:
                     break
         finally:
+            self._wanted.clear()
             self.lock.acquire()
         cells = self._symbols_by_seq.pop(frame.seq, None)
         self._symbols_by_seq.clear()
@@ -120,6 +139,7 @@ class CameraLink:
             self._reader.close()
         if self._emulator is not None:
             self._closing = True  # the camera thread stops photographing ...
+            self._wanted.set()
             if self.lock.locked():
                 self.lock.release()  # ... and may finish the frame it was waiting to take
             self._emulator.stop()

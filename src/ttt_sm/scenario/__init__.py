@@ -6,7 +6,8 @@ entered in order, conditions on chart data and signals).  It is a test and a
 piece of documentation: ``tests/scenarios/drive_1_turns_back_at_a_hard_stop.yaml``.
 
 - :mod:`.source`: YAML with line numbers (a ``SafeLoader`` subclass);
-- :mod:`.expr`: the condition language (parsed, never ``eval``-ed);
+- :mod:`ttt_sm.runtime.conditions`: the condition language (parsed, never ``eval``-ed),
+  shared with the debugger's ``break when``;
 - :mod:`.model`, :mod:`.loader`: the steps, checked against the charts;
 - :mod:`.runner`: runs a scenario on the simulated robot; :mod:`.suite`: several, with coverage;
 - :mod:`.cli`: ``ttt-sm scenario run``; :mod:`.pytest_plugin`: YAML files as tests.
@@ -14,8 +15,8 @@ piece of documentation: ``tests/scenarios/drive_1_turns_back_at_a_hard_stop.yaml
 See ``docs/scenarios.md``.
 """
 
+from ..runtime.conditions import ExprError, Expression, Ref, parse
 from .errors import ScenarioError
-from .expr import ExprError, Expression, Ref, parse
 from .loader import load_scenario, load_scenario_text, scenario_files
 from .model import SIGNALS, Catalog, Scenario
 from .runner import Failure, ScenarioResult, run_scenario

@@ -22,8 +22,8 @@ from pathlib import Path
 from typing import Any
 
 from ..runtime import TickChart
+from ..runtime.conditions import KEYWORDS, ExprError, Expression, parse
 from .errors import ScenarioError
-from .expr import KEYWORDS, ExprError, Expression, parse
 from .model import (
     BareCharts,
     Catalog,

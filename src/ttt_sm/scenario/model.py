@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from ..runtime import TickChart
-from .expr import Expression
+from ..runtime.conditions import Expression
 
 #: Signals a condition may read (``Robot.signal_values()``): name -> vector length, None for a scalar.
 #: SI units: seconds, radians, metres, amperes.  Elements are numbered from 1: ``q_true[1]`` is q1.

@@ -28,8 +28,8 @@ import numpy as np
 
 from ..params import ArmParams
 from ..runtime import TickChart, states_entered_by
+from ..runtime.conditions import ExprError, Expression, Ref
 from ..runtime.listeners import Coverage
-from .expr import ExprError, Expression, Ref
 from .model import (
     BareCharts,
     ChartRef,

@@ -1,4 +1,4 @@
-"""The condition language of scenarios: parsed, never eval-ed."""
+"""The condition language of scenarios and debugger breakpoints: parsed, never eval-ed."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from ttt_sm.scenario.expr import ExprError, Ref, parse
+from ttt_sm.runtime.conditions import ExprError, Ref, parse
 
 VALUES = {
     "DriveInit1.ini_23": True,

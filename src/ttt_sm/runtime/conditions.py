@@ -1,6 +1,6 @@
-"""A tiny, safe expression language for scenario conditions (no ``eval``).
+"""Conditions over chart data and signals: a tiny, safe expression language (no ``eval``).
 
-Conditions in scenario files read like Python but can only *look*:
+Conditions read like Python but can only *look*:
 
     DriveInit1.ini_23 == true and abs(q_true[1] + 100deg) < 0.5deg
 

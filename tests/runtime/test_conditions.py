@@ -94,14 +94,17 @@ def test_and_or_short_circuit() -> None:
     ("x = 1", "use == to compare", 3),
     ("a && b", "use 'and'", 3),
     ("(1 + 2", "expected ')'", 7),
-    ("1 2", "unexpected '2'", 3),
+    ("1 2", "unexpected '2'; expected 'and', 'or', an operator or the end", 3),
+    ("C.x > 1 )", "unexpected ')'", 9),
     ("sqrt(2)", "unknown function 'sqrt'", 1),
     ("abs(1, 2)", "abs() takes 1 argument(s), got 2", 1),
     ("min(1)", "min() takes 2 or more arguments", 1),
-    ("q_true[x]", "expected an element number", 8),
+    ("q_true[x]", "expected an element number (1, 2, ...) inside [ ], found 'x'", 8),
+    ("q_true[1.5]", "found '1.5'", 8),
     ("q_true[1", "expected ']'", 9),
     ("5 furlongs", "unknown unit 'furlongs'", 3),
     ("DriveInit1.", "expected a datum or state name", 12),
+    ("DriveInit1.pos.x > 1", "a name has one dot at most (Chart.name): DriveInit1.pos is followed by '.'", 15),
     ("and 1", "'and' needs something before it", 1),
     ("__import__('os')", "unknown function '__import__'", 1),
     ("C.message == 'You win.", "unexpected character \"'\" (text in quotes ends with the quote it starts"
@@ -113,6 +116,19 @@ def test_syntax_errors_name_the_column(text: str, message: str, column: int) -> 
         parse(text)
     assert message in str(info.value)
     assert info.value.column == column
+
+
+def test_the_message_says_the_column_and_quotes_the_condition() -> None:
+    with pytest.raises(ExprError) as info:
+        parse("C.x > > 1")
+    assert str(info.value) == "expected a number, a name or '(', found '>' at column 7 in 'C.x > > 1'"
+    assert (info.value.message, info.value.text) == ("expected a number, a name or '(', found '>'", "C.x > > 1")
+
+
+def test_names_are_identifiers_as_in_python() -> None:
+    assert parse("Δq_1 > 0 and Chart_2.x_y").refs == (Ref(None, "Δq_1", None, 1), Ref("Chart_2", "x_y", None, 14))
+    with pytest.raises(ExprError, match="unknown unit '_x'"):
+        parse("1_x")  # a name cannot start with a digit: 1 then an unknown unit
 
 
 def test_nothing_is_executed() -> None:

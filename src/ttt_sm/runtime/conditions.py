@@ -95,7 +95,7 @@ _TOKEN = re.compile(r"""
     (?P<space>\s+)
   | (?P<text>"[^"]*"|'[^']*')
   | (?P<number>(?:\d+\.\d*|\.\d+|\d+)(?:[eE][+-]?\d+)?)
-  | (?P<name>[A-Za-z_][A-Za-z_0-9]*)
+  | (?P<name>[^\W\d]\w*)  # an identifier, as in Python
   | (?P<op>==|!=|<=|>=|<|>|\+|-|\*|/|\(|\)|\[|\]|\.|,)
 """, re.VERBOSE)
 _UNCLOSED = "text in quotes ends with the quote it starts with"
@@ -149,6 +149,10 @@ class _Parser:
     def error(self, message: str, tok: _Tok | None = None) -> ExprError:
         return ExprError(message, self.text, (tok or self.tok).column)
 
+    @property
+    def found(self) -> str:
+        return repr(self.tok.text) if self.tok.kind != "end" else "the end"
+
     def take(self, text: str) -> bool:
         if self.tok.text == text and self.tok.kind in ("op", "name"):
             self.pos += 1
@@ -157,15 +161,14 @@ class _Parser:
 
     def expect(self, text: str, what: str) -> None:
         if not self.take(text):
-            found = repr(self.tok.text) if self.tok.kind != "end" else "the end"
-            raise self.error(f"expected {what}, found {found}")
+            raise self.error(f"expected {what}, found {self.found}")
 
     def parse(self) -> Node:
         if self.tok.kind == "end":
             raise self.error("empty condition")
         node = self.parse_or()
         if self.tok.kind != "end":
-            raise self.error(f"unexpected {self.tok.text!r}")
+            raise self.error(f"unexpected {self.tok.text!r}; expected 'and', 'or', an operator or the end")
         return node
 
     def parse_or(self) -> Node:
@@ -235,8 +238,7 @@ class _Parser:
             self.expect(")", "')'")
             return node
         if tok.kind != "name":
-            found = repr(tok.text) if tok.kind != "end" else "the end"
-            raise self.error(f"expected a number, a name or '(', found {found}")
+            raise self.error(f"expected a number, a name or '(', found {self.found}")
         self.pos += 1
         if tok.text in ("true", "True"):
             return ("const", True)
@@ -253,10 +255,12 @@ class _Parser:
                 raise self.error(f"expected a datum or state name after '{tok.text}.'")
             chart, name = tok.text, self.tok.text
             self.pos += 1
+            if self.tok.text == "." and self.tok.kind == "op":
+                raise self.error(f"a name has one dot at most (Chart.name): {chart}.{name} is followed by '.'")
         index: int | None = None
         if self.take("["):
             if self.tok.kind != "number" or not self.tok.text.isdigit():
-                raise self.error("expected an element number (1, 2, ...) inside [ ]")
+                raise self.error(f"expected an element number (1, 2, ...) inside [ ], found {self.found}")
             index = int(self.tok.text)
             self.pos += 1
             self.expect("]", "']'")

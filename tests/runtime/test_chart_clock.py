@@ -278,3 +278,27 @@ def test_a_chain_of_guards_that_all_hold_is_walked_one_transition_per_tick():
     chain.tick()
     assert chain.configuration_values == {"c"} and listener.taken == [("a", "b"), ("b", "c")]
     assert chain.tick() is None
+
+
+def test_active_ids_follow_the_configuration_through_ticks_sends_and_posted_events():
+    lamp = Lamp()
+    seen = []
+
+    def check() -> None:
+        assert lamp.active_ids == frozenset(lamp.configuration_values)
+        seen.append(lamp.active_ids)
+
+    check()  # before the first tick
+    lamp.switch = True
+    lamp.tick()
+    check()  # a tick transition into the compound
+    lamp.bright_req = True
+    lamp.tick()
+    check()
+    lamp.send("button")  # straight through the library, between ticks
+    check()
+    lamp.post("button")
+    lamp.tick()  # a posted event (into on.dim), then the tick transition on to bright
+    check()
+    assert seen == [frozenset({"off"}), frozenset({"on", "dim"}), frozenset({"on", "bright"}),
+                    frozenset({"off"}), frozenset({"on", "bright"})]

@@ -69,7 +69,7 @@ class ControlStage:
         if not math.isfinite(servo):
             servo = float(sim.q_true[3])
         x, y, z, _ = _fk_python(q1, q2, q3, servo, *self._geometry)
-        if self.erase_requested and "turn_pen" in c.configuration_values:
+        if self.erase_requested and "turn_pen" in c.active_ids:
             self.erase_requested = False
         # plain attribute writes: this runs every chart step
         vars(c).update(X_now=x, Y_now=y, Z_now=z, initialised=self.init.done, erase=self.erase_requested)

@@ -195,7 +195,7 @@ class DrawSession:
         self.say = progress or (lambda _m: None)
 
     def _control_in(self, state: str) -> bool:
-        return state in self.robot.control.configuration_values
+        return state in self.robot.control.active_ids
 
     def run_to_wait(self, timeout_s: float) -> None:
         """Run until the Control chart waits in wait_1 (raises DrawError on timeout)."""

@@ -136,16 +136,18 @@ class GameStage:
 
     def __init__(self, session: GameSession) -> None:
         self.s = session
+        self.game_inputs = vars(session.game)  # plain attribute writes: this runs every chart step
+        self.activator_inputs = vars(session.activator)
 
     def tick(self, signals: Signals) -> None:
         s = self.s
         r, c = s.robot, s.robot.control
-        active = c.configuration_values
-        ready = "wait_1" in active and bool(c.Pl_fld)
+        active = c.active_ids
+        waiting = "wait_1" in active
         g = s.game
-        vars(g).update(initialised=r.initialised, ready=ready, busy="wait_1" not in active,
-                       result=s.result_code, erased=s.erased_seen, play_again=False,
-                       finished="finished" in active)
+        self.game_inputs.update(initialised=r.init_stage.done, ready=waiting and bool(c.Pl_fld),
+                                busy=not waiting, result=s.result_code, erased=s.erased_seen,
+                                play_again=False, finished="finished" in active)
         g.tick()
         if g.erase and not r.control_stage.erase_requested and not s.erase_started:
             r.control_stage.erase_requested = True
@@ -155,7 +157,7 @@ class GameStage:
         if g.finish:
             c.finish = True
         a = s.activator
-        a.o_pos = s.o_pos
+        self.activator_inputs["o_pos"] = s.o_pos
         a.tick()
         if a.enable:
             s.robot_turn_now()
@@ -235,7 +237,7 @@ class GameSession:
 
     def _waiting(self) -> bool:
         c = self.robot.control
-        return "wait_1" in c.configuration_values and bool(c.Pl_fld)
+        return "wait_1" in c.active_ids and bool(c.Pl_fld)
 
     def _place(self, cell: Cell, symbol: str, which: str) -> None:
         i = cell_index(*cell)
@@ -271,7 +273,7 @@ class GameSession:
         self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3}.get(outcome, 3)
         self.record.add(robot.t, "result", outcome=outcome)
         self.say(f"result: {outcome}; erasing and turning off")
-        self._run_until(lambda: "off" in self.game.configuration_values, 600.0, "erasing and turning off")
+        self._run_until(lambda: "off" in self.game.active_ids, 600.0, "erasing and turning off")
         wall = time.perf_counter() - wall0
         ink_left = robot.board.ink_area_mm2()
         winner = {self.robot_symbol: "robot", self.person_symbol: "person"}.get(outcome, outcome)

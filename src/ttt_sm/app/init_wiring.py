@@ -66,8 +66,8 @@ class DriveInitStage:
 
     def _update_status(self) -> None:
         # Reading the configuration costs microseconds: only after a transition.
-        self.done = all("pass_pos" in c.configuration_values for c in self.charts)
-        self.failed = any("failed" in c.configuration_values for c in self.charts)
+        self.done = all("pass_pos" in c.active_ids for c in self.charts)
+        self.failed = any("failed" in c.active_ids for c in self.charts)
 
     def tick(self, signals: Signals) -> None:
         """Encoder blocks in, charts ticked, offsets applied, pos_out out."""

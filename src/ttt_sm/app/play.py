@@ -85,7 +85,7 @@ def game_motion(params: ArmParams, seed: int = 0, symbols: int = 12) -> dict[str
     wall0 = time.perf_counter()
 
     def waiting() -> bool:
-        return "wait_1" in c.configuration_values and c.Pl_fld
+        return "wait_1" in c.active_ids and c.Pl_fld
 
     if not robot.run_until(waiting, 200.0):
         raise DrawError("the field was not drawn within 200 s")
@@ -96,11 +96,11 @@ def game_motion(params: ArmParams, seed: int = 0, symbols: int = 12) -> dict[str
         robot.post("Control", "button")
         robot.chart_step()
         robot.chart_step()
-        if not robot.run_until(lambda: "wait_1" in c.configuration_values, 60.0):
+        if not robot.run_until(lambda: "wait_1" in c.active_ids, 60.0):
             raise DrawError(f"symbol {k + 1} did not finish within 60 s")
     robot.control_stage.erase_requested = True
-    robot.run_until(lambda: "Erase" in c.configuration_values, 10.0)
-    if not robot.run_until(lambda: "go_wait" in c.configuration_values, 300.0):
+    robot.run_until(lambda: "Erase" in c.active_ids, 10.0)
+    if not robot.run_until(lambda: "go_wait" in c.active_ids, 300.0):
         raise DrawError("erasing did not finish within 300 s")
     wall = time.perf_counter() - wall0
     return {

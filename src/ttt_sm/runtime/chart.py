@@ -50,7 +50,9 @@ from .structure import (
 from .temporal import temporal_of
 
 _NO_PLAN = object()
-_Plan = tuple[tuple[tuple[Guard | None, str, Transition], ...], tuple[Callable[[], Any], ...]]
+# What a tick does in one configuration: the tick transitions to try (in order),
+# the during actions, and the active state ids.
+_Plan = tuple[tuple[tuple[Guard | None, str, Transition], ...], tuple[Callable[[], Any], ...], frozenset[str]]
 
 
 class TickChartMeta(StateMachineMetaclass):
@@ -219,9 +221,9 @@ class TickChart(StateChart, metaclass=TickChartMeta):
             self._handle_posted_events()
         raw = getattr(d["model"], d["state_field"])
         if raw is d["_plan_key"]:
-            candidates, durings = d["_plan"]
+            candidates, durings, _ = d["_plan"]
         else:
-            candidates, durings = self._load_plan(raw)
+            candidates, durings, _ = self._load_plan(raw)
         for guard, event, transition in candidates:
             if guard is None or guard():
                 self._take(event, transition)
@@ -229,6 +231,16 @@ class TickChart(StateChart, metaclass=TickChartMeta):
         for during in durings:
             during()
         return None
+
+    @property
+    def active_ids(self) -> frozenset[str]:
+        """The ids of the active states: ``configuration_values`` as a frozenset, cached per
+        configuration (a tenth of its cost: wiring code asks every chart step)."""
+        d = self.__dict__
+        raw = getattr(d["model"], d["state_field"])
+        if raw is d["_plan_key"]:
+            return d["_plan"][2]
+        return self._load_plan(raw)[2]
 
     def run_ticks(self, n: int) -> int:
         """Tick ``n`` times; return how many tick transitions were taken."""
@@ -322,7 +334,7 @@ class TickChart(StateChart, metaclass=TickChartMeta):
                 candidates.append((guards[id(t)], info.tick_event, t))
             for name in state.during:
                 durings.append(getattr(self, name))
-        return tuple(candidates), tuple(durings)
+        return tuple(candidates), tuple(durings), frozenset(active)
 
     def guard_paths(self) -> dict[str, str]:
         """For each tick transition, whether its guard runs as a plain call (``fast``) or

@@ -193,7 +193,7 @@ class Scheduler:
             s.ik_iterations = 0
         elif math.isfinite(pose[0] + pose[1] + pose[2] + pose[3]):
             try:
-                result = self.ik.solve(task)
+                q_ik, s.ik_iterations = self.ik.solve_pose(*pose)
             except IKError as exc:
                 # Unreachable pose: hold the last good joint setpoints (a safe
                 # state) and report; never pass a wrong answer to the drives.
@@ -201,9 +201,8 @@ class Scheduler:
                 s.ik_error = str(exc)
                 s.q_des = self._hold.copy()
             else:
-                s.q_des = result.q
-                s.ik_iterations = result.iterations
-                self._ik_pose, self._ik_q = pose, result.q
+                s.q_des = q_ik
+                self._ik_pose, self._ik_q = pose, q_ik
         else:
             s.q_des = self._hold.copy()
         s.q_set = s.q_des

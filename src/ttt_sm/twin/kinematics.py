@@ -502,6 +502,17 @@ def damped_least_squares(target: Any, q0: Any, geometry: Geometry, ik: IKParams,
     return IKResult(q, int(iterations), float(residual), converged)
 
 
+@numba.njit(cache=True)
+def _solve_pose_kernel(x: float, y: float, z: float, phi: float, q0: np.ndarray, geom: np.ndarray,
+                       q_min: np.ndarray, q_max: np.ndarray, damping: float, tolerance: float,
+                       max_iterations: int, adaptive: bool) -> tuple[np.ndarray, int, float, int]:
+    """:func:`_dls_kernel` then :func:`_unwind`, in one call: the control loop's warm solve."""
+    target = np.empty(4)
+    target[0], target[1], target[2], target[3] = x, y, z, phi
+    q, iterations, residual = _dls_kernel(target, q0, geom, damping, tolerance, max_iterations, adaptive)
+    return q, iterations, residual, _unwind(q, q_min, q_max)
+
+
 # --------------------------------------------------------------------------- solver for the control loop
 
 class IKSolver:
@@ -529,6 +540,8 @@ class IKSolver:
         self._q_min = np.array(params.joint_min)
         self._q_max = np.array(params.joint_max)
         self._last_q: np.ndarray | None = None
+        ik = params.ik
+        self._settings = (ik.damping, ik.tolerance, ik.max_iterations, adaptive)
 
     @property
     def last_q(self) -> np.ndarray | None:
@@ -591,3 +604,23 @@ class IKSolver:
         q.flags.writeable = False
         self._last_q = q
         return IKResult(q, iterations, residual, True)
+
+    def solve_pose(self, x: float, y: float, z: float, phi: float) -> tuple[np.ndarray, int]:
+        """:meth:`solve` warm-started, for the control loop: the pose as four numbers, the answer
+        as ``(q, iterations)``.
+
+        Same answer and the same errors as :meth:`solve`; the common case (the
+        warm start converges within the limits) is one compiled call.
+        """
+        start = self._last_q if self._last_q is not None else self._home
+        damping, tolerance, max_iterations, adaptive = self._settings
+        q, iterations, residual, violation = _solve_pose_kernel(
+            x, y, z, phi, start, self._geom, self._q_min, self._q_max, damping, tolerance,
+            max_iterations, adaptive)
+        if violation or not residual <= tolerance:
+            # a retry from HOME_Q, or an error that names the problem: the full path
+            result = self.solve([x, y, z, phi])
+            return result.q, result.iterations
+        q.flags.writeable = False
+        self._last_q = q
+        return q, iterations

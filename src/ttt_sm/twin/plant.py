@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -114,6 +115,11 @@ def gravity_coefficients(params: ArmParams) -> tuple[float, float]:
     return g2, g23
 
 
+def _flat_view(a: np.ndarray) -> Any:
+    """A flat memoryview of `a`'s memory: its items read and written as plain Python numbers."""
+    return memoryview(a.reshape(-1))  # type: ignore[arg-type]  # numpy's stubs lack __buffer__
+
+
 class ArmSim:
     """The simulated arm with its cascade controllers, stepped at the control rate.
 
@@ -167,6 +173,12 @@ class ArmSim:
         self._di = np.zeros((3, K.N_DI), dtype=np.int64)
         self._gs = np.zeros(K.N_GS)
         self._no_rec = np.zeros((0, K.N_REC))
+        # Flat views of the same memory for the per-chart-step accessors: a
+        # memoryview reads and writes plain Python numbers at a third of the
+        # cost of numpy indexing or slicing.
+        self._dsv = _flat_view(self._ds)
+        self._div = _flat_view(self._di)
+        self._gsv = _flat_view(self._gs)
         self._power_on(q_start, np.random.default_rng(seed))
 
     # ---- construction -------------------------------------------------------
@@ -261,7 +273,7 @@ class ArmSim:
     @property
     def t(self) -> float:
         """Simulated time since power-on, s."""
-        return float(self._gs[K.GS_T])
+        return self._gsv[K.GS_T]
 
     def set_setpoints(self, q_des: Angles, fr_sw: bool = False) -> None:
         """Set the joint setpoints: drives 1-3 in encoder coordinates (rad), q4 the servo angle.
@@ -272,15 +284,16 @@ class ArmSim:
         if not (math.isfinite(q_des[0]) and math.isfinite(q_des[1]) and math.isfinite(q_des[2])
                 and math.isfinite(q_des[3])):
             raise SimError(f"setpoints must be 4 finite angles (rad), got {list(q_des)!r}")
-        ds = self._ds
-        ds[0, K.S_R_RAW] = q_des[0]
-        ds[1, K.S_R_RAW] = q_des[1]
-        ds[2, K.S_R_RAW] = q_des[2]
-        self._gs[K.GS_FR_SW] = 1.0 if fr_sw else 0.0
+        ds, n = self._dsv, K.N_DS
+        ds[K.S_R_RAW] = float(q_des[0])
+        ds[n + K.S_R_RAW] = float(q_des[1])
+        ds[2 * n + K.S_R_RAW] = float(q_des[2])
+        gs = self._gsv
+        gs[K.GS_FR_SW] = 1.0 if fr_sw else 0.0
         a = float(q_des[3])
-        if a != self._gs[K.GS_SV_SET]:
-            self._gs[K.GS_SV_SET] = a
-            self._gs[K.GS_SV_DUTY] = self.params.servo.duty_for_angle(a)
+        if a != gs[K.GS_SV_SET]:
+            gs[K.GS_SV_SET] = a
+            gs[K.GS_SV_DUTY] = self.params.servo.duty_for_angle(a)
 
     def step(self, n: int = 1) -> None:
         """Advance `n` control steps."""
@@ -332,15 +345,15 @@ class ArmSim:
 
     def true_angles(self) -> tuple[float, float, float, float]:
         """:attr:`q_true` as plain floats, for code that runs every chart step."""
-        q1, q2, q3 = self._ds[:, K.S_Q].tolist()
-        return q1, q2, q3, float(self._gs[K.GS_SV_Q])
+        ds, n = self._dsv, K.N_DS
+        return ds[K.S_Q], ds[n + K.S_Q], ds[2 * n + K.S_Q], self._gsv[K.GS_SV_Q]
 
     def encoder_angles(self) -> tuple[float, float, float]:
         """:attr:`q_encoder` as plain floats, for code that runs every chart step."""
-        c1, c2, c3 = self._di[:, K.I_COUNTS].tolist()
-        o1, o2, o3 = self._ds[:, K.S_OFFSET].tolist()
+        di, ni, ds, n = self._div, K.N_DI, self._dsv, K.N_DS
         r1, r2, r3 = self._rpc
-        return c1 * r1 + o1, c2 * r2 + o2, c3 * r3 + o3
+        return (di[K.I_COUNTS] * r1 + ds[K.S_OFFSET], di[ni + K.I_COUNTS] * r2 + ds[n + K.S_OFFSET],
+                di[2 * ni + K.I_COUNTS] * r3 + ds[2 * n + K.S_OFFSET])
 
     @property
     def offset_estimate(self) -> np.ndarray:

@@ -335,8 +335,8 @@ class SimulatedCamera:
             # from this camera's own generator keeps a seed's photos reproducible.
             cv2.setRNGSeed(int(self._rng.integers(1, 2**31)))
             noise = np.empty_like(lit)
-            sigma = float(self.lighting.noise_sigma)
-            cv2.randn(noise, (0.0, 0.0, 0.0), (sigma, sigma, sigma))  # scalars would fill channel 0 only
+            # one mean and sigma per channel: scalars would fill channel 0 only
+            cv2.randn(noise, np.zeros(3), np.full(3, float(self.lighting.noise_sigma)))
             lit += noise
         return np.clip(lit + 0.5, 0, 255).astype(np.uint8)
 

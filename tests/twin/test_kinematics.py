@@ -247,6 +247,29 @@ def test_warm_start_continues_from_the_last_solution() -> None:
     assert solver.last_q is None
 
 
+def test_solve_pose_gives_solve_s_answers_and_errors() -> None:
+    """The control loop's solve_pose: same angles, warm start and errors as solve."""
+    fast, full = IKSolver(PARAMS), IKSolver(PARAMS)
+    rng = np.random.default_rng(3)
+    x, y = 0.0, 0.25
+    for _ in range(300):  # a random walk over the field, 0.2 mm per tick, and a few jumps
+        x, y = x + rng.normal(0.0, 2e-4), y + rng.normal(0.0, 2e-4)
+        if rng.random() < 0.02:
+            x, y = rng.uniform(-0.08, 0.08), rng.uniform(0.18, 0.32)
+        pose = [x, y, 0.01, 0.0]
+        q, iterations = fast.solve_pose(*pose)
+        result = full.solve(pose)
+        np.testing.assert_array_equal(q, result.q)
+        assert iterations == result.iterations and fast.last_q is q and not q.flags.writeable
+    with pytest.raises(UnreachableTargetError):
+        fast.solve_pose(2.0, 0.0, 0.0, 0.0)
+    with pytest.raises(JointLimitError):
+        fast.solve_pose(0.0, 0.25, 0.05, math.radians(-80))
+    with pytest.raises(NonFiniteTargetError):
+        fast.solve_pose(0.0, math.nan, 0.0, 0.0)
+    np.testing.assert_array_equal(fast.last_q, full.last_q)  # errors leave the warm start alone
+
+
 def test_result_is_frozen_and_its_angles_read_only() -> None:
     result = IKSolver(PARAMS).solve([0.0, 0.25, 0.02, 0.0])
     assert isinstance(result, IKResult)

@@ -266,3 +266,22 @@ def test_numba_disabled_runs_the_same_kernel(params, gains, tmp_path):
     sim.run(150)
     fast = list(sim.q_true) + list(sim.sensors().counts)
     assert slow == pytest.approx(fast, abs=1e-9)
+
+
+def test_the_plain_number_accessors_read_what_the_sensors_and_true_state_say(params, gains):
+    sim = ArmSim(params, gains, seed=5)
+    sim.set_offset_estimate(2, 0.125)
+    sim.set_setpoints([0.2, 0.4, -0.6, 0.1])
+    sim.run(300, record=False)  # mid-move
+    sensors = sim.sensors()
+    rpc = [d.rad_per_count for d in params.drives]
+    offsets = sim.offset_estimate
+    expected = [sensors.counts[d] * rpc[d] + offsets[d] for d in range(3)]
+    assert sim.encoder_angles() == pytest.approx(expected, abs=1e-15) and offsets[1] == 0.125
+    assert list(sim.true_angles()) == sim.q_true.tolist()
+    assert all(type(v) is float for v in (*sim.encoder_angles(), *sim.true_angles(), sim.t))
+    assert sim.t == pytest.approx(0.3)
+    sim.set_setpoints(np.array([0.1, 0.2, -0.3, 0.0], dtype=np.float32))  # any float type is taken
+    sim.run(1, record=False)
+    with pytest.raises(SimError):
+        sim.set_setpoints([0.1, math.nan, 0.0, 0.0])

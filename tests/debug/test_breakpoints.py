@@ -130,12 +130,22 @@ def test_event_breakpoint_on_a_posted_event_taken_or_not(lamp_dbg: Debugger):
     ("event DriveInit1.stop", "DriveInit1 handles no event 'stop'"),
     ("when DriveInit1.pos_encoder > 1",
      "DriveInit1 has no datum 'pos_encoder' (did you mean 'pos_Encoder'?)"),
-    ("when DriveInit1.pos_Encoder >", "expected a number, a Chart.datum or a signal at column 25"),
-    ("when DriveInit1.pos_Encoder > 1 )", "found ')'"),
+    ("when DriveInit1.pos_Encoder[1] > 1",
+     "DriveInit1.pos_Encoder is a datum, not a list: write it without [1] (at column 1 of"),
+    ("when DriveInit1.turn_back", "DriveInit1 has no datum 'turn_back'"),  # states are not data here
+    ("when DriveInit1.pos_Encoder.x > 1",
+     "one dot at most (Chart.name): DriveInit1.pos_Encoder is followed by '.' at column 23"),
+    ("when DriveInit1.pos_Encoder >", "expected a number, a name or '(', found the end at column 25"),
+    ("when DriveInit1.pos_Encoder > 1 )", "unexpected ')'; expected 'and', 'or', an operator or the end"
+                                          " at column 28"),
+    ("when DriveInit1.pos_Encoder > 1 ; 2", "unexpected character ';' at column 28"),
     ("when q_true > 1", "signal 'q_true' has 4 elements: pick one"),
     ("when q_true[0] > 1", "q_true[0] does not exist"),
     ("when pos_Encoder > 1", "no signal 'pos_Encoder' (chart data are written Chart.datum)"),
-    ("when __import__('os') > 1", "unexpected character \"'\" at column 12"),
+    ("when q_true[1] < 1 and q_tru[2] > 0",
+     "no signal 'q_tru' (did you mean 'q_true'?); signals: t, "),
+    ("when q_true[1] < 1 and q_tru[2] > 0", "(at column 19 of 'q_true[1] < 1 and q_tru[2] > 0')"),
+    ("when __import__('os') > 1", "unknown function '__import__'; functions: abs, min, max at column 1"),
     ("when 1 < 2 furlongs", "unknown unit 'furlongs'"),
     ("when", "break when: what?"),
     ("watch x", "unknown breakpoint kind 'watch'"),
@@ -174,7 +184,35 @@ class _Values:
     ("C.x >= 2000mm", True), ("a == 90 deg", True), ("a > 89.9deg and a < 90.1deg", True),
     ("not (C.x > 1 or C.flag)", False), ("true and not false", True), ("C.flag == false", True),
     ("t < 5ms", True),
+    # The scenario language's arithmetic, functions and constants mean the same here.
+    ("-C.x < -1", True), ("C.x - 2 * v[1] == 0", True), ("abs(v[2]) == 3", True),
+    ("max(v[1], v[2]) < min(C.x, 3)", True), ("C.flag == False or True", True),
 ])
 def test_condition_grammar(text, expected):
     names = _Values(**{"C.x": 2.0, "C.flag": False, "v": [1, -3], "a": math.pi / 2, "t": 0.004})
     assert parse_condition(text, names).evaluate(names) is expected
+    assert parse_condition(text, names).evaluate() is expected  # the names it was checked against
+
+
+def test_a_condition_reads_the_names_it_is_given():
+    condition = parse_condition("  C.x > 1  ", _Values(**{"C.x": 2.0}))
+    assert condition.text == "C.x > 1"
+    assert condition.evaluate() is True
+    assert condition.evaluate(_Values(**{"C.x": 0.5})) is False
+
+
+@pytest.mark.parametrize("text, message", [
+    ("C.x < 1", "condition 'C.x < 1' cannot be evaluated: cannot compare: '<' not supported"),
+    ("C.x + 1 > 0", "condition 'C.x + 1 > 0' cannot be evaluated: cannot compute '+'"),
+    ("1 / C.zero > 0", "condition '1 / C.zero > 0' cannot be evaluated: cannot compute '/': division by zero"),
+])
+def test_values_that_cannot_be_compared_are_debug_errors(text, message):
+    names = _Values(**{"C.x": [1, 2], "C.zero": 0})
+    with pytest.raises(DebugError) as info:
+        parse_condition(text, names).evaluate(names)
+    assert message in str(info.value)
+
+
+def test_an_empty_condition_says_what_to_write():
+    with pytest.raises(DebugError, match="empty condition: write e.g. 'DriveInit1.pos_Encoder > 1.0'"):
+        parse_condition("  ", _Values())

@@ -75,8 +75,7 @@ where
     expected = [
         "error: unknown command 'frobnicate'; commands: ",
         "error: DriveInit1 has no state 'turn_bak' (did you mean 'turn_back'?); states: ",
-        "error: expected a number, a Chart.datum or a signal at column 26 of"
-        " 'DriveInit1.pos_Encoder > > 1', found '>'",
+        "error: expected a number, a name or '(', found '>' at column 26 in 'DriveInit1.pos_Encoder > > 1'",
         "error: no chart 'NoSuchChart'",
         "error: DriveInit1 has no datum 'stp' (did you mean 'stop'?)",
         "error: DriveInit1.stop is a flag: give 1 or 0 (true/false), not 'maybe'",

@@ -7,8 +7,8 @@ from typing import Any
 
 from ..app.robot import Robot
 from ..runtime import Data
+from ..runtime.conditions import UNITS
 from .errors import DebugError, suggest
-from .expr import UNITS
 
 
 def datum_decl(robot: Robot, chart: str, name: str) -> Data:

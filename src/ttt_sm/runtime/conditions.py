@@ -26,15 +26,14 @@ carry a unit that converts it: ``170deg`` (or ``170 deg``), ``20mm``, ``5ms``
 game's GUI message.  Vector signals are numbered from 1,
 as the thesis numbers joints and drives: ``q_true[1]`` is q1.
 
-It is the language of the debugger's ``break when`` conditions
-(:mod:`ttt_sm.debug.expr`: same names, units, numbering and chained
-comparisons), plus arithmetic and ``abs``/``min``/``max``: every ``break
-when`` condition means the same here.
+It is the one language of scenario files' conditions (:mod:`ttt_sm.scenario`)
+and of the debugger's ``break when`` (:mod:`ttt_sm.debug.expr`), so a
+condition means the same in both.
 
 The language knows nothing about robots: names are :class:`Ref` objects that
-the caller resolves (the scenario runner binds them to a robot's charts and
-signals).  :func:`parse` checks the syntax and lists the references, so a
-loader can check every name before anything runs.
+the caller resolves (the scenario runner and the debugger bind them to a
+robot's charts and signals).  :func:`parse` checks the syntax and lists the
+references, so a caller can check every name before anything runs.
 """
 
 from __future__ import annotations

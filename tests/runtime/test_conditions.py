@@ -125,6 +125,19 @@ def test_the_message_says_the_column_and_quotes_the_condition() -> None:
     assert (info.value.message, info.value.text) == ("expected a number, a name or '(', found '>'", "C.x > > 1")
 
 
+@pytest.mark.parametrize("text, refs", [
+    ("C.x", [Ref("C", "x", None, 1)]),
+    ("C . x [ 2 ]", [Ref("C", "x", 2, 1)]),  # spaces between tokens; an index is the caller's to check
+    ("q_true[1]>0", [Ref(None, "q_true", 1, 1)]),
+    ("(t)", [Ref(None, "t", None, 2)]),
+    ("1. + .5e1 + 2E-3 + 170 deg", []),
+    ("not not true", []),
+    ("'and' == \"or\"", []),  # keywords in quotes are text
+])
+def test_accepted_forms_and_the_names_they_read(text: str, refs: list[Ref]) -> None:
+    assert list(parse(text).refs) == refs
+
+
 def test_names_are_identifiers_as_in_python() -> None:
     assert parse("Δq_1 > 0 and Chart_2.x_y").refs == (Ref(None, "Δq_1", None, 1), Ref("Chart_2", "x_y", None, 14))
     with pytest.raises(ExprError, match="unknown unit '_x'"):

@@ -136,18 +136,36 @@ def bench_ai_section(params: ArmParams, seed: int = 0) -> dict[str, Any]:
     return bench_ai(seed)
 
 
-def bench_game(params: ArmParams, seed: int = 0) -> dict[str, Any]:
-    """A whole simulated game, the camera behind the pty serial emulator."""
+def bench_game(params: ArmParams, seed: int = 0, games: int = 3) -> dict[str, Any]:
+    """Whole simulated games (seeds `seed`, `seed` + 1, ...), the camera behind the pty serial emulator.
+
+    ``game_realtime_factor`` is the games' simulated time over their wall
+    time together; ``game_realtime_factor_min`` the slowest game's.
+    """
     from .app.game import GameSession
 
-    session = GameSession(params, seed=seed, camera="serial", record_trace=False)
-    try:
-        report = session.play()
-    finally:
-        session.close()
-    return {f"game_{k}": report[k] for k in ("winner", "detections_correct", "detections_wrong", "sim_time_s",
-                                             "wall_time_s", "realtime_factor", "setup_wall_s", "camera_wall_s",
-                                             "erased")}
+    reports = []
+    for k in range(games):
+        session = GameSession(params, seed=seed + k, camera="serial", record_trace=False)
+        try:
+            reports.append(session.play())
+        finally:
+            session.close()
+    sim = sum(r["sim_time_s"] for r in reports)
+    wall = sum(r["wall_time_s"] for r in reports)
+    return {
+        "game_games": games,
+        "game_winners": [r["winner"] for r in reports],
+        "game_detections_correct": sum(r["detections_correct"] for r in reports),
+        "game_detections_wrong": sum(r["detections_wrong"] for r in reports),
+        "game_sim_time_s": round(sim, 3),
+        "game_wall_time_s": round(wall, 3),
+        "game_realtime_factor": round(sim / wall, 1),
+        "game_realtime_factor_min": min(r["realtime_factor"] for r in reports),
+        "game_setup_wall_s": max(r["setup_wall_s"] for r in reports),
+        "game_camera_wall_s": round(sum(r["camera_wall_s"] for r in reports), 3),
+        "game_erased": all(r["erased"] for r in reports),
+    }
 
 
 SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
@@ -160,7 +178,7 @@ SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "motion": lambda p, a: bench_game_motion(p, a["seed"]),
     "vision": lambda p, a: bench_vision_section(p, a["seed"]),
     "ai": lambda p, a: bench_ai_section(p, a["seed"]),
-    "game": lambda p, a: bench_game(p, a["seed"]),
+    "game": lambda p, a: bench_game(p, a["seed"], a["games"]),
 }
 
 
@@ -176,7 +194,8 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
     if unknown:
         raise ValueError(f"unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
     args = {"seed": seed, "out": out, "loop_seconds": 2.0 if quick else 20.0,
-            "pacing_seconds": 1.0 if quick else 10.0, "init_starts": 5 if quick else 200}
+            "pacing_seconds": 1.0 if quick else 10.0, "init_starts": 5 if quick else 200,
+            "games": 1 if quick else 3}
     result: dict[str, Any] = {
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
                     "numba_jit": os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"},

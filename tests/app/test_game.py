@@ -133,3 +133,15 @@ def test_play_json_reports_the_promised_keys(capsys, tmp_path):
                 "wall_time_s", "realtime_factor", "erased"):
         assert key in data
     assert data["detections_wrong"] == 0 and data["erased"] is True
+
+
+def test_the_game_bench_plays_whole_games_and_reports_their_pace():
+    from ttt_sm.bench import bench_game
+
+    result = bench_game(P, seed=11, games=1)
+    assert result["game_games"] == 1 and result["game_winners"][0] in ("robot", "draw")
+    assert result["game_detections_wrong"] == 0 and result["game_detections_correct"] >= 3
+    assert result["game_erased"] is True
+    sim, wall = result["game_sim_time_s"], result["game_wall_time_s"]
+    assert sim > 60.0 and result["game_realtime_factor"] == pytest.approx(sim / wall, abs=0.06)
+    assert result["game_realtime_factor_min"] == pytest.approx(result["game_realtime_factor"], abs=0.1)

@@ -57,6 +57,7 @@ class ControlStage:
         #: applied after the wiring's own: name -> value.
         self.overrides: dict[str, object] = {}
         self._no_task = np.full(4, np.nan)
+        self._inputs = vars(chart)  # plain attribute writes: this runs every chart step
         g = params.geometry
         self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
 
@@ -71,10 +72,11 @@ class ControlStage:
         x, y, z, _ = _fk_python(q1, q2, q3, servo, *self._geometry)
         if self.erase_requested and "turn_pen" in c.active_ids:
             self.erase_requested = False
-        # plain attribute writes: this runs every chart step
-        vars(c).update(X_now=x, Y_now=y, Z_now=z, initialised=self.init.done, erase=self.erase_requested)
+        d = self._inputs
+        d["X_now"], d["Y_now"], d["Z_now"] = x, y, z
+        d["initialised"], d["erase"] = self.init.done, self.erase_requested
         if self.overrides:
-            vars(c).update(self.overrides)
+            d.update(self.overrides)
         c.tick()
         if math.isfinite(c.X_out):
             signals.task = [c.X_out, c.Y_out, c.Z_out, c.phi]

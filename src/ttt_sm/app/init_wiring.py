@@ -23,7 +23,7 @@ import numpy as np
 
 from ..charts.drive_init import DriveInit1, DriveInit2, DriveInit3
 from ..params import ArmParams
-from ..sched.scheduler import Scheduler, Signals, as_floats
+from ..sched.scheduler import Scheduler, Signals
 from ..twin.kinematics import link_points
 from ..twin.plant import ArmSim
 
@@ -62,6 +62,8 @@ class DriveInitStage:
         #: Inputs forced by a test or scenario, applied after the Encoder blocks: (chart index, name) -> value.
         self.overrides: dict[tuple[int, str], object] = {}
         self.done = False  # every drive passes its commanded position through
+        # the charts' data as plain dictionaries: inputs are written every chart step
+        self._inputs = tuple(vars(c) for c in charts)
         self.failed = False  # a chart gave up (a switch not found)
 
     def _update_status(self) -> None:
@@ -72,15 +74,17 @@ class DriveInitStage:
     def tick(self, signals: Signals) -> None:
         """Encoder blocks in, charts ticked, offsets applied, pos_out out."""
         c1, c2, c3 = self.charts
-        pos_in = as_floats(signals.q_set)
+        q_set = signals.q_set
+        pos_in = q_set.tolist() if type(q_set) is np.ndarray else q_set
         # Each chart reads the others' flags as they were at the end of the last step.
         ini_23, ini2, ini3 = c1.ini_23, c2.ini2, c3.ini3
         if self.done:
             # Initialised: only pos_in and the flags matter; skip the Encoder blocks.
-            vars(c1).update(pos_in=pos_in[0], ini2=ini2, ini3=ini3)
-            vars(c2).update(pos_in=pos_in[1], ini1=ini_23, ini3=ini3)
-            vars(c3).update(pos_in=pos_in[2], ini1=ini_23, ini2=ini2)
-            if not self.overrides and not (c1._queue or c2._queue or c3._queue):
+            d1, d2, d3 = self._inputs
+            d1["pos_in"], d1["ini2"], d1["ini3"] = pos_in[0], ini2, ini3
+            d2["pos_in"], d2["ini1"], d2["ini3"] = pos_in[1], ini_23, ini3
+            d3["pos_in"], d3["ini1"], d3["ini2"] = pos_in[2], ini_23, ini2
+            if not self.overrides and not (d1["_queue"] or d2["_queue"] or d3["_queue"]):
                 # the offsets are set for good: tick and pass on (every chart step of a game)
                 t1, t2, t3 = c1.tick(), c2.tick(), c3.tick()
                 if t1 or t2 or t3:
@@ -111,7 +115,7 @@ class DriveInitStage:
             if chart.offset != applied[d]:
                 self.sim.set_offset_estimate(d + 1, chart.offset)
                 applied[d] = chart.offset
-                self.sched.homed[d] = True
+                self.sched.mark_homed(d + 1)
         if moved:
             self._update_status()
         servo = pos_in[3] if self.done else self.servo_init

@@ -147,8 +147,9 @@ class Scheduler:
         self.q_min = tuple(params.joint_min)
         self.q_max = tuple(params.joint_max)
         # Joint limits apply in encoder coordinates only once a drive's offset
-        # is known; the servo is absolute, so its limits always apply.
-        self.homed = [False, False, False, True]
+        # is known (mark_homed); the servo is absolute, so its limits always apply.
+        self._lo = [-math.inf, -math.inf, -math.inf, self.q_min[3]]
+        self._hi = [math.inf, math.inf, math.inf, self.q_max[3]]
         self.signals = Signals(sim.sensors)
         self.steps = 0
         self.chart_ticks = 0
@@ -166,10 +167,21 @@ class Scheduler:
         """Simulated time, s."""
         return self.sim.t
 
+    @property
+    def homed(self) -> tuple[bool, bool, bool, bool]:
+        """Whether each joint's limits are enforced (drives once initialised, the servo always)."""
+        return tuple(math.isfinite(v) for v in self._lo)  # type: ignore[return-value]
+
+    def mark_homed(self, drive: int) -> None:
+        """Enforce drive `drive`'s (1-3) joint limits from now on: its encoder offset is known."""
+        self._lo[drive - 1] = self.q_min[drive - 1]
+        self._hi[drive - 1] = self.q_max[drive - 1]
+
     def assume_homed(self) -> None:
         """Treat every drive as initialised: the twin's true offsets, no init charts."""
         self.sim.assume_initialised()
-        self.homed = [True, True, True, True]
+        for drive in (1, 2, 3):
+            self.mark_homed(drive)
         self._hold = np.asarray(self.sim.q_encoder.tolist() + [self.sim.q_true[3]], dtype=float)
 
     def set_clock(self, clock: VirtualClock | WallClock) -> None:
@@ -185,7 +197,7 @@ class Scheduler:
         for stage in self.task_stages:
             stage.tick(s)
         task = s.task
-        pose = as_floats(task)
+        pose = task.tolist() if type(task) is np.ndarray else list(task)
         if pose == self._ik_pose:
             # The same pose as last step (the arm waits): IK is a function of
             # the pose and its warm start, so the answer is the last one.
@@ -208,15 +220,13 @@ class Scheduler:
         s.q_set = s.q_des
         for stage in self.joint_stages:
             stage.tick(s)
-        q = as_floats(s.q_set)
-        clamped = False
-        for i in range(4):
-            if self.homed[i]:
-                if q[i] < self.q_min[i]:
-                    q[i], clamped = self.q_min[i], True
-                elif q[i] > self.q_max[i]:
-                    q[i], clamped = self.q_max[i], True
-        if clamped:
+        q_set = s.q_set
+        q: list[float] = q_set.tolist() if type(q_set) is np.ndarray else q_set  # type: ignore[assignment]
+        lo, hi = self._lo, self._hi
+        q1, q2, q3, q4 = q
+        if (q1 < lo[0] or q1 > hi[0] or q2 < lo[1] or q2 > hi[1] or q3 < lo[2] or q3 > hi[2]
+                or q4 < lo[3] or q4 > hi[3]):
+            q = [min(max(v, lo[i]), hi[i]) for i, v in enumerate(q)]
             self.limit_clamps += 1
             s.q_set = np.array(q)
         self._hold = s.q_set

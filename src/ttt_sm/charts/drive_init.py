@@ -37,11 +37,49 @@ def _step_towards(value: float, target: float, inc: float) -> float:
     return value + max(-inc, min(inc, target - value))
 
 
-class DriveInit1(TickChart):
+class _HomeAndPass(TickChart):
+    """What every DriveInit chart does alike: take the index as home, then pass pos_in.
+
+    An abstract chart (no states, no data): each DriveInit chart declares its own
+    states and data, and the runtime finds these methods on it by name as it finds
+    the chart's own (``on="set_home"``, ``during_pass_pos``).
+    """
+
+    # for type checkers: data every DriveInit chart declares
+    pos_in: float
+    pos_out: float
+    offset: float
+    index_pos: float
+    index_angle: float
+
+    def set_home(self) -> None:
+        """The index switch changed: its latched encoder angle is `index_angle` really."""
+        correction = self.index_angle - self.index_pos
+        self.offset = self.offset + correction
+        self.pos_out = self.pos_out + correction
+
+    def during_pass_pos(self) -> None:
+        self.pos_out = self.pos_in
+
+
+class _IndexSearch(_HomeAndPass):
+    """A DriveInit chart that waits for an edge of its index switch (drives 1 and 2).
+
+    Drive 3's switch is also its limit switch: its guards read the level itself.
+    """
+
+    index: bool
+    index_start: bool
+
+    def index_passed(self) -> bool:
+        """The index switch changed since the search began."""
+        return self.index != self.index_start
+
+
+class DriveInit1(_IndexSearch):
     """Drive 1: find the index (or a hard stop, then the index), park, wait, pass pos_in."""
 
     tick_period_s = CHART_PERIOD_S
-    offset: float  # for type checkers: set_home adds to its own value
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
@@ -96,10 +134,7 @@ class DriveInit1(TickChart):
     run.initialise.turn_back.to(failed, cond="stalled")
 
     # -- guards: pure functions of inputs and data -----------------------------
-
-    def index_passed(self) -> bool:
-        """The index switch changed since the search began."""
-        return self.index != self.index_start
+    # (index_passed, set_home and during_pass_pos: see _IndexSearch)
 
     def stalled(self) -> bool:
         """The encoder stands still while the setpoint moves on: a hard stop.
@@ -148,20 +183,11 @@ class DriveInit1(TickChart):
         self.pos_out = self.pos_out_p - self.inc
         self._watch_encoder()
 
-    def set_home(self) -> None:
-        """The index passed: its latched encoder angle is `index_angle` really."""
-        correction = self.index_angle - self.index_pos
-        self.offset = self.offset + correction
-        self.pos_out = self.pos_out + correction
-
     def during_go_park(self) -> None:
         self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc)
 
     def on_enter_wait_23(self) -> None:
         self.ini_23 = True
-
-    def during_pass_pos(self) -> None:
-        self.pos_out = self.pos_in
 
     def on_enter_stopped(self) -> None:
         self.pos_out = self.pos_Encoder
@@ -170,11 +196,10 @@ class DriveInit1(TickChart):
         self.pos_out = self.pos_Encoder
 
 
-class DriveInit2(TickChart):
+class DriveInit2(_IndexSearch):
     """Drive 2: wait for drive 1, turn a set angle, turn back if the index did not pass, wait, park."""
 
     tick_period_s = CHART_PERIOD_S
-    offset: float  # for type checkers: set_home adds to its own value
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
@@ -214,9 +239,7 @@ class DriveInit2(TickChart):
     wait_ini3.to(go_park, cond="ini3")
     go_park.to(pass_pos, cond="pos_out == park")
 
-    def index_passed(self) -> bool:
-        """The index switch changed since the search began."""
-        return self.index != self.index_start
+    # (index_passed, set_home and during_pass_pos: see _IndexSearch)
 
     def start_search(self) -> None:
         self.index_start = self.index
@@ -230,27 +253,17 @@ class DriveInit2(TickChart):
         self.pos_out = self.pos_out_p - self.inc
         self.travel = self.travel + self.inc
 
-    def set_home(self) -> None:
-        """The index passed: its latched encoder angle is `index_angle` really."""
-        correction = self.index_angle - self.index_pos
-        self.offset = self.offset + correction
-        self.pos_out = self.pos_out + correction
-
     def on_enter_wait_ini3(self) -> None:
         self.ini2 = True
 
     def during_go_park(self) -> None:
         self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc)
 
-    def during_pass_pos(self) -> None:
-        self.pos_out = self.pos_in
 
-
-class DriveInit3(TickChart):
+class DriveInit3(_HomeAndPass):
     """Drive 3: turn towards the index-and-limit switch with a shrinking increment."""
 
     tick_period_s = CHART_PERIOD_S
-    offset: float  # for type checkers: set_home adds to its own value
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
@@ -292,6 +305,8 @@ class DriveInit3(TickChart):
     back_off.to(wait_ini2, cond="pos_out == park")
     wait_ini2.to(pass_pos, cond="ini2")
 
+    # (set_home and during_pass_pos: see _HomeAndPass)
+
     def start_search(self) -> None:
         self.inc = self.inc_max
         self.travel = 0.0
@@ -305,20 +320,11 @@ class DriveInit3(TickChart):
         self.pos_out = self.pos_out_p - self.inc_min
         self.travel = self.travel + self.inc_min
 
-    def set_home(self) -> None:
-        """The switch changed: its latched encoder angle is `index_angle` really."""
-        correction = self.index_angle - self.index_pos
-        self.offset = self.offset + correction
-        self.pos_out = self.pos_out + correction
-
     def during_back_off(self) -> None:
         self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc_max)
 
     def on_enter_wait_ini2(self) -> None:
         self.ini3 = True
-
-    def during_pass_pos(self) -> None:
-        self.pos_out = self.pos_in
 
 
 INIT_CHARTS = (DriveInit1, DriveInit2, DriveInit3)

@@ -104,3 +104,17 @@ def test_states_cannot_be_overwritten():
     pen = Pen()
     with pytest.raises(Exception, match="State overriding is not allowed"):
         pen.idle = 3
+    assert pen.idle.id == "idle" and Pen.idle.id == "idle" and pen.idle.is_active
+    pen.X_out = 0.5  # data are plain attributes
+    assert pen.X_out == 0.5
+
+
+def test_nested_states_cannot_be_overwritten_and_events_stay_callable():
+    from tests.runtime.test_chart_clock import Lamp
+
+    lamp = Lamp()
+    for name in ("on", "dim", "bright", "off"):
+        with pytest.raises(Exception, match="State overriding is not allowed"):
+            setattr(lamp, name, 1)
+    lamp.button()  # an event is still a method of the instance
+    assert lamp.on.is_active and lamp.dim.is_active and not lamp.bright.is_active

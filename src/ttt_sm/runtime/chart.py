@@ -33,6 +33,7 @@ from collections.abc import Callable, Mapping, MutableSet
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from statemachine import StateChart
+from statemachine.exceptions import StateMachineError
 from statemachine.factory import StateMachineMetaclass
 from statemachine.state import State
 from statemachine.transition import Transition
@@ -69,6 +70,11 @@ class TickChartMeta(StateMachineMetaclass):
         _check_temporal_guards(cls, structure)
         cls._structure = structure
         cls._state_names = frozenset(s.id for s in structure.states)
+        events = getattr(cls, "_events", {})
+        for state in structure.states:
+            # (a state named like an event is reached through the event, as in the library)
+            if state.id not in events and not isinstance(cls.__dict__.get(state.id), _StateName):
+                setattr(cls, state.id, _StateName(state.id, getattr(cls, state.id, state)))
         cls._data_decls = decls
         cls._prev_pairs = tuple(
             (d.name, d.name + PREVIOUS_SUFFIX) for d in decls if d.kind == "output"
@@ -96,6 +102,32 @@ def _check_temporal_guards(cls: type, structure: ChartStructure) -> None:
                         " (written without an event); an event transition is only tried when"
                         " its event arrives"
                     )
+
+
+class _StateName:
+    """A chart class's attribute named after a state: reads as the state, refuses assignment.
+
+    python-statemachine refuses ``chart.some_state = value`` in a Python-level
+    ``__setattr__``, which every attribute assignment then pays for (0.4 us:
+    during actions assign outputs on every tick).  A data descriptor per state
+    name gives the same protection and leaves every other assignment plain.
+    """
+
+    __slots__ = ("name", "state")
+
+    def __init__(self, name: str, state: Any) -> None:
+        self.name = name
+        self.state = state
+
+    def __get__(self, instance: Any, owner: type | None = None) -> Any:
+        if instance is None:
+            return self.state
+        # the library keeps each instance's own copy of the state in its __dict__
+        return instance.__dict__.get(self.name, self.state)
+
+    def __set__(self, instance: Any, value: Any) -> None:
+        raise StateMachineError(
+            f"State overriding is not allowed. Trying to add {value!r} to {self.name}")
 
 
 class _Clock:
@@ -202,12 +234,12 @@ class TickChart(StateChart, metaclass=TickChartMeta):
         # (``X_out: float``) for precise types.
         def __getattr__(self, name: str) -> Any: ...
 
-    def __setattr__(self, name: str, value: Any) -> None:
-        # Same protection as StateChart.__setattr__ (a state cannot be overwritten),
-        # at a third of its cost: during actions assign outputs on every quiet tick.
-        if name in self._state_names:
-            super().__setattr__(name, value)  # raises the library's error
-        object.__setattr__(self, name, value)
+    if TYPE_CHECKING:
+        def __setattr__(self, name: str, value: Any) -> None: ...  # declared data, as __getattr__
+    else:
+        # Plain assignment: a state's name is protected by its _StateName descriptor instead
+        # of StateChart.__setattr__ (during actions assign outputs on every quiet tick).
+        __setattr__ = object.__setattr__
 
     # -- the clock ---------------------------------------------------------
 

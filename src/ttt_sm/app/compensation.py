@@ -24,7 +24,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..params import ArmParams
-from ..sched.scheduler import Signals, as_floats
+from ..sched.scheduler import Signals
 from ..twin.plant import gravity_coefficients, gravity_torques
 
 
@@ -56,12 +56,16 @@ class GearPlayCompensation:
         """Add the offset to the setpoints once the drives are initialised."""
         if self.gain == 0.0 or not self.active():
             return
-        q = as_floats(signals.q_set)
+        q1, q2, q3, q4 = signals.q_set
         g2, g23 = self._gravity
-        tau23 = -g23 * math.sin(q[1] + q[2])  # as gravity_torques, on plain floats
-        tau2 = -g2 * math.sin(q[1]) + tau23
+        tau23 = -g23 * math.sin(q2 + q3)  # as gravity_torques, on plain floats
+        tau2 = -g2 * math.sin(q2) + tau23
         c2, k2, c3, k3 = self._play
-        q[1] -= self.gain * _offset(tau2, c2, k2)
-        q[2] -= self.gain * _offset(tau23, c3, k3)
-        signals.q_set = q
+        gain = self.gain
+        # _offset, written out: this runs every chart step
+        if tau2 != 0.0:
+            q2 -= gain * math.copysign(c2 / 2 + abs(tau2) / k2, tau2)
+        if tau23 != 0.0:
+            q3 -= gain * math.copysign(c3 / 2 + abs(tau23) / k3, tau23)
+        signals.q_set = [float(q1), float(q2), float(q3), float(q4)]
 

@@ -41,8 +41,8 @@ class Signals:
         self.t = 0.0
         self.task: np.ndarray | list[float] = np.full(4, np.nan)  # X, Y, Z, phi; NaN: no task pose
         self.fr_sw = False
-        self.q_des: np.ndarray = np.full(4, np.nan)  # IK output
-        self.q_set: np.ndarray | list[float] = np.full(4, np.nan)  # to the controllers
+        self.q_des: np.ndarray | Sequence[float] = np.full(4, np.nan)  # IK output
+        self.q_set: np.ndarray | Sequence[float] = np.full(4, np.nan)  # to the controllers
         self.ik_iterations = 0
         self.ik_error: str | None = None
         self._read_sensors = read_sensors
@@ -156,11 +156,11 @@ class Scheduler:
         self.ik_failures = 0
         self.limit_clamps = 0
         self.record = Record() if record else None
-        self._hold = np.asarray(sim.q_encoder.tolist() + [sim.q_true[3]], dtype=float)
+        self._hold: Sequence[float] = [*sim.encoder_angles(), sim.true_angles()[3]]
         self._clock_started = False
         self._period0 = 0
         self._ik_pose: list[float] = []  # the last pose solved, and its answer
-        self._ik_q: np.ndarray = np.full(4, np.nan)
+        self._ik_q: Sequence[float] = (math.nan,) * 4
 
     @property
     def t(self) -> float:
@@ -182,7 +182,7 @@ class Scheduler:
         self.sim.assume_initialised()
         for drive in (1, 2, 3):
             self.mark_homed(drive)
-        self._hold = np.asarray(self.sim.q_encoder.tolist() + [self.sim.q_true[3]], dtype=float)
+        self._hold = [*self.sim.encoder_angles(), self.sim.true_angles()[3]]
 
     def set_clock(self, clock: VirtualClock | WallClock) -> None:
         """Switch clocks; the new clock's period 0 is the next control step."""
@@ -211,12 +211,12 @@ class Scheduler:
                 # state) and report; never pass a wrong answer to the drives.
                 self.ik_failures += 1
                 s.ik_error = str(exc)
-                s.q_des = self._hold.copy()
+                s.q_des = list(self._hold)
             else:
                 s.q_des = q_ik
                 self._ik_pose, self._ik_q = pose, q_ik
         else:
-            s.q_des = self._hold.copy()
+            s.q_des = list(self._hold)
         s.q_set = s.q_des
         for stage in self.joint_stages:
             stage.tick(s)
@@ -228,8 +228,8 @@ class Scheduler:
                 or q4 < lo[3] or q4 > hi[3]):
             q = [min(max(v, lo[i]), hi[i]) for i, v in enumerate(q)]
             self.limit_clamps += 1
-            s.q_set = np.array(q)
-        self._hold = s.q_set
+            s.q_set = q
+        self._hold = q
         self.sim.set_setpoints(q, s.fr_sw)
         self.chart_ticks += 1
         if self.record is not None:

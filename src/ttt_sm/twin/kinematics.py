@@ -503,14 +503,23 @@ def damped_least_squares(target: Any, q0: Any, geometry: Geometry, ik: IKParams,
 
 
 @numba.njit(cache=True)
-def _solve_pose_kernel(x: float, y: float, z: float, phi: float, q0: np.ndarray, geom: np.ndarray,
-                       q_min: np.ndarray, q_max: np.ndarray, damping: float, tolerance: float,
-                       max_iterations: int, adaptive: bool) -> tuple[np.ndarray, int, float, int]:
-    """:func:`_dls_kernel` then :func:`_unwind`, in one call: the control loop's warm solve."""
+def _solve_pose_kernel(x: float, y: float, z: float, phi: float, s1: float, s2: float, s3: float, s4: float,
+                       consts: np.ndarray, damping: float, tolerance: float, max_iterations: int,
+                       adaptive: bool) -> tuple[float, float, float, float, int, float, int]:
+    """:func:`_dls_kernel` then :func:`_unwind` in one call, on plain numbers: the control loop's solve.
+
+    `consts` is the geometry vector, then the joint minima, then the maxima.
+    Returns ``(q1, q2, q3, q4, iterations, residual, violation)``: numbers
+    only, because a returned array costs more to hand back than the solve.
+    """
     target = np.empty(4)
     target[0], target[1], target[2], target[3] = x, y, z, phi
-    q, iterations, residual = _dls_kernel(target, q0, geom, damping, tolerance, max_iterations, adaptive)
-    return q, iterations, residual, _unwind(q, q_min, q_max)
+    start = np.empty(4)
+    start[0], start[1], start[2], start[3] = s1, s2, s3, s4
+    q, iterations, residual = _dls_kernel(target, start, consts[:5], damping, tolerance, max_iterations,
+                                          adaptive)
+    violation = _unwind(q, consts[5:9], consts[9:13])
+    return q[0], q[1], q[2], q[3], iterations, residual, violation
 
 
 # --------------------------------------------------------------------------- solver for the control loop
@@ -540,17 +549,25 @@ class IKSolver:
         self._q_min = np.array(params.joint_min)
         self._q_max = np.array(params.joint_max)
         self._last_q: np.ndarray | None = None
+        # the last solution as numbers (solve_pose keeps only these; last_q is made on demand)
+        self._last_floats: tuple[float, float, float, float] | None = None
+        self._consts = np.concatenate([self._geom, self._q_min, self._q_max])
         ik = params.ik
         self._settings = (ik.damping, ik.tolerance, ik.max_iterations, adaptive)
 
     @property
     def last_q(self) -> np.ndarray | None:
         """The last solution (rad, shape (4,), read-only), None after :meth:`reset`."""
+        if self._last_q is None and self._last_floats is not None:
+            q = np.array(self._last_floats)
+            q.flags.writeable = False
+            self._last_q = q
         return self._last_q
 
     def reset(self) -> None:
         """Forget the last solution: the next solve starts from :data:`HOME_Q`."""
         self._last_q = None
+        self._last_floats = None
 
     def solve(self, target: Any, q0: Any = None) -> IKResult:
         """Joint angles that put the tool at `target`.
@@ -580,7 +597,8 @@ class IKSolver:
         if q0 is not None:
             start = _as_shape4(q0, "start pose q0")
         else:
-            start = self._last_q if self._last_q is not None else self._home
+            last = self.last_q
+            start = last if last is not None else self._home
         ik = self.params.ik
         q, iterations, residual = _dls_kernel(t, start, self._geom, ik.damping, ik.tolerance,
                                               ik.max_iterations, self.adaptive)
@@ -603,24 +621,29 @@ class IKSolver:
             raise JointLimitError(t, violation, q[joint], self._q_min[joint], self._q_max[joint])
         q.flags.writeable = False
         self._last_q = q
+        self._last_floats = tuple(q.tolist())  # type: ignore[assignment]
         return IKResult(q, iterations, residual, True)
 
-    def solve_pose(self, x: float, y: float, z: float, phi: float) -> tuple[np.ndarray, int]:
+    def solve_pose(self, x: float, y: float, z: float, phi: float
+                   ) -> tuple[tuple[float, float, float, float], int]:
         """:meth:`solve` warm-started, for the control loop: the pose as four numbers, the answer
-        as ``(q, iterations)``.
+        as ``((q1, q2, q3, q4), iterations)``.
 
-        Same answer and the same errors as :meth:`solve`; the common case (the
-        warm start converges within the limits) is one compiled call.
+        Same angles and the same errors as :meth:`solve`; the common case (the
+        warm start converges within the limits) is one compiled call on plain
+        numbers, with no array made.
         """
-        start = self._last_q if self._last_q is not None else self._home
+        start = self._last_floats if self._last_floats is not None else HOME_Q
         damping, tolerance, max_iterations, adaptive = self._settings
-        q, iterations, residual, violation = _solve_pose_kernel(
-            x, y, z, phi, start, self._geom, self._q_min, self._q_max, damping, tolerance,
+        q1, q2, q3, q4, iterations, residual, violation = _solve_pose_kernel(
+            x, y, z, phi, start[0], start[1], start[2], start[3], self._consts, damping, tolerance,
             max_iterations, adaptive)
         if violation or not residual <= tolerance:
             # a retry from HOME_Q, or an error that names the problem: the full path
             result = self.solve([x, y, z, phi])
-            return result.q, result.iterations
-        q.flags.writeable = False
-        self._last_q = q
+            assert self._last_floats is not None
+            return self._last_floats, result.iterations
+        q = (q1, q2, q3, q4)
+        self._last_floats = q
+        self._last_q = None
         return q, iterations

@@ -83,7 +83,9 @@ def cmd_play(args: argparse.Namespace) -> int:
         report = session.play()
         files = session.save(Path(args.out))
     except GameError as exc:
-        raise CliError(str(exc)) from exc
+        # what happened up to the failure is kept: the record and the board as it is
+        saved = session.save(Path(args.out))
+        raise CliError(f"{exc} (the game so far: {saved['record']}, {saved['board_png']})") from exc
     finally:
         session.close()
     report.update(files)

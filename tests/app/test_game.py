@@ -145,3 +145,26 @@ def test_the_game_bench_plays_whole_games_and_reports_their_pace():
     sim, wall = result["game_sim_time_s"], result["game_wall_time_s"]
     assert sim > 60.0 and result["game_realtime_factor"] == pytest.approx(sim / wall, abs=0.06)
     assert result["game_realtime_factor_min"] == pytest.approx(result["game_realtime_factor"], abs=0.1)
+
+
+def test_two_symbols_at_once_end_the_game_with_a_clear_error_and_the_record_kept(monkeypatch, capsys, tmp_path):
+    from ttt_sm.twin.whiteboard import Whiteboard
+
+    draw = Whiteboard.draw_symbol
+
+    def two_at_once(self, kind, row, column, **kw):  # the person's hand draws a second symbol too
+        draw(self, kind, row, column, **kw)
+        draw(self, kind, *((1, 1) if (row, column) != (1, 1) else (5, 5)), **kw)
+
+    monkeypatch.setattr(Whiteboard, "draw_symbol", two_at_once)
+    code = main(["play", "--opponent", "simulated", "--camera", "direct", "--seed", "2", "--json",
+                 "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code != 0
+    assert "the camera's view was refused" in err and "2 new symbols" in err and "game.jsonl" in err
+    events = [json.loads(line) for line in (tmp_path / "game.jsonl").read_text().splitlines()]
+    kinds = [e["event"] for e in events]
+    assert "field_drawn" in kinds and kinds.count("person_drew") == 1
+    rejected = [e for e in events if e["event"] == "detection_rejected"]
+    assert len(rejected) == 1 and "only one per turn" in rejected[0]["message"]
+    assert (tmp_path / "board_final.png").stat().st_size > 0

@@ -1,0 +1,74 @@
+"""`ttt-sm play` at a real terminal (a pseudo-terminal): the person types moves, a whole game is played."""
+
+import os
+import re
+import select
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pty = pytest.importorskip("pty")
+
+TTT = Path(sys.executable).with_name("ttt-sm")
+
+
+def _read_until(fd: int, pattern: re.Pattern[str], buffer: list[str], timeout_s: float) -> re.Match[str] | None:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        text = "".join(buffer)
+        found = pattern.search(text)
+        if found:
+            return found
+        ready, _, _ = select.select([fd], [], [], 0.5)
+        if ready:
+            try:
+                chunk = os.read(fd, 4096)
+            except OSError:  # the child closed the terminal
+                return pattern.search("".join(buffer))
+            if not chunk:
+                return pattern.search("".join(buffer))
+            buffer.append(chunk.decode(errors="replace"))
+    return None
+
+
+def _free_cell(picture: str) -> tuple[int, int]:
+    rows = [line.split()[1:] for line in picture.splitlines()[1:]]
+    for r, row in enumerate(rows, 1):
+        for c, mark in enumerate(row, 1):
+            if mark == ".":
+                return r, c
+    raise AssertionError(f"no free cell in\n{picture}")
+
+
+@pytest.mark.skipif(not TTT.exists(), reason="the ttt-sm console script is not installed beside python")
+def test_make_play_s_command_plays_a_whole_game_with_the_person_typing(tmp_path):
+    main_fd, child_fd = pty.openpty()
+    proc = subprocess.Popen([str(TTT), "play", "--out", str(tmp_path)], stdin=child_fd, stdout=child_fd,
+                            stderr=child_fd, close_fds=True, cwd=tmp_path)
+    os.close(child_fd)
+    buffer: list[str] = []
+    prompt = re.compile(r"(    1 2 3 4 5\r?\n(?:  \d [.XO ]+\r?\n){5})Your move \(X\): [^\n]*$")
+    moves = 0
+    try:
+        while moves < 13:
+            found = _read_until(main_fd, prompt, buffer, 120.0)
+            if found is None:
+                break
+            picture = found.group(1).replace("\r", "")
+            row, column = _free_cell(picture)
+            buffer.clear()
+            os.write(main_fd, f"{row} {column}\n".encode())
+            moves += 1
+        assert proc.wait(timeout=180) == 0
+        _read_until(main_fd, re.compile(r"board_png"), buffer, 5.0)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        os.close(main_fd)
+    text = "".join(buffer)
+    assert moves >= 4  # four in a row takes at least four moves of the winner
+    assert "The manipulator wins." in text or "You win." in text or "Draw" in text
+    assert "erased: True" in text and (tmp_path / "game.jsonl").exists()

@@ -554,6 +554,9 @@ class IKSolver:
         self._consts = np.concatenate([self._geom, self._q_min, self._q_max])
         ik = params.ik
         self._settings = (ik.damping, ik.tolerance, ik.max_iterations, adaptive)
+        # Load the control loop's compiled solve now, not in the first chart step; the answer
+        # is not kept (the first solve still starts from HOME_Q).
+        _solve_pose_kernel(*_fk_floats(*HOME_Q, *self._geom.tolist()), *HOME_Q, self._consts, *self._settings)
 
     @property
     def last_q(self) -> np.ndarray | None:

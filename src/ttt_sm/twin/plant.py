@@ -180,6 +180,9 @@ class ArmSim:
         self._div = _flat_view(self._di)
         self._gsv = _flat_view(self._gs)
         self._power_on(q_start, np.random.default_rng(seed))
+        # Load the compiled kernel now (from numba's disk cache: ~0.3 s the first time in a
+        # process), not in the first control step: zero steps change nothing.
+        K.run_steps(0, self._dp, self._gp, self._ds, self._di, self._gs, self._no_rec)
 
     # ---- construction -------------------------------------------------------
 

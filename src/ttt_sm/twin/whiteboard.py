@@ -79,6 +79,14 @@ _SPONGE_MIN_SIN = math.cos(SPONGE_MAX_TILT_RAD)
 Region = tuple[float, float, float, float]
 
 
+def _load_kernels(ink: np.dtype, stamp: np.dtype) -> None:
+    """Load the compiled ink and wipe kernels now (numba's disk cache), not when the pen first
+    touches: on a scratch raster, with the argument types the board passes."""
+    raster, stamps = np.zeros((2, 2), ink), np.zeros((2, 2), stamp)
+    ink_capsule(raster, 0.0, 0.0, 1.0, 0.5, 0.5, 0.5, 0.5, 0.1, 1)
+    wipe_sweep(raster, stamps, 0.0, 0.0, 1.0, 0.1, 0.5, 0.5, 1.0, 0.0, 0.5, 0.5, 1.0, 0.0, False, 1)
+
+
 class WhiteboardError(ValueError):
     """A whiteboard call got a value it cannot use (cell, region, stroke, file)."""
 
@@ -218,6 +226,7 @@ class Whiteboard:
         self._x1, self._y1 = x0 + nx * self._res, y0 + ny * self._res
         self._ink = np.zeros((ny, nx), np.uint8)
         self._stamp = np.zeros((ny, nx), np.int32)  # sequence number of each pixel's last wipe
+        _load_kernels(self._ink.dtype, self._stamp.dtype)
         self._travel = params.pen.spring_travel
         self._zone_depth = b.zone_depth
         self._tip_dev = params.pen.holder_clearance * TIP_DEVIATION_PER_CLEARANCE

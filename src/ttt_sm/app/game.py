@@ -146,7 +146,7 @@ class GameStage:
         active = c.active_ids
         waiting = "wait_1" in active
         g = s.game
-        self.game_inputs.update(initialised=r.init_stage.done, ready=waiting and bool(c.Pl_fld),
+        self.game_inputs.update(initialised=r.initialised, ready=waiting and bool(c.Pl_fld),
                                 busy=not waiting, result=s.result_code, erased=s.erased_seen,
                                 play_again=False, finished="finished" in active)
         g.tick()

@@ -69,7 +69,6 @@ class TickChartMeta(StateMachineMetaclass):
         _check_during_names(cls, structure)
         _check_temporal_guards(cls, structure)
         cls._structure = structure
-        cls._state_names = frozenset(s.id for s in structure.states)
         events = getattr(cls, "_events", {})
         for state in structure.states:
             # (a state named like an event is reached through the event, as in the library)
@@ -191,7 +190,6 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     _structure: ClassVar[ChartStructure]
     _data_decls: ClassVar[tuple[Data, ...]] = ()
     _prev_pairs: ClassVar[tuple[tuple[str, str], ...]] = ()
-    _state_names: ClassVar[frozenset[str]] = frozenset()
 
     def __init__(
         self,

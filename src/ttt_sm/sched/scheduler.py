@@ -197,7 +197,7 @@ class Scheduler:
         for stage in self.task_stages:
             stage.tick(s)
         task = s.task
-        pose = task.tolist() if type(task) is np.ndarray else list(task)
+        pose = as_floats(task)
         if pose == self._ik_pose:
             # The same pose as last step (the arm waits): IK is a function of
             # the pose and its warm start, so the answer is the last one.

@@ -3,7 +3,7 @@
 from pathlib import Path
 
 from ttt_sm.charts import ALL_CHARTS
-from ttt_sm.cli import REPO_CHART_FORMATS
+from ttt_sm.cli.commands import REPO_CHART_FORMATS
 from ttt_sm.runtime.export import stale_files
 
 REPO = Path(__file__).resolve().parents[2]

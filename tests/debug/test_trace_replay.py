@@ -10,7 +10,8 @@ import pytest
 from ttt_sm.app.robot import Robot
 from ttt_sm.debug import DebugError, Debugger
 from ttt_sm.debug.replay import differences
-from ttt_sm.runtime.listeners import Trace, jsonable
+from ttt_sm.runtime.jsonable import jsonable
+from ttt_sm.runtime.listeners import Trace
 
 
 def _twin_arrays(d: Debugger) -> list[np.ndarray]:

@@ -6,7 +6,8 @@ import json
 
 import pytest
 
-from ttt_sm.game.cli import ai_move, main
+from ttt_sm.cli import main
+from ttt_sm.cli.ai import ai_move
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:

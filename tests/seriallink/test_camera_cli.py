@@ -10,8 +10,8 @@ import time
 
 import pytest
 
+from ttt_sm.cli.camera import register
 from ttt_sm.seriallink import CameraEmulator, board_source
-from ttt_sm.seriallink.cli import register
 
 
 def run(*argv: str) -> int:

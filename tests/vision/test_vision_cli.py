@@ -9,7 +9,7 @@ from pathlib import Path
 import cv2
 import pytest
 
-from ttt_sm.vision.cli import register
+from ttt_sm.cli.vision import register
 
 
 def run(argv: list[str]) -> int:

@@ -13,7 +13,6 @@ announces the result, erases the board and turns the arm off.
 from __future__ import annotations
 
 import gc
-import json
 import sys
 import time
 from collections.abc import Callable
@@ -27,6 +26,7 @@ from ..charts.game import AlgorithmActivator, Game
 from ..game.bitboard import FULL, bits, cell_index, cell_of, win_cells
 from ..game.rules import is_full, parse_board, winner
 from ..params import ArmParams
+from ..runtime.jsonable import dumps
 from ..runtime.listeners import Trace
 from ..sched.scheduler import Signals
 from ..vision import MoveError, percent_process
@@ -372,10 +372,10 @@ class GameSession:
         record = out_dir / "game.jsonl"
         with record.open("w") as f:
             for e in self.record.events:
-                f.write(json.dumps(e) + "\n")
+                f.write(dumps(e) + "\n")
             if self.trace is not None:
                 for rec in self.trace.records:
-                    f.write(json.dumps({"event": "transition", **asdict(rec)}, default=str) + "\n")
+                    f.write(dumps({"event": "transition", **asdict(rec)}) + "\n")
         png = self.robot.board.save_png(out_dir / "board_final.png", grid_mm=True)
         return {"record": str(record), "board_png": str(png)}
 

@@ -28,8 +28,9 @@ from statemachine import StateChart
 from statemachine.state import State
 from statemachine.transition import Transition
 
+from ..runtime.errors import suggest
 from ..runtime.structure import TICK_EVENT_NAME, TICK_EVENT_PREFIX, ChartStructure
-from .errors import DebugError, suggest
+from .errors import DebugError
 from .expr import Condition, Names, parse_condition
 
 Kind = Literal["enter", "exit", "transition", "event", "when"]

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import difflib
-from collections.abc import Iterable
-
 
 class DebugError(ValueError):
     """A debugger command or API call that cannot be done: unknown chart, state,
@@ -13,9 +10,3 @@ class DebugError(ValueError):
     The message is one line naming what was wrong and, where it helps, what
     exists instead; the REPL prints it and the session goes on.
     """
-
-
-def suggest(word: str, options: Iterable[str]) -> str:
-    """`` (did you mean 'x'?)`` for a near miss among ``options``, else ``""``."""
-    close = difflib.get_close_matches(word, list(options), n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""

@@ -8,7 +8,8 @@ from typing import Any
 from ..app.robot import Robot
 from ..runtime import Data
 from ..runtime.conditions import UNITS
-from .errors import DebugError, suggest
+from ..runtime.errors import suggest
+from .errors import DebugError
 
 
 def datum_decl(robot: Robot, chart: str, name: str) -> Data:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import cmd
 import inspect
-import json
 import shlex
 import sys
 from collections.abc import Iterable
@@ -19,7 +18,7 @@ from typing import IO, Any
 
 from ..app.robot import RobotError
 from ..runtime import UnknownDataError, UnknownEventError
-from ..runtime.listeners import jsonable
+from ..runtime.jsonable import dumps
 from . import views
 from .debugger import Debugger
 from .errors import DebugError
@@ -238,7 +237,7 @@ class DebugShell(cmd.Cmd):
         elif what == "inputs":
             self.say(*views.action_lines(self.dbg.actions))
         elif what == "snapshot":
-            self.say(json.dumps(jsonable(self.dbg.robot.snapshot()), sort_keys=True))
+            self.say(dumps(self.dbg.robot.snapshot(), sort_keys=True))
         else:
             raise DebugError(f"show what? {what!r} is not one of: {', '.join(_SHOW)}" if what
                              else f"show what? one of: {', '.join(_SHOW)}")

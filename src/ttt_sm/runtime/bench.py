@@ -5,7 +5,6 @@ Run ``python -m ttt_sm.runtime.bench`` (prints JSON), or call :func:`bench_quiet
 
 from __future__ import annotations
 
-import json
 import statistics
 import timeit
 from typing import Any
@@ -14,6 +13,7 @@ from statemachine import State, StateChart
 
 from .chart import TickChart
 from .data import Data
+from .jsonable import dumps
 
 
 class BenchMove(TickChart):
@@ -130,4 +130,4 @@ def bench_quiet_tick(repeat: int = 21, number: int = 2000) -> dict[str, float]:
 
 
 if __name__ == "__main__":
-    print(json.dumps(bench_quiet_tick(), indent=2))
+    print(dumps(bench_quiet_tick(), indent=2))

@@ -2,7 +2,20 @@
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
 from statemachine.exceptions import InvalidDefinition
+
+
+def suggest(word: object, options: Iterable[str]) -> str:
+    """`` (did you mean 'x'?)`` for a near miss of ``word`` among ``options``, else ``""``.
+
+    The one name-suggestion helper of the package: the debugger and the
+    scenario loader name a chart, state, event or datum the same way.
+    """
+    close = difflib.get_close_matches(str(word), list(options), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 class ChartDefinitionError(InvalidDefinition):

@@ -11,8 +11,7 @@ every state of the library's own instance diagrams.
 from __future__ import annotations
 
 import json
-import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -20,6 +19,7 @@ from typing import IO, Any
 from statemachine import StateChart
 from statemachine.transition import Transition
 
+from .jsonable import dumps, jsonable
 from .structure import TICK_EVENT_NAME, TICK_EVENT_PREFIX, build_structure, states_entered_by
 
 
@@ -31,22 +31,6 @@ def _structure_of(machine: StateChart | type[StateChart]) -> Any:
     cls = machine if isinstance(machine, type) else type(machine)
     structure = getattr(cls, "_structure", None)
     return structure if structure is not None else build_structure(cls)
-
-
-def jsonable(value: Any) -> Any:
-    """A JSON-friendly copy of ``value``: numpy scalars and arrays become numbers and lists."""
-    if value is None or isinstance(value, (bool, int, str)):
-        return value
-    if isinstance(value, float):
-        return value if math.isfinite(value) else repr(value)
-    if isinstance(value, Mapping):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [jsonable(v) for v in value]
-    tolist = getattr(value, "tolist", None)  # numpy arrays and scalars
-    if callable(tolist):
-        return jsonable(tolist())
-    return repr(value)
 
 
 @dataclass(frozen=True)
@@ -68,7 +52,7 @@ class TraceRecord:
     event_args: dict[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> str:
-        return json.dumps(asdict(self), sort_keys=True)
+        return dumps(asdict(self), sort_keys=True)
 
     @classmethod
     def from_json(cls, line: str) -> TraceRecord:

@@ -10,7 +10,7 @@ piece of documentation: ``tests/scenarios/drive_1_turns_back_at_a_hard_stop.yaml
   shared with the debugger's ``break when``;
 - :mod:`.model`, :mod:`.loader`: the steps, checked against the charts;
 - :mod:`.runner`: runs a scenario on the simulated robot; :mod:`.suite`: several, with coverage;
-- :mod:`.cli`: ``ttt-sm scenario run``; :mod:`.pytest_plugin`: YAML files as tests.
+- :mod:`.pytest_plugin`: YAML files as tests; ``ttt-sm scenario run`` is :mod:`ttt_sm.cli.scenario`.
 
 See ``docs/scenarios.md``.
 """

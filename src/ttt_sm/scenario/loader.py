@@ -15,7 +15,6 @@ them).
 
 from __future__ import annotations
 
-import difflib
 import math
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
@@ -23,6 +22,7 @@ from typing import Any
 
 from ..runtime import TickChart
 from ..runtime.conditions import KEYWORDS, ExprError, Expression, parse
+from ..runtime.errors import suggest
 from .errors import ScenarioError
 from .model import (
     BareCharts,
@@ -60,11 +60,6 @@ STEP_OPTIONS: dict[str, tuple[str, ...]] = {
 MATCH_MODES = ("subsequence", "exact")
 #: The signals a bare-chart scenario may read: the chart time, s.
 BARE_SIGNALS: Mapping[str, int | None] = {"t": None}
-
-
-def _guess(word: object, options: Iterable[str]) -> str:
-    close = difflib.get_close_matches(str(word), list(options), n=1, cutoff=0.6)
-    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def _type_name(value: Any) -> str:
@@ -176,7 +171,7 @@ class _Checker:
         charts: dict[str, type[TickChart]] = {}
         for name, chart, n_line in pairs:
             if not isinstance(chart, str) or chart not in known:
-                raise self.error(n_line, f"{key}: unknown chart {chart!r}{_guess(chart, known)};"
+                raise self.error(n_line, f"{key}: unknown chart {chart!r}{suggest(chart, known)};"
                                          f" charts: {', '.join(known)}")
             if not isinstance(name, str) or not name.isidentifier() or name in KEYWORDS:
                 raise self.error(n_line, f"charts: {name!r} cannot name a chart in a condition: use letters,"
@@ -192,7 +187,7 @@ class _Checker:
         allowed = tuple(allowed)
         for key in mapping:
             if key not in allowed:
-                raise self.error(mapping.key_lines[key], f"{what}: unknown key {key!r}{_guess(key, allowed)};"
+                raise self.error(mapping.key_lines[key], f"{what}: unknown key {key!r}{suggest(key, allowed)};"
                                                          f" keys: {', '.join(allowed)}")
 
     def text(self, mapping: MarkedDict, key: str) -> str:
@@ -236,7 +231,7 @@ class _Checker:
         kinds = [k for k in item if k in STEP_OPTIONS]
         if not kinds:
             key = next(iter(item))
-            raise self.error(item.key_lines[key], f"unknown step kind {key!r}{_guess(key, STEP_OPTIONS)};"
+            raise self.error(item.key_lines[key], f"unknown step kind {key!r}{suggest(key, STEP_OPTIONS)};"
                                                   f" step kinds: {', '.join(STEP_OPTIONS)}")
         if len(kinds) > 1:
             raise self.error(item.key_lines[kinds[1]], f"one step, two actions ({kinds[0]!r} and"
@@ -297,7 +292,7 @@ class _Checker:
         if event not in events:
             listed = ", ".join(events) or "(none: all its transitions are tick transitions)"
             raise self.error(value.line_of("event"), f"post: {chart} handles no event {event!r}"
-                                                     f"{_guess(event, events)}; events: {listed}")
+                                                     f"{suggest(event, events)}; events: {listed}")
         data = value.get("data", {})
         if not isinstance(data, dict) or not all(isinstance(k, str) and k.isidentifier() for k in data):
             raise self.error(value.line_of("data"), "post: data expected a mapping of names to values")
@@ -398,7 +393,7 @@ class _Checker:
                                    f" {', '.join(charts)}); run it alone: put 'chart: {name}' at the top"
                                    " of the file")
         if not isinstance(name, str) or name not in charts:
-            raise self.error(line, f"{what}: unknown chart {name!r}{_guess(name, charts)};"
+            raise self.error(line, f"{what}: unknown chart {name!r}{suggest(name, charts)};"
                                    f" charts: {', '.join(charts)}")
         return name
 
@@ -407,7 +402,7 @@ class _Checker:
         states = states if states is not None else chart_states(self.charts[chart])
         if not isinstance(name, str) or name not in states:
             real = [s for s, k in states.items() if k != "history"]
-            raise self.error(line, f"{what}: {chart} has no state {name!r}{_guess(name, real)};"
+            raise self.error(line, f"{what}: {chart} has no state {name!r}{suggest(name, real)};"
                                    f" states: {', '.join(real)}")
         if states[name] == "history":
             raise self.error(line, f"{what}: {chart}.{name} is a history pseudo-state: it is never entered"
@@ -431,7 +426,7 @@ class _Checker:
             if name in data:
                 problem = f"{chart}.{name} is an {data[name]}, not an input"
             else:
-                problem = f"{chart} has no input {name!r}{_guess(name, inputs)}"
+                problem = f"{chart} has no input {name!r}{suggest(name, inputs)}"
             raise self.error(line, f"{what}: {problem}; inputs: {', '.join(inputs)}")
         return ChartRef(chart, name)
 
@@ -456,7 +451,7 @@ class _Checker:
             if ref.name not in data and ref.name not in states:
                 names = [*data, *(s for s, k in states.items() if k != "history")]
                 raise self.error(line, f"{what}: {ref.chart} has no datum or state {ref.name!r}"
-                                       f"{_guess(ref.name, names)}{at}; data: {', '.join(data)}")
+                                       f"{suggest(ref.name, names)}{at}; data: {', '.join(data)}")
             if ref.index is not None:
                 raise self.error(line, f"{what}: {ref.chart}.{ref.name} is not a list: no [{ref.index}]{at}")
             return
@@ -466,7 +461,7 @@ class _Checker:
                                    f" without the arm: a condition reads the charts' data and states, and"
                                    f" t (chart time){at}")
         if ref.name not in signals:
-            raise self.error(line, f"{what}: unknown name {ref.name!r}{_guess(ref.name, signals)}{at};"
+            raise self.error(line, f"{what}: unknown name {ref.name!r}{suggest(ref.name, signals)}{at};"
                                    f" a chart datum is Chart.name; signals: {', '.join(signals)}")
         size = signals[ref.name]
         if size is None and ref.index is not None:

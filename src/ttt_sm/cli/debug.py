@@ -11,6 +11,8 @@ import math
 import sys
 from typing import Any
 
+from .common import CliError
+
 
 def register(sub: Any) -> argparse.ArgumentParser:
     """Add the ``debug`` subcommand to the subparsers of ``ttt-sm``."""
@@ -44,10 +46,9 @@ def parse_start(text: str) -> tuple[float, ...]:
 
 def cmd_debug(args: argparse.Namespace) -> int:
     """Build the robot, then run the REPL: scripted (file or pipe) or interactive."""
-    from ..cli import CliError
+    from ..debug.debugger import Debugger
+    from ..debug.shell import DebugShell
     from ..params import load_params
-    from .debugger import Debugger
-    from .shell import DebugShell
 
     params = load_params(getattr(args, "params", None))
     try:

@@ -9,15 +9,15 @@ passed, 1 if one failed, 2 if a file could not be loaded (nothing runs then).
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from typing import Any
 
-from .errors import ScenarioError
-from .loader import load_scenario, scenario_files
-from .model import Scenario
-from .runner import ScenarioResult
-from .suite import run_scenarios
+from ..scenario.errors import ScenarioError
+from ..scenario.loader import load_scenario, scenario_files
+from ..scenario.model import Scenario
+from ..scenario.runner import ScenarioResult
+from ..scenario.suite import run_scenarios
+from .common import print_json
 
 
 def register(sub: Any) -> None:
@@ -59,7 +59,7 @@ def _report_errors(errors: list[ScenarioError], as_json: bool) -> int:
     for e in errors:
         print(f"ttt-sm scenario: error: {e}", file=sys.stderr)
     if as_json:
-        print(json.dumps({"passed": False, "errors": [str(e) for e in errors], "scenarios": []}, indent=2))
+        print_json({"passed": False, "errors": [str(e) for e in errors], "scenarios": []})
     return 2
 
 
@@ -85,7 +85,7 @@ def cmd_scenario_run(args: argparse.Namespace) -> int:
 
     report = run_scenarios(scenarios, params, coverage=args.coverage, trace_dir=args.trace, progress=progress)
     if args.json:
-        print(json.dumps(report.to_dict(), indent=2))
+        print_json(report.to_dict())
     else:
         counts = report.to_dict()["counts"]
         sim = sum(r.sim_time_s for r in report.results)
@@ -104,7 +104,7 @@ def cmd_scenario_check(args: argparse.Namespace) -> int:
         return _report_errors(errors, args.json)
     data = [{"name": s.name, "file": s.file, "steps": len(s.steps)} for s in scenarios]
     if args.json:
-        print(json.dumps({"passed": True, "errors": [], "scenarios": data}, indent=2))
+        print_json({"passed": True, "errors": [], "scenarios": data})
     else:
         for s in scenarios:
             print(f"ok {s.name}  ({s.file}; {len(s.steps)} steps)")

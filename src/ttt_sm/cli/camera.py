@@ -13,7 +13,6 @@ import argparse
 import contextlib
 import dataclasses
 import itertools
-import json
 import logging
 import math
 import sys
@@ -23,10 +22,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from .emulator import CameraEmulator, Fault
-from .errors import SerialLinkError
-from .reader import ReconnectPolicy, SerialCameraReader
-from .sources import board_source
+from ..seriallink.emulator import CameraEmulator, Fault
+from ..seriallink.errors import SerialLinkError
+from ..seriallink.reader import ReconnectPolicy, SerialCameraReader
+from ..seriallink.sources import board_source
+from .common import print_json
 
 DEFAULT_LINK = str(Path(tempfile.gettempdir()) / "ttt-sm-camera")
 """Where ``serve`` puts its stable link and ``read`` looks by default."""
@@ -124,7 +124,7 @@ def cmd_camera_serve(args: argparse.Namespace) -> int:
         pass
     stats = dataclasses.asdict(cam.stats)
     if args.json:
-        print(json.dumps({"link": args.link, "stats": stats}, indent=2))
+        print_json({"link": args.link, "stats": stats})
     else:
         print("camera: stopped; " + ", ".join(f"{k} {v}" for k, v in stats.items()), file=sys.stderr)
     return 0
@@ -153,7 +153,7 @@ def cmd_camera_read(args: argparse.Namespace) -> int:
     if args.json:
         doc = {"port": args.port, "frames": [{"seq": f.seq, "percentages": list(f.percentages)} for f in frames],
                "stats": {**dataclasses.asdict(stats), "rejected_total": stats.rejected_total}}
-        print(json.dumps(doc, indent=2))
+        print_json(doc)
     else:
         why = ", ".join(f"{k} {v}" for k, v in sorted(stats.rejected.items()))
         print(f"{stats.frames_ok} frames, rejected {stats.rejected_total}{f' ({why})' if why else ''},"

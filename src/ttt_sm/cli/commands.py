@@ -1,75 +1,39 @@
-"""`ttt-sm`: the command line.  A thin layer: parse, call the app, print.
+"""The robot's own subcommands of ``ttt-sm``: play, demo, draw, tune, bench, ik, init, charts, params.
 
-Every result-producing subcommand has `--json` (one JSON document on
-standard output, progress on standard error).  Errors are one readable line
-on standard error and exit status 2.
+Each ``cmd_*`` parses nothing and prints one result (:func:`.common.emit`);
+:func:`register` adds them, with their options, to the ``ttt-sm`` parser.
+The application is imported only when a command runs, so the CLI starts fast.
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import sys
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .debug.cli import register as register_debug
-from .game.cli import register as register_ai
-from .params import ParameterError, load_params
-from .scenario.cli import register as register_scenario
-from .seriallink.cli import register as register_camera
-from .vision.cli import register as register_vision
-
-
-class CliError(Exception):
-    """A user error the CLI reports as one line."""
-
-
-def _progress(enabled: bool):
-    def say(msg: str) -> None:
-        if enabled:
-            print(msg, file=sys.stderr, flush=True)
-    return say
-
-
-def _emit(data: Any, as_json: bool, text: str | None = None) -> None:
-    if as_json:
-        print(json.dumps(data, indent=2, default=_jsonable))
-    else:
-        print(text if text is not None else json.dumps(data, indent=2, default=_jsonable))
-
-
-def _jsonable(obj: Any) -> Any:
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        return dataclasses.asdict(obj)
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, (np.floating, np.integer, np.bool_)):
-        return obj.item()
-    if isinstance(obj, Path):
-        return str(obj)
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+from ..params import load_params
+from .common import CliError, add_command, emit, progress
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    from .app.play import run_play
+    from ..app.play import run_play
 
     params = load_params(args.params)
-    result = run_play(params, seed=args.seed, out_dir=Path(args.out), progress=_progress(True))
+    result = run_play(params, seed=args.seed, out_dir=Path(args.out), progress=progress(True))
     lines = [f"  {k}: {v}" for k, v in result.items() if k != "drawings"]
-    _emit(result, args.json, "demo:\n" + "\n".join(lines))
+    emit(result, args.json, "demo:\n" + "\n".join(lines))
     return 0
 
 
 def cmd_play(args: argparse.Namespace) -> int:
-    from .app.game import GameError, GameSession, SimulatedPerson, TerminalPerson
+    from ..app.game import GameError, GameSession, SimulatedPerson, TerminalPerson
 
     params = load_params(args.params)
-    say = _progress(True)
+    say = progress(True)
     opponent = args.opponent
     if opponent == "auto":
         opponent = "terminal" if sys.stdin.isatty() and not args.json else "simulated"
@@ -91,30 +55,30 @@ def cmd_play(args: argparse.Namespace) -> int:
     report.update(files)
     report["opponent"] = opponent
     lines = [f"  {k}: {v}" for k, v in report.items() if k not in ("moves", "camera_link")]
-    _emit(report, args.json, "play:\n" + "\n".join(lines))
+    emit(report, args.json, "play:\n" + "\n".join(lines))
     return 0
 
 
 def cmd_draw(args: argparse.Namespace) -> int:
-    from .app.drawing import DrawError, DrawSession, check_request
+    from ..app.drawing import DrawError, DrawSession, check_request
 
     params = load_params(args.params)
     speed = None if args.speed is None else args.speed / 1000
     size = None if args.size is None else args.size / 1000
     try:
         check_request(params, args.kind, args.row, args.column, speed, size)
-        session = DrawSession(params, seed=args.seed, progress=_progress(True))
+        session = DrawSession(params, seed=args.seed, progress=progress(True))
         session.start()
         result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=Path(args.out))
     except DrawError as exc:
         raise CliError(str(exc)) from exc
     data = dataclasses.asdict(result)
-    _emit(data, args.json, "\n".join(f"  {k}: {v}" for k, v in data.items()))
+    emit(data, args.json, "\n".join(f"  {k}: {v}" for k, v in data.items()))
     return 0
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
-    from .twin.tuning import tune_report
+    from ..twin.tuning import tune_report
 
     params = load_params(args.params)
     rows = tune_report(params, Path(args.out))
@@ -125,26 +89,26 @@ def cmd_tune(args: argparse.Namespace) -> int:
             f"{r['inner_phase_margin_deg']:>6.1f} {r['outer_phase_margin_deg']:>6.1f} "
             f"{r['outer_gain_margin_db']:>9.1f}" for r in rows]
     plots = [f"plot: {r['plot']}" for r in rows if r.get("plot")]
-    _emit(rows, args.json, "\n".join([header, *body, *plots]))
+    emit(rows, args.json, "\n".join([header, *body, *plots]))
     return 0
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from .bench import run_bench
+    from ..bench import run_bench
 
     params = load_params(args.params)
     only = [s.strip() for s in args.only.split(",")] if args.only else None
     try:
         result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=Path(args.out),
-                           progress=_progress(True))
+                           progress=progress(True))
     except ValueError as exc:
         raise CliError(str(exc)) from exc
-    _emit(result, args.json)
+    emit(result, args.json)
     return 0
 
 
 def cmd_ik(args: argparse.Namespace) -> int:
-    from .twin.kinematics import IKSolver, fk
+    from ..twin.kinematics import IKSolver, fk
 
     params = load_params(args.params)
     target = np.array([args.x / 1000, args.y / 1000, args.z / 1000, np.radians(args.phi)])
@@ -154,20 +118,20 @@ def cmd_ik(args: argparse.Namespace) -> int:
     data = {"q_deg": np.degrees(res.q).round(4).tolist(), "iterations": res.iterations,
             "residual": res.residual, "reached_mm_deg": [*(reached[:3] * 1000).round(4).tolist(),
                                                          round(float(np.degrees(reached[3])), 4)]}
-    _emit(data, args.json, f"q = {data['q_deg']} deg after {res.iterations} iterations "
+    emit(data, args.json, f"q = {data['q_deg']} deg after {res.iterations} iterations "
                            f"(residual {res.residual:.2e})")
     return 0
 
 
 def cmd_init(args: argparse.Namespace) -> int:
-    from .app.init_wiring import init_report
+    from ..app.init_wiring import init_report
 
     if args.starts < 1:
         raise CliError(f"--starts must be at least 1, got {args.starts}")
     params = load_params(args.params)
     report = init_report(params, args.starts, seed=args.seed)
     text = "\n".join(f"  {k}: {v}" for k, v in report.items())
-    _emit(report, args.json, f"init from {args.starts} random power-on poses:\n{text}")
+    emit(report, args.json, f"init from {args.starts} random power-on poses:\n{text}")
     ok = report["successes"] == report["runs"] and not report["limit_violations"] \
         and not report["board_zone_entries"]
     return 0 if ok else 1
@@ -178,8 +142,8 @@ REPO_CHART_FORMATS = ("svg", "mermaid")
 
 
 def cmd_charts(args: argparse.Namespace) -> int:
-    from .charts import ALL_CHARTS
-    from .runtime.export import FORMATS, export_command
+    from ..charts import ALL_CHARTS
+    from ..runtime.export import FORMATS, export_command
 
     formats = tuple(f.strip() for f in args.format.split(",")) if args.format else REPO_CHART_FORMATS
     unknown = [f for f in formats if f not in FORMATS]
@@ -191,31 +155,20 @@ def cmd_charts(args: argparse.Namespace) -> int:
             "stale (run `ttt-sm charts export`):\n" + "\n".join(f"  {f}" for f in result["stale"])  # type: ignore
     else:
         text = "wrote:\n" + "\n".join(f"  {f}" for f in result["written"])  # type: ignore[attr-defined]
-    _emit(result, args.json, text)
+    emit(result, args.json, text)
     return 0 if result.get("ok", True) else 1
 
 
 def cmd_params(args: argparse.Namespace) -> int:
     params = load_params(args.params)
-    _emit(dataclasses.asdict(params), args.json)
+    emit(dataclasses.asdict(params), args.json)
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of `ttt-sm` and its subcommands."""
-    p = argparse.ArgumentParser(prog="ttt-sm", description=__doc__.splitlines()[0])
-    p.add_argument("--params", metavar="FILE", default=None,
-                   help="parameter file (default: the packaged arm.toml)")
-    sub = p.add_subparsers(dest="command", required=True)
-
-    def add(name: str, func, help_: str) -> argparse.ArgumentParser:
-        sp = sub.add_parser(name, help=help_, description=help_)
-        sp.set_defaults(func=func)
-        sp.add_argument("--json", action="store_true", help="print one JSON document")
-        sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
-        return sp
-
-    sp = add("play", cmd_play, "the main job: the robot initialises, draws the field and plays a game against you")
+def register(sub: Any) -> None:
+    """Add the robot's subcommands to the subcommands of ``ttt-sm`` (``build_parser``'s ``sub``)."""
+    sp = add_command(sub, "play", cmd_play,
+                     "the main job: the robot initialises, draws the field and plays a game against you")
     sp.add_argument("--opponent", choices=["auto", "terminal", "simulated"], default="auto",
                     help="auto (default): the terminal when standard input is one, else a simulated person")
     sp.add_argument("--robot-symbol", choices=["X", "O"], default="O", help="the robot's symbol; X starts")
@@ -223,57 +176,33 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--camera", choices=["serial", "direct"], default="serial",
                     help="serial (default): the smart camera emulated on a pseudo-terminal; direct: in-process")
     sp.add_argument("--out", default="out/play", help="folder for the game record and the board PNG")
-    sp = add("demo", cmd_demo, "initialise, draw the field, an X and an O, erase, finish (no game)")
+    sp = add_command(sub, "demo", cmd_demo, "initialise, draw the field, an X and an O, erase, finish (no game)")
     sp.add_argument("--out", default="out/demo", help="folder for the board PNGs (default out/demo)")
-    sp = add("draw", cmd_draw, "draw one thing with the Control chart and measure its precision (thesis 3.5)")
+    sp = add_command(sub, "draw", cmd_draw,
+                     "draw one thing with the Control chart and measure its precision (thesis 3.5)")
     sp.add_argument("kind", choices=["field", "X", "O", "sine"])
     sp.add_argument("--row", type=int, default=3, help="cell row 1..5 for X and O (default 3)")
     sp.add_argument("--column", type=int, default=3, help="cell column 1..5 for X and O (default 3)")
     sp.add_argument("--speed", type=float, default=None, help="drawing speed, mm/s (default 20)")
     sp.add_argument("--size", type=float, default=None, help="symbol size, mm (default 18)")
     sp.add_argument("--out", default="out/draw", help="folder for the board PNG and the path plot")
-    sp = add("tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
+    sp = add_command(sub, "tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
-    sp = add("bench", cmd_bench, "measure the speed and quality targets")
+    sp = add_command(sub, "bench", cmd_bench, "measure the speed and quality targets")
     sp.add_argument("--only", default=None,
                     help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
-    sp = add("ik", cmd_ik, "solve inverse kinematics for one tool pose")
+    sp = add_command(sub, "ik", cmd_ik, "solve inverse kinematics for one tool pose")
     sp.add_argument("x", type=float, help="mm")
     sp.add_argument("y", type=float, help="mm")
     sp.add_argument("z", type=float, help="mm")
     sp.add_argument("--phi", type=float, default=0.0, help="pen angle phi, degrees (default 0)")
-    sp = add("init", cmd_init, "initialise the drives with the init charts from random power-on poses")
+    sp = add_command(sub, "init", cmd_init, "initialise the drives with the init charts from random power-on poses")
     sp.add_argument("--starts", type=int, default=20, help="number of random power-on poses (default 20)")
-    sp = add("charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
+    sp = add_command(sub, "charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
     sp.add_argument("action", choices=["export", "check"])
     sp.add_argument("--format", default=None,
                     help="comma-separated: svg,png,mermaid,dot (default svg,mermaid: what charts/ holds)")
     sp.add_argument("--out", default="charts", help="folder (default charts/)")
-    add("params", cmd_params, "print the parameters in force (SI units)")
-    register_scenario(sub)
-    register_debug(sub)
-    register_camera(sub)
-    register_vision(sub)
-    register_ai(sub)
-    return p
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the `ttt-sm` console script."""
-    from .twin.kinematics import IKError
-
-    args = build_parser().parse_args(argv)
-    try:
-        return int(args.func(args))
-    except (ParameterError, IKError, CliError) as exc:
-        print(f"ttt-sm {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(f"ttt-sm {args.command}: interrupted", file=sys.stderr)
-        return 130
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    add_command(sub, "params", cmd_params, "print the parameters in force (SI units)")

@@ -18,15 +18,15 @@ standard error and exit status 2.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 from typing import Any
 
 import cv2
 
-from .errors import VisionError
-from .orientation import VIEW_NAMES, board_text, board_values
+from ..vision.errors import VisionError
+from ..vision.orientation import VIEW_NAMES, board_text, board_values
+from .common import print_json
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
@@ -73,9 +73,9 @@ def _fail(exc: Exception) -> int:
 
 def cmd_vision_detect(args: argparse.Namespace) -> int:
     """Detect the cells of one photo; exit 0, or 2 if it is not an image or shows no field."""
-    from .camera import read_image
-    from .detection import detect
-    from .pictures import overlay
+    from ..vision.camera import read_image
+    from ..vision.detection import detect
+    from ..vision.pictures import overlay
 
     try:
         image = read_image(args.image)
@@ -92,7 +92,7 @@ def cmd_vision_detect(args: argparse.Namespace) -> int:
             return _fail(VisionError(f"{args.overlay}: could not write the picture (does the folder exist?)"))
         data["overlay"] = str(args.overlay)
     if args.json:
-        print(json.dumps(data, indent=2))
+        print_json(data)
         return 0
     board = data["board"]
     print(f"{args.image}: field found in {det.time_ms:.1f} ms (fit {det.grid.rms_cells:.3f} cells RMS)")
@@ -109,9 +109,9 @@ def cmd_vision_render(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..params import load_params
-    from .bench import random_shadow
-    from .scenes import random_scene, scene_from_text
-    from .simulated import Lighting, SimulatedCamera
+    from ..vision.bench import random_shadow
+    from ..vision.scenes import random_scene, scene_from_text
+    from ..vision.simulated import Lighting, SimulatedCamera
 
     params = load_params(args.params)
     try:
@@ -135,7 +135,7 @@ def cmd_vision_render(args: argparse.Namespace) -> int:
             "dim": round(cam.lighting.dim, 3), "roll_deg": round(cam.pose.roll_deg, 2),
             "position_m": [round(v, 4) for v in cam.pose.position_m]}
     if args.json:
-        print(json.dumps(data, indent=2))
+        print_json(data)
     else:
         rows = "\n".join(f"  {scene.text[5 * k:5 * k + 5]}" for k in range(5))
         print(f"wrote {out} (view {data['view']}, dim side at {data['dim']:.2f}); the board:\n{rows}")
@@ -145,7 +145,7 @@ def cmd_vision_render(args: argparse.Namespace) -> int:
 def cmd_vision_bench(args: argparse.Namespace) -> int:
     """Run the vision benchmark; exit 0 if every cell was read right, 1 if not."""
     from ..params import load_params
-    from .bench import bench_vision
+    from ..vision.bench import bench_vision
 
     if args.photos < 1:
         return _fail(VisionError(f"--photos must be at least 1, got {args.photos}"))
@@ -156,7 +156,7 @@ def cmd_vision_bench(args: argparse.Namespace) -> int:
 
     result = bench_vision(args.seed, args.photos, params, progress=say)
     if args.json:
-        print(json.dumps(result, indent=2))
+        print_json(result)
     else:
         for k, v in result.items():
             print(f"  {k}: {v}")

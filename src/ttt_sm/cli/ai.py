@@ -4,18 +4,16 @@
 prints the cell (``row``, ``column``) and the engine's thinking time
 (``time_ms``), or ``game_over`` with the winner when the game had already
 ended.  A malformed or impossible board is one line naming the problem and
-exit status 2.  :func:`register` adds the command to the ``ttt-sm`` parser;
-``python -m ttt_sm.game.cli ai move ...`` runs it on its own.
+exit status 2.  :func:`register` adds the command to the ``ttt-sm`` parser.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import sys
 import time
-from collections.abc import Sequence
 from typing import Any
+
+from .common import CliError, print_json
 
 ENGINES = ("strong", "thesis")
 
@@ -39,10 +37,10 @@ def register(sub: Any) -> argparse.ArgumentParser:
 
 def ai_move(board: str, symbol: str, engine: str = "strong") -> dict[str, Any]:
     """What ``ttt-sm ai move`` prints, as a dict; raises :class:`~ttt_sm.game.rules.GameError` for bad input."""
-    from .engine import GameOver
-    from .rules import GameError, check_symbol, parse_board
-    from .strong_engine import Analysis, StrongEngine
-    from .thesis_engine import ThesisEngine
+    from ..game.engine import GameOver
+    from ..game.rules import GameError, check_symbol, parse_board
+    from ..game.strong_engine import Analysis, StrongEngine
+    from ..game.thesis_engine import ThesisEngine
 
     if engine not in ENGINES:
         raise GameError(f"unknown engine {engine!r}; choose from {', '.join(ENGINES)}")
@@ -84,31 +82,15 @@ def _text(out: dict[str, Any]) -> str:
 
 def cmd_ai_move(args: argparse.Namespace) -> int:
     """Run ``ttt-sm ai move``: a game error becomes the CLI's one-line error (exit status 2)."""
-    from ..cli import CliError
-    from .book import BookError
-    from .rules import GameError
+    from ..game.book import BookError
+    from ..game.rules import GameError
 
     try:
         out = ai_move(args.board, args.symbol, args.engine)
     except (GameError, BookError) as exc:
         raise CliError(str(exc)) from exc
-    print(json.dumps(out, indent=2) if args.json else _text(out))
+    if args.json:
+        print_json(out)
+    else:
+        print(_text(out))
     return 0
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m ttt_sm.game.cli ai move ...``: the command on its own, as ``ttt-sm`` runs it."""
-    from ..cli import CliError
-
-    parser = argparse.ArgumentParser(prog="ttt-sm")
-    register(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args(argv)
-    try:
-        return int(args.func(args))
-    except CliError as exc:
-        print(f"ttt-sm {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -37,7 +37,8 @@ def _ready_sim(params: ArmParams, samples: np.ndarray, seed: int) -> tuple[ArmSi
     q0 = ik.solve(samples[0], q0=np.asarray(HOME_Q)).q
     sim = ArmSim(params, seed=seed, q0=q0)
     sched = Scheduler(params, sim, ik=ik)
-    sched.assume_homed()
+    sim.assume_initialised()  # simulation only: the true offsets, no init charts
+    sched.mark_all_homed()
     path = PathStage(samples)
     sched.task_stages = [path]
     return sim, sched, path

@@ -117,11 +117,11 @@ def test_a_bad_request_is_rejected_naming_it_before_anything_moves(drawn, kind, 
     session = drawn.session
     robot = session.robot
     before = (robot.t, robot.steps, sorted(robot.active("Control")), robot.control.speed, robot.control.size,
-              robot.control.row, robot.control.column, len(robot.board.strokes), robot.sim.q_true.copy())
+              robot.control.row, robot.control.column, len(robot.board.strokes), robot.truth.q.copy())
     with pytest.raises(DrawError, match=named.replace("(", r"\(").replace(")", r"\)")):
         session.draw(kind, row, column, speed=speed, size=size)
     after = (robot.t, robot.steps, sorted(robot.active("Control")), robot.control.speed, robot.control.size,
-             robot.control.row, robot.control.column, len(robot.board.strokes), robot.sim.q_true.copy())
+             robot.control.row, robot.control.column, len(robot.board.strokes), robot.truth.q.copy())
     assert after[:-1] == before[:-1] and np.array_equal(after[-1], before[-1])
     assert robot.control.pending_events == []
 
@@ -150,7 +150,7 @@ def test_finish_mid_stroke_lifts_the_pen_off_the_board_and_the_arm_returns_to_it
     lowest_over_board = math.inf
     while "finished" not in robot.active("Control"):
         robot.chart_step()
-        x, y, z, _ = fk(robot.sim.q_true, P.geometry)
+        x, y, z, _ = fk(robot.truth.q, P.geometry)
         if P.board.in_zone(x, y, 0.0):
             lowest_over_board = min(lowest_over_board, z)
         assert robot.t < 60.0
@@ -158,7 +158,7 @@ def test_finish_mid_stroke_lifts_the_pen_off_the_board_and_the_arm_returns_to_it
     assert lowest_over_board > P.board.surface_z
     assert board.ink_area_mm2() == ink_at_lift and board.contact.pen_collision_count == 0
     robot.run_for(1.0)
-    tool = fk(robot.sim.q_true, P.geometry)[:3]
+    tool = fk(robot.truth.q, P.geometry)[:3]
     assert np.linalg.norm(tool - (c.x_start, c.y_start, c.z_start)) < 0.002
 
 

@@ -29,12 +29,12 @@ def test_drive_1_turns_back_at_the_hard_stop_then_parks():
     robot = Robot(P, seed=0)  # rest pose: q1 = 0, above its index at -45 deg
     assert robot.run_until(lambda: "turn_back" in robot.active("DriveInit1"), timeout_s=10)
     # it turned back at the +170 deg stop, not before
-    assert robot.sim.q_true[0] == pytest.approx(P.drives[0].limit_max_rad, abs=1 * DEG)
+    assert robot.truth.q[0] == pytest.approx(P.drives[0].limit_max_rad, abs=1 * DEG)
     assert robot.run_until(lambda: "wait_23" in robot.active("DriveInit1"), timeout_s=15)
     assert robot.value("DriveInit1", "ini_23") is True
-    assert robot.sim.q_true[0] == pytest.approx(P.drives[0].park_rad, abs=0.2 * DEG)
+    assert robot.truth.q[0] == pytest.approx(P.drives[0].park_rad, abs=0.2 * DEG)
     # drives 2 and 3 did not move before drive 1 parked
-    assert abs(robot.sim.q_true[1] - 0.04) < 0.01
+    assert abs(robot.truth.q[1] - 0.04) < 0.01
 
 
 def test_drive_1_below_its_index_passes_it_without_touching_a_stop():
@@ -42,7 +42,7 @@ def test_drive_1_below_its_index_passes_it_without_touching_a_stop():
     seen = set()
     assert robot.run_until(lambda: seen.update(robot.active("DriveInit1")) or robot.initialised, 20)
     assert "turn_back" not in seen
-    assert abs(robot.sim.offset_estimate[0] - robot.sim.true_offset[0]) < one_count(0)
+    assert abs(robot.sim.offset_estimate[0] - robot.truth.offsets[0]) < one_count(0)
 
 
 def test_nothing_passes_pos_in_before_all_drives_are_initialised():
@@ -62,9 +62,9 @@ def test_stop_halts_drive_1_and_it_resumes_where_it_was():
     robot.set_input("DriveInit1", "stop", True)
     robot.run_for(0.5)
     assert robot.active("DriveInit1") == {"stopped"}
-    held = robot.sim.q_true[0]
+    held = robot.truth.q[0]
     robot.run_for(0.5)
-    assert abs(robot.sim.q_true[0] - held) < 0.002
+    assert abs(robot.truth.q[0] - held) < 0.002
     robot.set_input("DriveInit1", "stop", False)
     robot.chart_step()
     robot.chart_step()
@@ -76,7 +76,7 @@ def test_a_dead_index_switch_ends_in_failed_not_past_the_stops():
     robot = Robot(P, seed=0)
     robot.set_input("DriveInit1", "index", True, force=True)  # the switch never changes
     assert robot.run_until(lambda: "failed" in robot.active("DriveInit1"), timeout_s=30)
-    q1 = robot.sim.q_true[0]
+    q1 = robot.truth.q[0]
     assert P.drives[0].limit_min_rad - 0.01 <= q1 <= P.drives[0].limit_min_rad + 2 * DEG
     assert not robot.initialised
 
@@ -86,7 +86,7 @@ def test_drive_3_starting_on_its_switch_leaves_it_first():
     seen = set()
     assert robot.run_until(lambda: seen.update(robot.active("DriveInit3")) or robot.initialised, 25)
     assert "leave_switch" in seen and "approach" not in seen
-    assert abs(robot.sim.offset_estimate[2] - robot.sim.true_offset[2]) < one_count(2)
+    assert abs(robot.sim.offset_estimate[2] - robot.truth.offsets[2]) < one_count(2)
 
 
 def test_random_power_on_poses_all_initialise_safely():

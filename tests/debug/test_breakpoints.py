@@ -11,7 +11,7 @@ from ttt_sm.debug.expr import parse_condition
 
 
 def q1_deg(d: Debugger) -> float:
-    return math.degrees(float(d.robot.sim.q_true[0]))
+    return math.degrees(float(d.robot.truth.q[0]))
 
 
 def test_break_on_entering_turn_back_stops_at_the_tick_the_hard_stop_was_detected(dbg: Debugger, params):
@@ -44,7 +44,7 @@ def test_the_stop_is_the_first_control_step_at_which_the_state_is_active(dbg: De
     while "turn_back" not in plain.active("DriveInit1"):
         plain.control_step()
     assert plain.steps == dbg.robot.steps
-    assert plain.sim.q_true.tolist() == dbg.robot.sim.q_true.tolist()
+    assert plain.truth.q.tolist() == dbg.robot.truth.q.tolist()
 
 
 def test_exit_and_transition_breakpoints_hit_in_the_same_tick(dbg: Debugger):

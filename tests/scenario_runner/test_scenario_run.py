@@ -174,7 +174,7 @@ def test_start_pose_seed_and_settling_reach_the_robot() -> None:
     def factory(scenario, params, listeners):
         robot = Robot(params, seed=scenario.seed, q_start=[math.radians(v) for v in scenario.start.q_deg],
                       settle_s=scenario.start.settle_s, listeners=listeners)
-        seen["q"] = robot.sim.q_true
+        seen["q"] = robot.truth.q
         seen["seed"] = robot.seed
         return robot
     r = run("""\

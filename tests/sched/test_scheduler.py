@@ -19,8 +19,20 @@ def ready(seed=0, record=False):
     q0 = np.asarray(HOME_Q)
     sim = ArmSim(P, seed=seed, q0=q0)
     sched = Scheduler(P, sim, record=record)
-    sched.assume_homed()
+    sim.assume_initialised()
+    sched.mark_all_homed()
     return sim, sched
+
+
+class TruthRecorder:
+    """A joint stage that records the true joint angles every chart step (simulation only)."""
+
+    def __init__(self, sim):
+        self.sim = sim
+        self.q = []
+
+    def tick(self, signals: Signals) -> None:
+        self.q.append(self.sim.truth.q)
 
 
 class CountingStage:
@@ -49,15 +61,18 @@ def test_charts_tick_every_second_control_step():
 
 def test_the_tool_follows_a_line_on_the_real_loop():
     sim, sched = ready(record=True)
-    start = fk(sim.q_true, P.geometry)
+    truth = TruthRecorder(sim)
+    start = fk(sim.truth.q, P.geometry)
     line = [Waypoint(*start), Waypoint(start[0] - 0.04, start[1], start[2]),
             Waypoint(start[0] - 0.04, start[1] - 0.03, start[2])]
     samples = sample_polyline(line, 0.02, P.control.chart_dt)
     path = PathStage(samples)
     sched.task_stages = [path]
+    sched.joint_stages = [truth]
     assert sched.run_until(lambda: path.done, timeout_s=10.0)
     sched.run_for(1.0)
-    tool = tool_path(P, np.asarray(sched.record.q_true))
+    assert len(truth.q) == len(sched.record.q_encoder)
+    tool = tool_path(P, np.asarray(truth.q))
     # the true tool (forward kinematics of the true joint angles) stays near the line
     dev = distance_to_path(tool[:, :3], samples[:, :3])
     assert dev.max() < 0.002
@@ -69,15 +84,15 @@ def test_the_tool_follows_a_line_on_the_real_loop():
 def test_an_unreachable_pose_holds_the_arm_and_is_reported():
     sim, sched = ready()
     sched.run_for(0.2)
-    held = sim.q_true.copy()
+    held = sim.truth.q.copy()
     far = np.array([[2.0, 0.0, 0.0, 0.0]] * 50)
     sched.task_stages = [PathStage(far)]
     sched.run_for(0.5)
     assert sched.ik_failures == 250
     assert "2" in sched.signals.ik_error
-    assert np.abs(sim.q_true - held).max() < 0.01
+    assert np.abs(sim.truth.q - held).max() < 0.01
     lo, hi = np.asarray(P.joint_min), np.asarray(P.joint_max)
-    assert np.all(sim.q_true >= lo) and np.all(sim.q_true <= hi)
+    assert np.all(sim.truth.q >= lo) and np.all(sim.truth.q <= hi)
 
 
 class PastLimitStage:
@@ -96,7 +111,7 @@ def test_setpoints_past_a_joint_limit_are_clamped_once_homed():
     sched.run_for(2.0)
     assert sched.limit_clamps == 1000
     assert sched.signals.q_set[1] == pytest.approx(P.drives[1].limit_max_rad)
-    assert sim.q_true[1] <= P.drives[1].limit_max_rad + P.drives[1].gear_clearance
+    assert sim.truth.q[1] <= P.drives[1].limit_max_rad + P.drives[1].gear_clearance
 
 
 def test_unhomed_drives_are_not_clamped_in_encoder_coordinates():
@@ -110,14 +125,14 @@ def test_unhomed_drives_are_not_clamped_in_encoder_coordinates():
 
 def test_joint_move_stage_reaches_its_target_without_ik():
     sim, sched = ready()
-    q_from = np.asarray(sim.q_encoder.tolist() + [sim.q_true[3]])
+    q_from = np.asarray(sim.q_encoder.tolist() + [sim.truth.q[3]])
     q_to = q_from + np.radians([20.0, -10.0, 10.0, 5.0])
     move = JointMoveStage(q_from, q_to, P.control.chart_dt, max_speed=0.5)
     sched.joint_stages = [move]
     assert sched.run_until(lambda: move.done, timeout_s=5.0)
     sched.run_for(1.0)
     assert np.abs(sim.q_encoder - q_to[:3]).max() < 2e-4
-    assert abs(sim.q_true[3] - q_to[3]) < np.radians(1.0)
+    assert abs(sim.truth.q[3] - q_to[3]) < np.radians(1.0)
 
 
 def test_sensors_are_read_lazily_and_fresh_each_chart_step():
@@ -147,14 +162,15 @@ def test_runs_are_reproducible_from_the_seed():
     def run(seed):
         sim = ArmSim(P, seed=seed)
         sched = Scheduler(P, sim)
-        sched.assume_homed()
+        sim.assume_initialised()
+        sched.mark_all_homed()
         ik = IKSolver(P)
         target = ik.solve(np.array([0.0, 0.25, 0.05, 0.0]), q0=np.asarray(HOME_Q)).q
-        sched.joint_stages = [JointMoveStage(np.asarray(sim.q_encoder.tolist() + [sim.q_true[3]]),
+        sched.joint_stages = [JointMoveStage(np.asarray(sim.q_encoder.tolist() + [sim.truth.q[3]]),
                                              target, P.control.chart_dt)]
         sched.run_for(1.0)
         s = sim.sensors()
-        return sim.q_true, s.counts, np.asarray(s.current_a)
+        return sim.truth.q, s.counts, np.asarray(s.current_a)
 
     a, b = run(3), run(3)
     assert np.array_equal(a[0], b[0]) and tuple(a[1]) == tuple(b[1]) and np.array_equal(a[2], b[2])

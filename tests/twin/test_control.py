@@ -59,7 +59,7 @@ def test_holds_at_power_on_without_knowing_the_offsets(params, gains):
     tr = sim.run(500)
     assert np.all(sim.offset_estimate == 0.0)
     assert np.abs(tr.q_encoder).max() < 5e-4  # held where it woke up, gravity notwithstanding
-    assert np.abs(sim.q_true - WORK_POSE).max() < 3e-3
+    assert np.abs(sim.truth.q - WORK_POSE).max() < 3e-3
 
 
 def test_tracks_a_ramp(params, gains):
@@ -119,8 +119,8 @@ def test_anti_windup_after_pushing_against_a_hard_stop(params, gains):
     sim, q = homed(params, gains, q0=(d1.limit_max_rad - 0.2, 0.0, 0.0, 0.0))
     sim.set_setpoints(q + [0.5, 0.0, 0.0, 0.0])  # beyond the stop: the loop saturates for a second
     sim.run(1000)
-    assert sim.at_limit[0] and sim.duty[0] == 1.0
-    assert sim.current_a[0] == pytest.approx(d1.supply_v / d1.resistance_ohm, rel=0.01)  # stall current
+    assert sim.truth.at_limit[0] and sim.duty[0] == 1.0
+    assert sim.truth.current_a[0] == pytest.approx(d1.supply_v / d1.resistance_ohm, rel=0.01)  # stall current
     target = sim.q_encoder[0] - 0.3
     sim.set_setpoints(np.array([target, q[1], q[2], q[3]]))
     tr = sim.run(1000)
@@ -132,12 +132,12 @@ def test_anti_windup_after_pushing_against_a_hard_stop(params, gains):
 def test_offset_estimate_change_does_not_move_the_arm(params, gains):
     sim = ArmSim(params, gains, q0=WORK_POSE)
     sim.run(200)
-    before = sim.q_true
+    before = sim.truth.q
     sim.set_offset_estimate(2, 1.234)
     sim.set_offset_estimate(3, -0.5)
     sim.run(500)
     assert sim.q_encoder[1] == pytest.approx(1.234, abs=2e-3)
-    assert np.abs(sim.q_true - before).max() < 5e-4
+    assert np.abs(sim.truth.q - before).max() < 5e-4
 
 
 def test_disabled_drive_gets_no_pwm_and_enabling_holds_it(params, gains):
@@ -147,7 +147,7 @@ def test_disabled_drive_gets_no_pwm_and_enabling_holds_it(params, gains):
     tr = sim.run(200)
     assert np.all(tr.duty[1:, 0] == 0.0)
     assert np.all(tr.q_encoder[:, 0] == tr.q_encoder[0, 0])
-    assert sim.current_a[0] == 0.0
+    assert sim.truth.current_a[0] == 0.0
     sim.set_enabled(1, True)  # holds where it is, whatever the old setpoint
     sim.run(200)
     assert abs(sim.q_encoder[0] - q[0]) < 1e-4

@@ -58,10 +58,10 @@ def test_unpowered_arm_only_loses_energy(params, gains):
     sim = ArmSim(params, gains, q0=(0.0, 1.2, -0.6, 0.0))
     for d in (1, 2, 3):
         sim.set_enabled(d, False)
-    energy = [sim.mechanical_energy()]
+    energy = [sim.truth.mechanical_energy()]
     for _ in range(1500):
         sim.step(1)
-        energy.append(sim.mechanical_energy())
+        energy.append(sim.truth.mechanical_energy())
     de = np.diff(energy)
     assert energy[-1] < 0.2 * energy[0]
     assert de.max() <= 1e-9 * energy[0]
@@ -71,24 +71,24 @@ def test_unpowered_drive_2_falls_toward_zero_and_friction_holds_it(params, gains
     d2 = params.drives[1]
     sim = ArmSim(params, gains, q0=(0.0, 0.8, 0.0, 0.0))
     sim.settle_unpowered(3.0)
-    q2 = sim.q_true[1]
+    q2 = sim.truth.q[1]
     # friction at the motor holds gravity up to the band where N Tc = gravity torque
     g_slope = -gravity_torques(params, (0.0, 1e-6, 0.0, 0.0))[1] / 1e-6  # N m / rad near zero
     band = d2.gear_ratio * d2.motor_coulomb / g_slope
     assert 0.05 < band < 0.2  # "within some degrees"
     assert abs(q2) < 1.1 * band
     # ... and it stays there: at rest, no current, the drives re-enabled hold it
-    assert np.abs(sim.speed_load).max() < 1e-9
-    before = sim.q_true
+    assert np.abs(sim.truth.speed_load).max() < 1e-9
+    before = sim.truth.q
     sim.run(300, record=False)
-    assert np.abs(sim.q_true - before).max() < 1e-4
+    assert np.abs(sim.truth.q - before).max() < 1e-4
 
 
 def test_rest_pose_is_held_by_friction_unpowered(params, gains):
     sim = ArmSim(params, gains)
-    assert np.allclose(sim.q_true, REST_POSE)
+    assert np.allclose(sim.truth.q, REST_POSE)
     sim.settle_unpowered(0.5)
-    assert np.abs(sim.q_true - REST_POSE).max() < 2e-3  # within the gear clearance and deflection
+    assert np.abs(sim.truth.q - REST_POSE).max() < 2e-3  # within the gear clearance and deflection
 
 
 def test_hard_stop_holds_the_joint_and_the_motor_stalls(params, gains):
@@ -97,14 +97,14 @@ def test_hard_stop_holds_the_joint_and_the_motor_stalls(params, gains):
     sim.set_duty(1, 0.6)
     tr = sim.run(800)
     assert tr.q_true[:, 0].max() <= d1.limit_max_rad  # never integrated past the stop
-    assert sim.q_true[0] == d1.limit_max_rad
-    assert sim.at_limit[0] and not sim.at_limit[1]
-    assert sim.stalled[0]
-    assert sim.speed_motor[0] == 0.0
+    assert sim.truth.q[0] == d1.limit_max_rad
+    assert sim.truth.at_limit[0] and not sim.truth.at_limit[1]
+    assert sim.truth.stalled[0]
+    assert sim.truth.speed_motor[0] == 0.0
     stall_current = 0.6 * d1.supply_v / d1.resistance_ohm
-    assert sim.current_a[0] == pytest.approx(stall_current, rel=1e-3)
+    assert sim.truth.current_a[0] == pytest.approx(stall_current, rel=1e-3)
     # the motor winds into the gear only by the clearance and the spring deflection
-    squeeze = sim.q_motor[0] - d1.limit_max_rad
+    squeeze = sim.truth.q_motor[0] - d1.limit_max_rad
     torque = d1.torque_constant * stall_current * d1.gear_ratio
     assert squeeze == pytest.approx(d1.gear_clearance / 2 + (torque - 0) / d1.gear_stiffness, rel=0.05)
 
@@ -122,7 +122,7 @@ def test_pwm_saturates_at_the_supply_voltage(params, gains):
     # at full duty the motor runs near its no-load speed V / Ke, less friction
     d1 = params.drives[0]
     no_load = d1.supply_v / d1.torque_constant
-    assert 0.9 * no_load < sim_sat.speed_motor[0] < no_load
+    assert 0.9 * no_load < sim_sat.truth.speed_motor[0] < no_load
 
 
 def test_gear_clearance_load_lags_motor_on_reversal(params, gains):
@@ -155,7 +155,7 @@ def test_encoder_counts_are_relative_integers_that_quantize(params, gains):
     assert s.counts[0] > 1000
     sim.assume_initialised()
     rpc = np.array([d.rad_per_count for d in params.drives])
-    err = sim.q_encoder - sim.q_motor
+    err = sim.q_encoder - sim.truth.q_motor
     assert np.all(np.abs(err) <= rpc / 2 + 1e-12)
     assert np.allclose(sim.q_encoder / rpc - sim.offset_estimate / rpc, sim.sensors().counts)
 
@@ -180,8 +180,8 @@ def test_index_switch_level_and_latched_count_are_repeatable(params, gains):
         assert up.index_count[0] == down.index_count[0]  # the same count both ways
         # the init charts' estimate: the joint angle of the switch minus the latched counts
         estimate = d1.index_rad - up.index_count[0] * d1.rad_per_count
-        assert abs(estimate - sim.true_offset[0]) <= d1.rad_per_count
-        offsets.append(estimate - sim.true_offset[0])
+        assert abs(estimate - sim.truth.offsets[0]) <= d1.rad_per_count
+        offsets.append(estimate - sim.truth.offsets[0])
     assert offsets[0] == pytest.approx(offsets[1], abs=1e-12)  # homing repeats to the count
 
 
@@ -199,7 +199,7 @@ def test_same_seed_same_run_other_seed_other_noise_only(params, gains):
         for _ in range(200):
             sim.step(2)
             currents.append(sim.sensors().current_a)
-        return sim.q_true, np.array(currents)
+        return sim.truth.q, np.array(currents)
 
     q_a, i_a = run(7)
     q_b, i_b = run(7)
@@ -223,7 +223,7 @@ def test_servo_follows_its_pwm_with_a_rate_limit(params, gains):
     t_reach = tr.t[np.argmax(tr.q_true[:, 3] > 1.0 - s.clearance_rad)]
     assert 1.0 / s.rate_rad_s < t_reach < 1.0 / s.rate_rad_s + 5 * s.time_constant_s
     # gear play: the output stops within half the clearance of the command
-    assert abs(sim.q_true[3] - 1.0) <= s.clearance_rad / 2 + 1e-6
+    assert abs(sim.truth.q[3] - 1.0) <= s.clearance_rad / 2 + 1e-6
 
 
 def test_bad_requests_are_specific_errors(params, gains):
@@ -250,7 +250,7 @@ def test_numba_disabled_runs_the_same_kernel(params, gains, tmp_path):
         sim.assume_initialised()
         sim.set_setpoints(list(sim.q_encoder + [0.05, 0.05, -0.05]) + [0.4])
         sim.run(150)
-        print(json.dumps(list(sim.q_true) + list(sim.sensors().counts)))
+        print(json.dumps(list(sim.truth.q) + list(sim.sensors().counts)))
     """)
     import dataclasses
 
@@ -264,7 +264,7 @@ def test_numba_disabled_runs_the_same_kernel(params, gains, tmp_path):
     sim.assume_initialised()
     sim.set_setpoints(list(sim.q_encoder + [0.05, 0.05, -0.05]) + [0.4])
     sim.run(150)
-    fast = list(sim.q_true) + list(sim.sensors().counts)
+    fast = list(sim.truth.q) + list(sim.sensors().counts)
     assert slow == pytest.approx(fast, abs=1e-9)
 
 
@@ -278,8 +278,8 @@ def test_the_plain_number_accessors_read_what_the_sensors_and_true_state_say(par
     offsets = sim.offset_estimate
     expected = [sensors.counts[d] * rpc[d] + offsets[d] for d in range(3)]
     assert sim.encoder_angles() == pytest.approx(expected, abs=1e-15) and offsets[1] == 0.125
-    assert list(sim.true_angles()) == sim.q_true.tolist()
-    assert all(type(v) is float for v in (*sim.encoder_angles(), *sim.true_angles(), sim.t))
+    assert list(sim.truth.angles()) == sim.truth.q.tolist()
+    assert all(type(v) is float for v in (*sim.encoder_angles(), *sim.truth.angles(), sim.t))
     assert sim.t == pytest.approx(0.3)
     sim.set_setpoints(np.array([0.1, 0.2, -0.3, 0.0], dtype=np.float32))  # any float type is taken
     sim.run(1, record=False)

@@ -14,11 +14,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..arm import Arm
 from ..charts.control import Control
 from ..params import ArmParams
 from ..sched.scheduler import Signals
 from ..twin.kinematics import fk_floats
-from ..twin.plant import ArmSim
 from .init_wiring import DriveInitStage
 
 # The compiled forward kinematics' Python original: a numba call with nine
@@ -46,9 +46,9 @@ def make_control_chart(params: ArmParams, listeners: Sequence[object] = ()) -> C
 class ControlStage:
     """Task stage: the Control chart between the game and inverse kinematics."""
 
-    def __init__(self, params: ArmParams, sim: ArmSim, init: DriveInitStage, chart: Control) -> None:
+    def __init__(self, params: ArmParams, arm: Arm, init: DriveInitStage, chart: Control) -> None:
         self.params = params
-        self.sim = sim
+        self.arm = arm
         self.init = init
         self.chart = chart
         #: The game's request to erase (the thesis' Erase_flag); cleared once erased.
@@ -64,11 +64,13 @@ class ControlStage:
     def tick(self, signals: Signals) -> None:
         """Inputs in, chart ticked, tool pose out."""
         c = self.chart
-        sim = self.sim
-        q1, q2, q3 = sim.encoder_angles()
+        arm = self.arm
+        q1, q2, q3 = arm.encoder_angles()
         servo = float(signals.q_set[3])
         if not math.isfinite(servo):
-            servo = float(sim.q_true[3])
+            # no setpoint yet (the first chart step): the servo has no sensor, so
+            # its pose is the angle it was last commanded
+            servo = arm.servo_setpoint
         x, y, z, _ = _fk_python(q1, q2, q3, servo, *self._geometry)
         if self.erase_requested and "turn_pen" in c.active_ids:
             self.erase_requested = False

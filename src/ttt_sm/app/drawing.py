@@ -48,10 +48,16 @@ class DrawRecord:
 
 
 class RecordStage:
-    """Joint stage run last: records the three paths of section 3.5 while `on`."""
+    """Joint stage run last: records the three paths of section 3.5 while `on`.
+
+    Simulation only: the true path is the twin's ground truth.
+    """
 
     def __init__(self, robot: Robot) -> None:
+        if robot.truth is None:
+            raise DrawError("measuring a drawing's precision needs the simulated arm's ground truth")
         self.robot = robot
+        self.truth = robot.truth
         self.on = False
         self.record = DrawRecord()
 
@@ -62,13 +68,13 @@ class RecordStage:
         r = self.robot
         c = r.control
         g = r.params.geometry
-        q_enc = r.sim.q_encoder
+        q_enc = r.arm.encoder_angles()
         servo = float(signals.q_set[3])
         rec = self.record
-        rec.t.append(r.sim.t)
+        rec.t.append(r.t)
         rec.desired.append((c.X_out, c.Y_out, c.Z_out))
         rec.fk_encoder.append(tuple(fk((q_enc[0], q_enc[1], q_enc[2], servo), g)[:3]))
-        rec.fk_true.append(tuple(fk(r.sim.q_true, g)[:3]))
+        rec.fk_true.append(tuple(self.truth.tool_pose()[:3]))
         contact = r.board.contact
         rec.tip.append(contact.tip_m if contact.pen_touching and contact.tip_m else (math.nan, math.nan))
 

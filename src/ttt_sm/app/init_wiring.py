@@ -5,10 +5,13 @@ plays the thesis' Encoder block (index level, the encoder angle latched at the
 index edge, the encoder angle itself), feeds the three charts, ticks them, and
 passes their `pos_out` to the controllers.  When a chart moves its `offset`
 output, the Encoder block applies it, so the drive's encoder angle becomes its
-true joint angle from then on.
+true joint angle from then on.  It reads only what a real arm reports (an
+:class:`~ttt_sm.arm.Arm`).
 
 :func:`run_init` initialises the twin from one power-on pose, and
-:func:`init_report` from many, measuring what `ttt-sm init` reports.
+:func:`init_report` from many, measuring what `ttt-sm init` reports; the
+measurement (:class:`InitMonitor`, the offset errors) compares with the
+twin's ground truth, so these exist in simulation only.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from ..arm import Arm
 from ..charts.drive_init import DriveInit1, DriveInit2, DriveInit3
 from ..params import ArmParams
 from ..sched.scheduler import Scheduler, Signals
@@ -51,9 +55,9 @@ def make_init_charts(params: ArmParams, listeners: Sequence[object] = ()) -> tup
 class DriveInitStage:
     """Joint stage: the Encoder blocks and the three init charts between IK and the drives."""
 
-    def __init__(self, params: ArmParams, sim: ArmSim, sched: Scheduler,
+    def __init__(self, params: ArmParams, arm: Arm, sched: Scheduler,
                  charts: tuple[DriveInit1, DriveInit2, DriveInit3]) -> None:
-        self.sim = sim
+        self.arm = arm
         self.sched = sched
         self.charts = charts
         self.rad_per_count = [d.rad_per_count for d in params.drives]
@@ -94,8 +98,8 @@ class DriveInitStage:
         else:
             sensors = signals.sensors
             assert sensors is not None
-            enc = self.sim.q_encoder.tolist()
-            offsets = self.sim.offset_estimate.tolist()
+            enc = self.arm.encoder_angles()
+            offsets = self.arm.offset_estimates()
             idx, counts, rpc = sensors.index, sensors.index_count, self.rad_per_count
             latched = [counts[d] * rpc[d] + offsets[d] for d in range(3)]
             # vars(...).update: the inputs are plain attributes; this skips the
@@ -113,7 +117,7 @@ class DriveInitStage:
             if chart.tick() is not None:
                 moved = True
             if chart.offset != applied[d]:
-                self.sim.set_offset_estimate(d + 1, chart.offset)
+                self.arm.set_offset_estimate(d + 1, chart.offset)
                 applied[d] = chart.offset
                 self.sched.mark_homed(d + 1)
         if moved:
@@ -134,11 +138,14 @@ class InitMonitor:
     finds a stop by pushing its setpoint a little past it (that is how the
     thesis detects a stall without a limit-switch signal), and no more.
     Drives 2 and 3 get no allowance.
+
+    Simulation only: it measures against the twin's ground truth.
     """
 
     def __init__(self, params: ArmParams, sim: ArmSim, allowance_rad: float) -> None:
         self.params = params
         self.sim = sim
+        self.truth = sim.truth
         allowance = np.array([allowance_rad, 0.0, 0.0])
         self.lo = np.array([d.limit_min_rad for d in params.drives]) - allowance
         self.hi = np.array([d.limit_max_rad for d in params.drives]) + allowance
@@ -148,14 +155,14 @@ class InitMonitor:
 
     def tick(self, signals: Signals) -> None:
         """Check this chart step's setpoints and the true tool position."""
-        sim = self.sim
-        q_true_cmd = np.asarray(signals.q_set[:3]) - sim.offset_estimate + sim.true_offset
+        sim, truth = self.sim, self.truth
+        q_true_cmd = np.asarray(signals.q_set[:3]) - sim.offset_estimate + truth.offsets
         over = np.maximum(q_true_cmd - self.hi, self.lo - q_true_cmd)
         self.max_overtravel_rad = max(self.max_overtravel_rad, float(over.max()))
         if np.any(over > 0):
             self.limit_violations += 1
         board = self.params.board
-        if any(board.in_zone(x, y, z) for x, y, z in link_points(sim.q_true, self.params.geometry)):
+        if any(board.in_zone(x, y, z) for x, y, z in link_points(truth.q, self.params.geometry)):
             self.zone_ticks += 1
 
 
@@ -183,7 +190,7 @@ def settled_pose(params: ArmParams, q_start: np.ndarray | None, seconds: float, 
     """Where the unpowered arm comes to rest from `q_start` under gravity and friction."""
     sim = ArmSim(params, seed=seed, q0=q_start)
     sim.settle_unpowered(seconds)
-    return sim.q_true
+    return sim.truth.q
 
 
 def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None,
@@ -198,7 +205,7 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
     """
     q_power_on = settled_pose(params, q_start, settle_s, seed) if settle_s > 0 else q_start
     sim = ArmSim(params, seed=seed, q0=q_power_on)
-    q0_true = sim.q_true
+    q0_true = sim.truth.q
     sched = Scheduler(params, sim)
     charts = make_init_charts(params)
     stage = DriveInitStage(params, sim, sched, charts)
@@ -213,7 +220,7 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
         time_s=round(sim.t - t0, 4),
         limit_violations=monitor.limit_violations,
         board_zone_ticks=monitor.zone_ticks,
-        offset_error_rad=tuple(float(v) for v in sim.offset_estimate - sim.true_offset),  # type: ignore
+        offset_error_rad=tuple(float(v) for v in sim.offset_estimate - sim.truth.offsets),  # type: ignore
         max_overtravel_rad=round(monitor.max_overtravel_rad, 5),
     )
 

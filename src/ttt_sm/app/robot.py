@@ -1,4 +1,4 @@
-"""The robot as a whole: the twin, the scheduler and the charts, wired.
+"""The robot as a whole: the arm, the scheduler and the charts, wired.
 
 :class:`Robot` is the one object the debugger, the scenario runner, the CLI
 and (later) the GUIs drive.  It knows the charts by name, steps the loop by a
@@ -7,20 +7,27 @@ chart data and the signals of the current step without anyone reading code.
 
 It holds the three drive-initialisation charts and the Control chart; the
 game charts join it in a later issue.
+
+The charts' wiring and the scheduler talk to an :class:`~ttt_sm.arm.Arm`
+(:attr:`Robot.arm`).  Ground truth (:attr:`Robot.truth`, the simulated arm's
+``truth``) feeds only what exists in simulation alone: the whiteboard's
+inking and the ``q_true`` / ``tool_true`` signals.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
+from ..arm import Arm
 from ..params import ArmParams
 from ..runtime import TickChart
-from ..sched.scheduler import Scheduler, Signals
-from ..twin.kinematics import fk
+from ..sched.scheduler import Scheduler, Signals, Stage
 from ..twin.plant import ArmSim
+from ..twin.truth import ArmTruth
 from ..twin.whiteboard import Whiteboard
 from .compensation import GearPlayCompensation
 from .control_wiring import ControlStage, make_control_chart
@@ -28,15 +35,18 @@ from .init_wiring import DriveInitStage, make_init_charts, settled_pose
 
 
 class BoardStage:
-    """Joint stage run after the setpoints are set: the whiteboard sees the true pen and sponge."""
+    """Joint stage run after the setpoints are set: the whiteboard sees the true pen and sponge.
 
-    def __init__(self, board: Whiteboard, sim: ArmSim) -> None:
+    Simulation only: the simulated whiteboard is inked by the true tool.
+    """
+
+    def __init__(self, board: Whiteboard, truth: ArmTruth) -> None:
         self.board = board
-        self.sim = sim
+        self.truth = truth
 
     def tick(self, signals: Signals) -> None:
         """Ink or wipe where the true tool touches the board now."""
-        self.board.update(signals.t, self.sim.true_angles())
+        self.board.update(signals.t, self.truth.angles())
 
 
 class RobotError(ValueError):
@@ -59,24 +69,44 @@ class Robot:
     listeners : sequence
         python-statemachine listeners attached to every chart (trace, coverage,
         the debugger's breakpoints).
+    arm : Arm, optional
+        The arm to drive; None builds the simulated arm (:class:`ArmSim`) from
+        `params`, `seed`, `q_start` and `settle_s`.
+    truth : ArmTruth, optional
+        Ground truth for the simulation-only parts (the whiteboard's ink, the
+        ``q_true`` and ``tool_true`` signals); by default the simulated arm's
+        own.  Without it (an arm that is no simulation) the whiteboard stays
+        blank and those signals are NaN.
     """
 
     def __init__(self, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
-                 settle_s: float = 0.0, listeners: Sequence[object] = ()) -> None:
+                 settle_s: float = 0.0, listeners: Sequence[object] = (), arm: Arm | None = None,
+                 truth: ArmTruth | None = None) -> None:
         self.params = params
         self.seed = seed
-        q0 = np.asarray(q_start, dtype=float) if q_start is not None else None
-        if settle_s > 0:
-            q0 = settled_pose(params, q0, settle_s, seed)
-        self.sim = ArmSim(params, seed=seed, q0=q0)
-        self.sched = Scheduler(params, self.sim)
+        #: The simulated arm when this robot built it, else None.
+        self.sim: ArmSim | None = None
+        if arm is None:
+            q0 = np.asarray(q_start, dtype=float) if q_start is not None else None
+            if settle_s > 0:
+                q0 = settled_pose(params, q0, settle_s, seed)
+            self.sim = ArmSim(params, seed=seed, q0=q0)
+            arm, truth = self.sim, self.sim.truth
+        #: What the scheduler and the charts' wiring talk to.
+        self.arm: Arm = arm
+        #: Ground truth, simulation only (None for an arm that is no simulation).
+        self.truth = truth
+        self.sched = Scheduler(params, arm)
         init = make_init_charts(params, listeners)
-        self.init_stage = DriveInitStage(params, self.sim, self.sched, init)
+        self.init_stage = DriveInitStage(params, arm, self.sched, init)
         self.compensation = GearPlayCompensation(params, lambda: self.init_stage.done)
         self.board = Whiteboard(params, seed=seed)
-        self.sched.joint_stages = [self.init_stage, self.compensation, BoardStage(self.board, self.sim)]
+        joint_stages: list[Stage] = [self.init_stage, self.compensation]
+        if truth is not None:
+            joint_stages.append(BoardStage(self.board, truth))
+        self.sched.joint_stages = joint_stages
         self.control = make_control_chart(params, listeners)
-        self.control_stage = ControlStage(params, self.sim, self.init_stage, self.control)
+        self.control_stage = ControlStage(params, arm, self.init_stage, self.control)
         self.sched.task_stages = [self.control_stage]
         self.charts: dict[str, TickChart] = {c.chart_name: c for c in (*init, self.control)}
 
@@ -84,8 +114,8 @@ class Robot:
 
     @property
     def t(self) -> float:
-        """Simulated time since power-on, s."""
-        return self.sim.t
+        """The arm's time since power-on, s."""
+        return self.arm.t
 
     @property
     def steps(self) -> int:
@@ -175,21 +205,29 @@ class Robot:
     # -- signals -------------------------------------------------------------------
 
     def signal_values(self) -> dict[str, Any]:
-        """The signals of the current step, as plain numbers (SI units)."""
+        """The signals of the current step, as plain numbers (SI units).
+
+        ``q_true`` and ``tool_true`` are simulation only: the ground truth of
+        the simulated arm (NaN when the robot has none).
+        """
         s = self.sched.signals
-        sim = self.sim
-        tool = fk(sim.q_true, self.params.geometry)
-        sensors = sim.sensors()
+        arm = self.arm
+        if self.truth is not None:
+            q_true = [float(v) for v in self.truth.q]
+            tool = [float(v) for v in self.truth.tool_pose()]
+        else:
+            q_true = tool = [math.nan] * 4
+        sensors = arm.sensors()
         return {
-            "t": round(sim.t, 6),
+            "t": round(arm.t, 6),
             "q_set": [float(v) for v in s.q_set],
-            "q_encoder": [float(v) for v in sim.q_encoder],
-            "q_true": [float(v) for v in sim.q_true],
-            "offset_estimate": [float(v) for v in sim.offset_estimate],
+            "q_encoder": list(arm.encoder_angles()),
+            "q_true": q_true,
+            "offset_estimate": list(arm.offset_estimates()),
             "index": list(sensors.index),
             "counts": list(sensors.counts),
             "current_a": [round(float(v), 4) for v in sensors.current_a],
-            "tool_true": [float(v) for v in tool],
+            "tool_true": tool,
             "fr_sw": bool(s.fr_sw),
             "ik_error": s.ik_error,
         }
@@ -197,7 +235,7 @@ class Robot:
     def snapshot(self) -> dict[str, Any]:
         """Every chart's configuration and data, and the signals: what a debugger shows."""
         return {
-            "t": round(self.sim.t, 6),
+            "t": round(self.arm.t, 6),
             "charts": {name: {"active": sorted(c.configuration_values), "data": c.snapshot()}
                        for name, c in self.charts.items()},
             "signals": self.signal_values(),

@@ -16,11 +16,14 @@ from typing import Any, Protocol
 
 from ..app.robot import Robot
 from ..params import ArmParams
+from ..twin.plant import ArmSim
 from .errors import DebugError
 
-#: Twin quantities a fingerprint compares (arrays of the simulated arm, exact floats).
-TWIN_FIELDS = ("q_true", "q_motor", "q_encoder", "offset_estimate", "current_a", "duty",
-               "speed_motor", "speed_load")
+#: Quantities of the simulated arm a fingerprint compares (arrays, exact floats): its
+#: controllers' ...
+TWIN_FIELDS = ("q_encoder", "offset_estimate", "duty")
+#: ... and its ground truth (``ArmSim.truth``; a replay is of a simulation).
+TRUTH_FIELDS = ("q", "q_motor", "current_a", "speed_motor", "speed_load")
 
 
 class Recipe(Protocol):
@@ -52,7 +55,7 @@ class RobotRecipe:
         if robot.steps:
             raise DebugError(f"the robot has run {robot.steps} control steps: its recipe cannot be"
                              " read back; pass recipe=RobotRecipe(params, seed, q_start, settle_s)")
-        return cls(robot.params, robot.seed, tuple(float(v) for v in robot.sim.q_true))
+        return cls(robot.params, robot.seed, tuple(float(v) for v in _sim(robot).truth.q))
 
 
 @dataclass(frozen=True)
@@ -87,16 +90,24 @@ class ReplayResult:
 def fingerprint(robot: Robot, forced: Mapping[tuple[str, str], Any] = MappingProxyType({})) -> dict[str, Any]:
     """The whole state a replay must reproduce: configurations, chart data (and their
     previous outputs, clocks, queued events), forced inputs and the twin's state, exact."""
-    sim = robot.sim
+    sim = _sim(robot)
     charts = {}
     for name, c in robot.charts.items():
         charts[name] = {"active": sorted(c.configuration_values), "tick": c.tick_count,
                         "data": c.snapshot(), "previous": c.previous_outputs(),
                         "pending": c.pending_events}
     twin = {name: getattr(sim, name).tolist() for name in TWIN_FIELDS}
+    twin.update({f"truth.{name}": getattr(sim.truth, name).tolist() for name in TRUTH_FIELDS})
     twin["sensors"] = asdict(sim.sensors())
     return {"steps": robot.steps, "chart_ticks": robot.chart_ticks, "t": sim.t, "charts": charts,
             "forced": sorted(forced.items()), "twin": twin}
+
+
+def _sim(robot: Robot) -> ArmSim:
+    """The robot's simulated arm: replaying needs a simulation."""
+    if robot.sim is None:
+        raise DebugError("replay needs a robot on the simulated arm (its whole state is compared)")
+    return robot.sim
 
 
 def differences(a: Any, b: Any, path: str = "") -> Iterator[str]:

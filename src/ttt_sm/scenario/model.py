@@ -22,12 +22,12 @@ SIGNALS: dict[str, int | None] = {
     "t": None,  # simulated time since power-on, s
     "q_set": 4,  # joint setpoints sent to the drives this chart step, rad
     "q_encoder": 3,  # joint angles the controllers see (encoder + offset), rad
-    "q_true": 4,  # true joint angles of the twin, rad
+    "q_true": 4,  # true joint angles of the twin, rad (simulation only)
     "offset_estimate": 3,  # encoder offsets applied so far, rad
     "index": 3,  # index switch levels
     "counts": 3,  # raw encoder counts
     "current_a": 3,  # motor currents, A
-    "tool_true": 4,  # true tool pose X, Y, Z (m), phi (rad)
+    "tool_true": 4,  # true tool pose X, Y, Z (m), phi (rad) (simulation only)
     "fr_sw": None,  # setpoint filter switch (slow filter when true)
 }
 

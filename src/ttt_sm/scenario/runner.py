@@ -302,11 +302,16 @@ class _Run:
             return lambda: name in chart.configuration_values
         if ref.name == "t":
             return lambda: robot.t
-        sim = getattr(robot, "sim", None)
         i = ref.index - 1 if ref.index is not None else None  # written 1-based, as the thesis numbers joints
-        if sim is not None and ref.name in ("q_true", "q_encoder", "offset_estimate"):
-            attr = ref.name
-            return lambda: float(getattr(sim, attr)[i])
+        # the arm's own accessors, without building every signal (a condition is checked every chart step)
+        arm, truth = getattr(robot, "arm", None), getattr(robot, "truth", None)
+        if i is not None and arm is not None:
+            if ref.name == "q_encoder":
+                return lambda: arm.encoder_angles()[i]
+            if ref.name == "offset_estimate":
+                return lambda: arm.offset_estimates()[i]
+        if i is not None and truth is not None and ref.name == "q_true":  # simulation only
+            return lambda: truth.angles()[i]
         name = ref.name
         if i is None:
             return lambda: robot.signal_values()[name]

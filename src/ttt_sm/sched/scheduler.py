@@ -4,7 +4,11 @@ One control step: read the sensors; every `chart_divider`-th step tick the
 chart stages (task stages produce the tool pose, inverse kinematics turns it
 into joint setpoints, joint stages such as the drive-initialisation charts
 pass or replace them); clamp to the joint limits; then the setpoint filters,
-cascade controllers and plant advance one step (inside :class:`ArmSim`).
+cascade controllers and plant advance one step (``arm.step``: inside the
+simulated arm, or in the microcontroller of a hardware arm).
+
+The scheduler is typed on :class:`~ttt_sm.arm.Arm`: it reads what a real arm
+reports and never the simulation's ground truth.
 
 Charts plug in as *stages*: objects with ``tick(signals)`` that read and write
 the :class:`Signals` of the current chart step.  A plain path is a task stage
@@ -20,9 +24,9 @@ from typing import Protocol
 
 import numpy as np
 
+from ..arm import Arm, Sensors
 from ..params import ArmParams
 from ..twin.kinematics import IKError, IKSolver, fk
-from ..twin.plant import ArmSim, Sensors
 from .clock import VirtualClock, WallClock
 
 
@@ -31,7 +35,7 @@ class Signals:
 
     Stages read and write these fields; the scheduler fills `t`, `q_des` (from
     IK of `task`) and `q_set` (clamped) around them.  `sensors` is read from
-    the twin on first use in a chart step, so steps that need none pay nothing.
+    the arm on first use in a chart step, so steps that need none pay nothing.
     """
 
     __slots__ = ("t", "task", "fr_sw", "q_des", "q_set", "ik_iterations", "ik_error",
@@ -108,13 +112,11 @@ class Record:
     task: list[np.ndarray] = field(default_factory=list)
     q_set: list[np.ndarray] = field(default_factory=list)
     q_encoder: list[np.ndarray] = field(default_factory=list)
-    q_true: list[np.ndarray] = field(default_factory=list)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The history as arrays, one row per chart tick."""
         return {"t": np.asarray(self.t), "task": np.asarray(self.task),
-                "q_set": np.asarray(self.q_set), "q_encoder": np.asarray(self.q_encoder),
-                "q_true": np.asarray(self.q_true)}
+                "q_set": np.asarray(self.q_set), "q_encoder": np.asarray(self.q_encoder)}
 
 
 class Scheduler:
@@ -124,8 +126,8 @@ class Scheduler:
     ----------
     params : ArmParams
         The arm.
-    sim : ArmSim
-        The simulated arm with its controllers (the plant of one control step).
+    arm : Arm
+        The arm with its controllers: the simulated arm, or a hardware backend.
     task_stages, joint_stages : sequence of Stage
         Ticked at the chart rate before and after inverse kinematics.
     clock : VirtualClock or WallClock, optional
@@ -134,11 +136,11 @@ class Scheduler:
         Keep a per-chart-tick :class:`Record` (costs time; off for benchmarks).
     """
 
-    def __init__(self, params: ArmParams, sim: ArmSim, task_stages: Sequence[Stage] = (),
+    def __init__(self, params: ArmParams, arm: Arm, task_stages: Sequence[Stage] = (),
                  joint_stages: Sequence[Stage] = (), clock: VirtualClock | WallClock | None = None,
                  ik: IKSolver | None = None, record: bool = False) -> None:
         self.params = params
-        self.sim = sim
+        self.arm = arm
         self.task_stages = list(task_stages)
         self.joint_stages = list(joint_stages)
         self.clock = clock if clock is not None else VirtualClock()
@@ -150,13 +152,13 @@ class Scheduler:
         # is known (mark_homed); the servo is absolute, so its limits always apply.
         self._lo = [-math.inf, -math.inf, -math.inf, self.q_min[3]]
         self._hi = [math.inf, math.inf, math.inf, self.q_max[3]]
-        self.signals = Signals(sim.sensors)
+        self.signals = Signals(arm.sensors)
         self.steps = 0
         self.chart_ticks = 0
         self.ik_failures = 0
         self.limit_clamps = 0
         self.record = Record() if record else None
-        self._hold: Sequence[float] = [*sim.encoder_angles(), sim.true_angles()[3]]
+        self._hold: Sequence[float] = [*arm.encoder_angles(), arm.servo_setpoint]
         self._clock_started = False
         self._period0 = 0
         self._ik_pose: list[float] = []  # the last pose solved, and its answer
@@ -164,8 +166,8 @@ class Scheduler:
 
     @property
     def t(self) -> float:
-        """Simulated time, s."""
-        return self.sim.t
+        """The arm's time, s."""
+        return self.arm.t
 
     @property
     def homed(self) -> tuple[bool, bool, bool, bool]:
@@ -177,12 +179,15 @@ class Scheduler:
         self._lo[drive - 1] = self.q_min[drive - 1]
         self._hi[drive - 1] = self.q_max[drive - 1]
 
-    def assume_homed(self) -> None:
-        """Treat every drive as initialised: the twin's true offsets, no init charts."""
-        self.sim.assume_initialised()
+    def mark_all_homed(self) -> None:
+        """Enforce every drive's limits and hold where the arm is: all offsets are known.
+
+        For an arm whose offsets were set without the init charts (in
+        simulation, ``ArmSim.assume_initialised``: tests and the bench).
+        """
         for drive in (1, 2, 3):
             self.mark_homed(drive)
-        self._hold = [*self.sim.encoder_angles(), self.sim.true_angles()[3]]
+        self._hold = [*self.arm.encoder_angles(), self.arm.servo_setpoint]
 
     def set_clock(self, clock: VirtualClock | WallClock) -> None:
         """Switch clocks; the new clock's period 0 is the next control step."""
@@ -193,7 +198,7 @@ class Scheduler:
     def tick_charts(self) -> Signals:
         """One chart step: task stages, IK, joint stages, clamp, setpoints."""
         s = self.signals
-        s.new_step(self.sim.t)
+        s.new_step(self.arm.t)
         for stage in self.task_stages:
             stage.tick(s)
         task = s.task
@@ -230,15 +235,14 @@ class Scheduler:
             self.limit_clamps += 1
             s.q_set = q
         self._hold = q
-        self.sim.set_setpoints(q, s.fr_sw)
+        self.arm.set_setpoints(q, s.fr_sw)
         self.chart_ticks += 1
         if self.record is not None:
             r = self.record
             r.t.append(s.t)
             r.task.append(np.array(task, dtype=float))
             r.q_set.append(np.array(q))
-            r.q_encoder.append(self.sim.q_encoder)
-            r.q_true.append(self.sim.q_true)
+            r.q_encoder.append(np.array(self.arm.encoder_angles()))
         return s
 
     def control_step(self) -> None:
@@ -247,7 +251,7 @@ class Scheduler:
         if self.steps % self.divider == 0:
             self.tick_charts()
         self.clock.wait_period(self.steps - self._period0)
-        self.sim.step(1)
+        self.arm.step(1)
         self.steps += 1
 
     def run_for(self, seconds: float) -> None:
@@ -266,10 +270,10 @@ class Scheduler:
             if paced:
                 for _ in range(self.divider):
                     self.clock.wait_period(self.steps - self._period0)
-                    self.sim.step(1)
+                    self.arm.step(1)
                     self.steps += 1
             else:
-                self.sim.step(self.divider)
+                self.arm.step(self.divider)
                 self.steps += self.divider
             if predicate():
                 return True

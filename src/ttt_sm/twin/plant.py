@@ -18,10 +18,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
+from ..arm.protocol import Sensors
 from ..params import ArmParams
 from . import _kernel as K
 from .control import (
@@ -30,6 +30,7 @@ from .control import (
     setpoint_filter_row,
     speed_filter_alpha,
 )
+from .truth import ArmTruth, flat_view
 
 #: Plant sub-steps per control step.  At 1 kHz this is a 0.1 ms step: the
 #: current is integrated exactly over it, the stiffest mechanical mode (the
@@ -55,24 +56,6 @@ Angles = Sequence[float] | np.ndarray
 
 class SimError(ValueError):
     """An invalid request to the simulated arm (bad pose, bad setpoints)."""
-
-
-@dataclass(frozen=True)
-class Sensors:
-    """What the controller hardware reads at one instant (drives 1..3 in order).
-
-    counts: encoder counts since power-on (motor shaft).  index: index switch
-    levels (True above the switch angle).  index_count: counts latched at the
-    last index edge (0 before any).  index_edges: edges seen since power-on.
-    current_a: measured motor currents (with noise).  t: simulated time, s.
-    """
-
-    counts: tuple[int, int, int]
-    index: tuple[bool, bool, bool]
-    index_count: tuple[int, int, int]
-    index_edges: tuple[int, int, int]
-    current_a: tuple[float, float, float]
-    t: float
 
 
 @dataclass(frozen=True)
@@ -113,11 +96,6 @@ def gravity_coefficients(params: ArmParams) -> tuple[float, float]:
     g2 = G * (m.link2_kg * m.link2_com + (m.link3_kg + m.tool_kg) * geo.L2)
     g23 = G * (m.link3_kg * m.link3_com + m.tool_kg * geo.L3)
     return g2, g23
-
-
-def _flat_view(a: np.ndarray) -> Any:
-    """A flat memoryview of `a`'s memory: its items read and written as plain Python numbers."""
-    return memoryview(a.reshape(-1))  # type: ignore[arg-type]  # numpy's stubs lack __buffer__
 
 
 class ArmSim:
@@ -176,10 +154,13 @@ class ArmSim:
         # Flat views of the same memory for the per-chart-step accessors: a
         # memoryview reads and writes plain Python numbers at a third of the
         # cost of numpy indexing or slicing.
-        self._dsv = _flat_view(self._ds)
-        self._div = _flat_view(self._di)
-        self._gsv = _flat_view(self._gs)
+        self._dsv = flat_view(self._ds)
+        self._div = flat_view(self._di)
+        self._gsv = flat_view(self._gs)
         self._power_on(q_start, np.random.default_rng(seed))
+        #: Ground truth (true angles, offsets, tool pose ...): simulation only, never read by
+        #: code typed on :class:`~ttt_sm.arm.Arm` (docs/model.md, "Ground truth").
+        self.truth = ArmTruth(params, self._dp, self._gp, self._ds, self._di, self._gs)
         # Load the compiled kernel now (from numba's disk cache: ~0.3 s the first time in a
         # process), not in the first control step: zero steps change nothing.
         K.run_steps(0, self._dp, self._gp, self._ds, self._di, self._gs, self._no_rec)
@@ -319,7 +300,7 @@ class ArmSim:
         """:meth:`run` for a duration, rounded to whole control steps."""
         return self.run(int(round(seconds / self.dt)), record)
 
-    # ---- sensors and true state ----------------------------------------------
+    # ---- sensors (the Arm protocol) -----------------------------------------
 
     def sensors(self) -> Sensors:
         """The readings of the encoders, index switches and current sensors now."""
@@ -330,94 +311,42 @@ class ArmSim:
                        index_count=(a[ic], b[ic], c[ic]), index_edges=(a[ie], b[ie], c[ie]),
                        current_a=(i1, i2, i3), t=float(self._gs[K.GS_T]))
 
-    @property
-    def q_true(self) -> np.ndarray:
-        """True load-side joint angles q1..q4 (rad), a copy."""
-        # built from a list: np.append costs several microseconds, and this runs every chart step
-        return np.array([*self._ds[:, K.S_Q].tolist(), float(self._gs[K.GS_SV_Q])])
-
-    @property
-    def q_motor(self) -> np.ndarray:
-        """True motor angles divided by the gear ratios (rad): what an ideal encoder would see."""
-        return self._ds[:, K.S_TH] / self._dp[:, K.P_N]
-
-    @property
-    def q_encoder(self) -> np.ndarray:
-        """What the controllers see: counts * rad_per_count + offset estimate (rad)."""
-        return np.array(self.encoder_angles())
-
-    def true_angles(self) -> tuple[float, float, float, float]:
-        """:attr:`q_true` as plain floats, for code that runs every chart step."""
-        ds, n = self._dsv, K.N_DS
-        return ds[K.S_Q], ds[n + K.S_Q], ds[2 * n + K.S_Q], self._gsv[K.GS_SV_Q]
-
     def encoder_angles(self) -> tuple[float, float, float]:
-        """:attr:`q_encoder` as plain floats, for code that runs every chart step."""
+        """What the controllers see: counts * rad_per_count + offset estimate (rad), as plain floats."""
         di, ni, ds, n = self._div, K.N_DI, self._dsv, K.N_DS
         r1, r2, r3 = self._rpc
         return (di[K.I_COUNTS] * r1 + ds[K.S_OFFSET], di[ni + K.I_COUNTS] * r2 + ds[n + K.S_OFFSET],
                 di[2 * ni + K.I_COUNTS] * r3 + ds[2 * n + K.S_OFFSET])
 
+    def offset_estimates(self) -> tuple[float, float, float]:
+        """The controllers' encoder offsets (rad), 0 until a drive is initialised."""
+        ds, n = self._dsv, K.N_DS
+        return ds[K.S_OFFSET], ds[n + K.S_OFFSET], ds[2 * n + K.S_OFFSET]
+
+    @property
+    def servo_setpoint(self) -> float:
+        """The servo angle last commanded (rad); at power-on, where the servo stands."""
+        return self._gsv[K.GS_SV_SET]
+
+    def enabled(self) -> tuple[bool, bool, bool]:
+        """True per drive while its cascade controller runs."""
+        di, ni, on = self._div, K.N_DI, K.MODE_CLOSED
+        return di[K.I_MODE] == on, di[ni + K.I_MODE] == on, di[2 * ni + K.I_MODE] == on
+
+    @property
+    def q_encoder(self) -> np.ndarray:
+        """:meth:`encoder_angles` as an array (rad)."""
+        return np.array(self.encoder_angles())
+
     @property
     def offset_estimate(self) -> np.ndarray:
-        """The controllers' encoder offsets (rad), 0 until a drive is initialised."""
+        """:meth:`offset_estimates` as an array (rad), a copy."""
         return self._ds[:, K.S_OFFSET].copy()
 
     @property
-    def true_offset(self) -> np.ndarray:
-        """The offsets that make q_encoder the motor-side joint angle within half a count (rad)."""
-        return (self._di[:, K.I_C0] + 0.5) * self._dp[:, K.P_RPC]
-
-    @property
-    def current_a(self) -> np.ndarray:
-        """True armature currents (A)."""
-        return self._ds[:, K.S_I].copy()
-
-    @property
     def duty(self) -> np.ndarray:
-        """PWM duties applied to the three H-bridges now (-1..1)."""
+        """PWM duties the controllers apply to the three H-bridges now (-1..1)."""
         return self._ds[:, K.S_DUTY].copy()
-
-    @property
-    def speed_motor(self) -> np.ndarray:
-        """True motor shaft speeds (rad/s)."""
-        return self._ds[:, K.S_WM].copy()
-
-    @property
-    def speed_load(self) -> np.ndarray:
-        """True load (joint) speeds of drives 1..3 (rad/s)."""
-        return self._ds[:, K.S_WQ].copy()
-
-    def mechanical_energy(self) -> float:
-        """Kinetic energy of rotors and loads + gravity and gear-spring potential of drives 1..3, J.
-
-        Gravity's zero is the arm hanging straight down.  With the drives
-        off, friction can only take energy out: a check of the integrator.
-        """
-        ds, dp = self._ds, self._dp
-        kinetic = 0.5 * float(np.sum(dp[:, K.P_JM] * ds[:, K.S_WM] ** 2 + dp[:, K.P_JL] * ds[:, K.S_WQ] ** 2))
-        g2, g23 = float(self._gp[K.G_GRAV2]), float(self._gp[K.G_GRAV23])
-        q2, q3 = float(ds[1, K.S_Q]), float(ds[2, K.S_Q])
-        gravity = g2 * (1.0 - math.cos(q2)) + g23 * (1.0 - math.cos(q2 + q3))
-        delta = ds[:, K.S_TH] / dp[:, K.P_N] - ds[:, K.S_Q]
-        squeeze = np.maximum(np.abs(delta) - 0.5 * dp[:, K.P_CLEAR], 0.0)
-        spring = 0.5 * float(np.sum(dp[:, K.P_K] * squeeze**2))
-        return kinetic + gravity + spring
-
-    @property
-    def at_limit(self) -> np.ndarray:
-        """True per drive while its load rests on a hard stop."""
-        return self._di[:, K.I_AT_LIMIT] != 0
-
-    @property
-    def stalled(self) -> np.ndarray:
-        """True per drive while the bridge drives it (|duty| > 0.1) but the motor stands still."""
-        return (np.abs(self._ds[:, K.S_DUTY]) > 0.1) & (self._ds[:, K.S_WM] == 0.0)
-
-    @property
-    def enabled(self) -> np.ndarray:
-        """True per drive while its cascade controller runs."""
-        return self._di[:, K.I_MODE] == K.MODE_CLOSED
 
     # ---- controller management ------------------------------------------------
 
@@ -435,8 +364,12 @@ class ArmSim:
             ds[d, k] += shift
 
     def assume_initialised(self) -> None:
-        """Give every drive its true offset (a stand-in for the init charts; tests, bench)."""
-        for d, off in enumerate(self.true_offset):
+        """Give every drive its true offset: simulation only, a stand-in for the init charts.
+
+        A real arm learns its offsets from the init charts; tests and the
+        bench that start from an initialised arm use this instead.
+        """
+        for d, off in enumerate(self.truth.offsets):
             self.set_offset_estimate(d + 1, float(off))
 
     def set_enabled(self, drive: int, enabled: bool) -> None:

@@ -313,7 +313,7 @@ def step_response(params: ArmParams, gains: Gains, drive: int, step_rad: float, 
     if drive == 2:
         sim.settle_unpowered(UNPOWERED_SETTLE_S)
     sim.assume_initialised()
-    hold = np.append(sim.q_encoder, sim.q_true[3])
+    hold = np.append(sim.q_encoder, sim.truth.q[3])
     sim.set_setpoints(hold)
     sim.run_for(PRE_ROLL_S, record=False)
     target = hold.copy()

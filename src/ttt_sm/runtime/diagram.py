@@ -53,6 +53,20 @@ def state_actions(state: StateInfo) -> list[str]:
     )
 
 
+def handler_lines(state: StateInfo, structure: ChartStructure) -> list[str]:
+    """The state's targetless transitions (``button / ignore_button``), listed inside it.
+
+    They leave no state and enter none (python-statemachine runs their actions only),
+    so they are written in the state's box rather than drawn as loops, which would read
+    as an exit and a re-entry.
+    """
+    lines = []
+    for t in structure.transitions:
+        if t.source == state.id and t.target is None:
+            lines.append(" ".join(p for p in edge_text(t, structure) if p))
+    return lines
+
+
 def edge_text(t: TransitionInfo, structure: ChartStructure) -> tuple[str, str]:
     """(trigger and guard, action) of a transition as drawn on its edge."""
     trigger = ""
@@ -222,6 +236,8 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
 
     def edges(scope: str | None, indent: str) -> None:
         for t in scoped.get(scope, []):
+            if t.target is None:
+                continue  # listed in its state (handler_lines)
             first, action = edge_text(t, structure)
             label = " ".join(p for p in (first, action) if p)
             target = t.target or t.source
@@ -235,7 +251,10 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
         for i, state in enumerate(states):
             if parent is not None and parent.parallel and i > 0:
                 out.append(f"{indent}--")
-            if state.label != state.id:
+            actions = state_actions(state) + handler_lines(state, structure)
+            # Mermaid titles a state with its first description line: declare the name
+            # as that line, so `s : entry / ...` lines sit under the name, not in its place.
+            if state.label != state.id or (actions and not state.is_compound):
                 out.append(f'{indent}state "{_m(state.label)}" as {state.id}')
             if state.history:
                 continue
@@ -244,12 +263,11 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
                 emit([by_id[c] for c in state.children], indent + "    ", state)
                 edges(state.id, indent + "    ")
                 out.append(f"{indent}}}")
-                if state_actions(state):
+                if actions:
                     notes.append(f"    note right of {state.id}")
-                    notes.extend(f"        {_m(a)}" for a in state_actions(state))
+                    notes.extend(f"        {_m(a)}" for a in actions)
                     notes.append("    end note")
             else:
-                actions = state_actions(state)
                 if actions:
                     out.extend(f"{indent}{state.id} : {_m(a)}" for a in actions)
                 else:

@@ -10,7 +10,7 @@ symmetries, the cell to play and the exact outcome for the player to move in
   they are few, and there the search still costs up to a few hundred ms).
 
 It is built by :func:`build_book` (``python -m ttt_sm.game.book``) with the
-same :func:`~ttt_sm.game.strong_engine.choose` the engine uses, searching
+same :func:`~ttt_sm.game.solver.choose` the engine uses, searching
 for wins without a budget, and shipped as ``book.bin`` in this package.  The
 tests re-solve a sample of its entries and check what it covers.
 
@@ -33,11 +33,10 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Literal
 
 from .bitboard import FULL, N_CELLS, bits, canonical, has_four
+from .solver import Outcome, Solver, choose
 
-Outcome = Literal["win", "draw", "loss"]
 OUTCOMES: tuple[Outcome, Outcome, Outcome] = ("win", "draw", "loss")
 MAGIC = b"TTTB"
 VERSION = 2
@@ -123,9 +122,6 @@ def build_book(max_stones: int = DEFAULT_MAX_STONES, line_stones: int = DEFAULT_
     ``known`` entries are taken as they are instead of solved again (to extend
     a book; :func:`choose` is deterministic, so the result is the same).
     """
-    from .solver import Solver
-    from .strong_engine import choose
-
     solver = Solver(max_entries=20_000_000)
     entries: dict[int, tuple[int, Outcome]] = {}
     old = known.entries if known is not None else {}

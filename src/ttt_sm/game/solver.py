@@ -26,7 +26,12 @@ field is about 0.6 million nodes, a few seconds):
 
 from __future__ import annotations
 
-from .bitboard import CELL_LINES, FULL, LINE_MASKS, LINES, N_CELLS, canonical, has_four
+from typing import Literal
+
+from .bitboard import CELL_LINES, FULL, LINE_MASKS, LINES, N_CELLS, canonical, has_four, win_cells
+
+Outcome = Literal["win", "draw", "loss"]
+"""What a side to move can force: a win, a draw, or (against best play) a loss."""
 
 CANON_UPTO = 12
 """Fold positions with this many marks or fewer under the symmetries (deeper, the look-up costs more than it saves)."""
@@ -136,3 +141,34 @@ class Solver:
             result = all(self._search(a, d | b, True, n + 1) for b in ordered_moves(d, a))
         self.table[key] = result
         return result
+
+
+def choose(solver: Solver, mine: int, theirs: int, win_budget: int | None) -> tuple[int, Outcome, int]:
+    """The move (a bit index) for the side holding ``mine`` to move, its outcome, and the nodes searched.
+
+    ``win_budget`` ``None`` searches for a forced win exactly (what the book
+    is built with); a number caps that search, and a fresh :class:`Solver`
+    does it so the answer does not depend on ``solver``'s table.
+    """
+    wins = win_cells(mine, theirs)
+    if wins:
+        return (wins & -wins).bit_length() - 1, "win", 0
+    threats = win_cells(theirs, mine)
+    if threats & (threats - 1):  # two cells to block: lost whatever we do; block one
+        return (threats & -threats).bit_length() - 1, "loss", 0
+    candidates = [threats] if threats else ordered_moves(mine, theirs)
+    nodes = 0
+    win_search = solver if win_budget is None else Solver()
+    win_search.nodes, win_search.budget = 0, win_budget
+    try:
+        for b in candidates:
+            if win_search.attacker_wins(mine | b, theirs, attacker_to_move=False):
+                return b.bit_length() - 1, "win", win_search.nodes
+    except OutOfBudget:
+        pass
+    nodes += win_search.nodes
+    solver.nodes, solver.budget = 0, None
+    for b in candidates:
+        if not solver.attacker_wins(theirs, mine | b, attacker_to_move=True):
+            return b.bit_length() - 1, "draw", nodes + solver.nodes
+    return candidates[0].bit_length() - 1, "loss", nodes + solver.nodes

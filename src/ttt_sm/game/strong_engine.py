@@ -36,9 +36,8 @@ from .bitboard import FULL, INVERSE, N_CELLS, SYMMETRIES, canonical, cell_of, wi
 from .book import Book, load_book
 from .engine import GameOver, Move, prepare
 from .rules import Board, Symbol, other
-from .solver import OutOfBudget, Solver, ordered_moves
+from .solver import Outcome, Solver, choose
 
-Outcome = Literal["win", "draw", "loss"]
 WIN_BUDGET_NODES = 3000
 """Nodes the forced-win search may visit per move (about 25 ms); the no-loss search has no budget."""
 
@@ -52,37 +51,6 @@ class Analysis:
     source: Literal["win-now", "book", "search"]
     nodes: int
     """Positions the searches visited for this move (0 for the book and an immediate win)."""
-
-
-def choose(solver: Solver, mine: int, theirs: int, win_budget: int | None) -> tuple[int, Outcome, int]:
-    """The move (a bit index) for the side holding ``mine`` to move, its outcome, and the nodes searched.
-
-    ``win_budget`` ``None`` searches for a forced win exactly (what the book
-    is built with); a number caps that search, and a fresh :class:`Solver`
-    does it so the answer does not depend on ``solver``'s table.
-    """
-    wins = win_cells(mine, theirs)
-    if wins:
-        return (wins & -wins).bit_length() - 1, "win", 0
-    threats = win_cells(theirs, mine)
-    if threats & (threats - 1):  # two cells to block: lost whatever we do; block one
-        return (threats & -threats).bit_length() - 1, "loss", 0
-    candidates = [threats] if threats else ordered_moves(mine, theirs)
-    nodes = 0
-    win_search = solver if win_budget is None else Solver()
-    win_search.nodes, win_search.budget = 0, win_budget
-    try:
-        for b in candidates:
-            if win_search.attacker_wins(mine | b, theirs, attacker_to_move=False):
-                return b.bit_length() - 1, "win", win_search.nodes
-    except OutOfBudget:
-        pass
-    nodes += win_search.nodes
-    solver.nodes, solver.budget = 0, None
-    for b in candidates:
-        if not solver.attacker_wins(theirs, mine | b, attacker_to_move=True):
-            return b.bit_length() - 1, "draw", nodes + solver.nodes
-    return candidates[0].bit_length() - 1, "loss", nodes + solver.nodes
 
 
 class StrongEngine:

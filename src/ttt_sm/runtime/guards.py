@@ -24,17 +24,28 @@ import inspect
 import operator
 from collections.abc import Callable
 from functools import partial
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol, cast
 
+from statemachine import StateChart
 from statemachine.callbacks import SpecReference
 from statemachine.event_data import EventData, TriggerData
 from statemachine.spec_parser import operator_mapping, parse_boolean_expr, replace_operators
 from statemachine.transition import Transition
 
-from .temporal import temporal_of
+from .temporal import TickCounter, temporal_of
 
-if TYPE_CHECKING:
-    from .chart import TickChart
+
+class FastPathChart(TickCounter, Protocol):
+    """What compiling a guard reads of its chart; :class:`~.chart.TickChart` is one.
+
+    A protocol rather than an import of :mod:`.chart`, which imports this
+    module: the chart's own declarations (``_entered_at``) and the library's
+    (``model``, ``_callbacks``) that the fast path binds once.
+    """
+
+    _entered_at: dict[str, int]
+    model: Any
+    _callbacks: Any
 
 Guard = Callable[[], Any]
 
@@ -43,7 +54,7 @@ class _Unsupported(Exception):
     """This guard cannot be made a plain call; use the library's evaluation."""
 
 
-def compile_guard(chart: TickChart, transition: Transition) -> tuple[Guard | None, bool]:
+def compile_guard(chart: FastPathChart, transition: Transition) -> tuple[Guard | None, bool]:
     """A zero-argument callable that is truthy when all guards of ``transition`` hold.
 
     Returns ``(guard, fast)``: ``guard`` is ``None`` when the transition has no
@@ -68,7 +79,7 @@ def compile_guard(chart: TickChart, transition: Transition) -> tuple[Guard | Non
     return all_hold, True
 
 
-def _compile_spec(chart: TickChart, transition: Transition, spec: Any) -> Guard:
+def _compile_spec(chart: FastPathChart, transition: Transition, spec: Any) -> Guard:
     if spec.reference is SpecReference.CALLABLE:
         fn = _compile_callable(chart, transition, spec)
     elif spec.reference is SpecReference.PROPERTY:
@@ -89,7 +100,7 @@ def _negate(fn: Guard) -> Guard:
     return negated
 
 
-def _compile_callable(chart: TickChart, transition: Transition, spec: Any) -> Guard:
+def _compile_callable(chart: FastPathChart, transition: Transition, spec: Any) -> Guard:
     func = spec.func
     temporal = temporal_of(func)
     if temporal is not None:
@@ -110,7 +121,7 @@ def _compile_callable(chart: TickChart, transition: Transition, spec: Any) -> Gu
     return _bind_known(chart, transition, func)
 
 
-def _compile_name(chart: TickChart, transition: Transition, name: str) -> Guard:
+def _compile_name(chart: FastPathChart, transition: Transition, name: str) -> Guard:
     static = inspect.getattr_static(chart, name, _MISSING)
     if static is _MISSING:
         model = chart.model
@@ -142,7 +153,7 @@ _ALLOWED_NODES = (
 class _Inline(ast.NodeTransformer):
     """Rewrite each name of a guard expression into a read of the chart's data or a call."""
 
-    def __init__(self, chart: TickChart, transition: Transition) -> None:
+    def __init__(self, chart: FastPathChart, transition: Transition) -> None:
         self.chart = chart
         self.transition = transition
         self.env: dict[str, Any] = {"_d": chart.__dict__}
@@ -160,7 +171,7 @@ class _Inline(ast.NodeTransformer):
         return ast.copy_location(new, node)
 
 
-def _inline_expression(chart: TickChart, transition: Transition, expr: str) -> Guard:
+def _inline_expression(chart: FastPathChart, transition: Transition, expr: str) -> Guard:
     """Compile ``"a and not b"`` / ``"n >= 3"`` into one Python lambda, or give up."""
     try:
         tree = ast.parse(replace_operators(expr).strip(), mode="eval")
@@ -178,7 +189,7 @@ def _inline_expression(chart: TickChart, transition: Transition, expr: str) -> G
     return eval(code, {"__builtins__": {}, **inline.env})  # noqa: S307 - our own AST, names only
 
 
-def _compile_expression(chart: TickChart, transition: Transition, expr: str) -> Guard:
+def _compile_expression(chart: FastPathChart, transition: Transition, expr: str) -> Guard:
     try:
         return _inline_expression(chart, transition, expr)
     except _Unsupported:
@@ -206,7 +217,7 @@ def _compile_expression(chart: TickChart, transition: Transition, expr: str) -> 
 _MISSING = object()
 
 
-def _bind_known(chart: TickChart, transition: Transition, func: Callable[..., Any]) -> Guard:
+def _bind_known(chart: FastPathChart, transition: Transition, func: Callable[..., Any]) -> Guard:
     """Bind the parameters python-statemachine would pass by name, or give up."""
     try:
         signature = inspect.signature(func)
@@ -230,12 +241,12 @@ def _bind_known(chart: TickChart, transition: Transition, func: Callable[..., An
     return partial(func, **kwargs) if kwargs else func
 
 
-def _library_guard(chart: TickChart, transition: Transition) -> Guard:
+def _library_guard(chart: FastPathChart, transition: Transition) -> Guard:
     key = transition.cond.key
     evaluate = chart._callbacks.all
     # The arguments the library gives a guard when the transition's own event is sent.
     event = next(iter(transition.events), None)
-    trigger = TriggerData(machine=chart, event=event)
+    trigger = TriggerData(machine=cast(StateChart, chart), event=event)  # a TickChart is a StateChart
     kwargs = EventData(trigger_data=trigger, transition=transition).extended_kwargs
 
     def library_guard() -> bool:

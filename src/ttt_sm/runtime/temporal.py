@@ -17,12 +17,23 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from .errors import TemporalLogicError
 
-if TYPE_CHECKING:
-    from .chart import TickChart
+
+class TickCounter(Protocol):
+    """What a temporal guard reads of its chart; :class:`~.chart.TickChart` is one.
+
+    Declared here, not imported from :mod:`.chart`, so the clock's guards do
+    not depend on the chart that uses them (no import circle).
+    """
+
+    tick_period_s: float | None
+
+    def ticks_in(self, state: Any) -> int:
+        """Chart ticks since ``state`` was entered."""
+        ...
 
 #: Relative slack when turning seconds into ticks, so 0.3 s at 0.1 s per tick is 3 ticks, not 4.
 _EPS = 1e-9
@@ -51,7 +62,7 @@ def _temporal_guard(spec: Temporal, label: str) -> Callable[..., bool]:
     # A real function (not a callable object): python-statemachine resolves and
     # caches guards by __qualname__ and __code__, and names them in diagrams by
     # __name__, so ``after(3)`` shows as ``[after(3)]`` on the edge.
-    def guard(machine: TickChart, source: Any) -> bool:
+    def guard(machine: TickCounter, source: Any) -> bool:
         return machine.ticks_in(source) >= spec.ticks(machine.tick_period_s)
 
     guard.__name__ = guard.__qualname__ = label

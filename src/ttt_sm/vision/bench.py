@@ -12,19 +12,19 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
-from ttt_sm.params import ArmParams, load_params
-from ttt_sm.twin.kinematics import ik_closed_form
+from ttt_sm.params import ArmParams, Geometry, load_params
+from ttt_sm.twin.kinematics import ik_closed_form, link_points
 
 from .detection import detect
 from .errors import VisionError
 from .orientation import board_text
 from .scenes import Scene, random_scene
-from .simulated import CameraJitter, Shadow, SimulatedCamera, shadow_of
+from .simulated import LAMP_M, SHADOW_DEPTH, CameraJitter, Shadow, SimulatedCamera
 
 #: Each photo is detected this many times; its time is the fastest run.
 REPEATS = 3
@@ -32,6 +32,16 @@ REPEATS = 3
 BENCH_PHOTOS = 200
 #: How far the benchmark's cameras stray from the nominal pose: twice the default jitter.
 BENCH_JITTER = CameraJitter(position_m=0.04, target_m=0.02, roll_deg=8.0, focal_rel=0.08)
+
+
+def shadow_of(q: Sequence[float], geometry: Geometry, lamp_m: tuple[float, float, float] = LAMP_M,
+              depth: float = SHADOW_DEPTH) -> Shadow:
+    """The :class:`Shadow` of the arm at joint angles ``q`` (rad): its links from the twin's kinematics."""
+    g = geometry
+    # the column's foot and the shoulder, then the elbow, the wrist and the pen tip
+    points = [(-g.l_f, 0.0, 0.0), (-g.l_f, 0.0, g.L1)]
+    points += [(float(x), float(y), float(z)) for x, y, z in link_points(q, g)]
+    return Shadow(tuple(points), lamp_m, depth)
 
 
 def random_shadow(params: ArmParams, rng: np.random.Generator) -> Shadow:
@@ -45,7 +55,7 @@ def random_shadow(params: ArmParams, rng: np.random.Generator) -> Shadow:
         except ValueError:
             continue
         if np.all(np.isfinite(q)):
-            return shadow_of([float(v) for v in q])
+            return shadow_of([float(v) for v in q], params.geometry)
     raise VisionError("random_shadow: no reachable pose found")
 
 

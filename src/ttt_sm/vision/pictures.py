@@ -105,9 +105,10 @@ def doc_pictures(out_dir: str | Path, params: ArmParams | None = None) -> list[P
     from ttt_sm.params import load_params
     from ttt_sm.twin.kinematics import ik_closed_form
 
+    from .bench import shadow_of
     from .detection import detect
     from .scenes import scene_from_text
-    from .simulated import Lighting, SimulatedCamera, shadow_of
+    from .simulated import Lighting, SimulatedCamera
 
     params = params if params is not None else load_params()
     out = Path(out_dir)
@@ -116,7 +117,7 @@ def doc_pictures(out_dir: str | Path, params: ArmParams | None = None) -> list[P
     light = Lighting(dim=0.45, direction_deg=20.0, spread=0.8, exposure=0.9, vignette=0.12, noise_sigma=1.2,
                      blur_sigma_px=0.7)
     hover = ik_closed_form([0.04, 0.21, 0.06, 0.0], params.geometry)  # the arm waiting over the field
-    cam = SimulatedCamera(scene.board, params, seed=12, lighting=light, shadow=shadow_of(list(hover)))
+    cam = SimulatedCamera(scene.board, params, seed=12, lighting=light, shadow=shadow_of(list(hover), params.geometry))
     photo = cam.frame()
     det = detect(photo)
     dim_cam = SimulatedCamera(scene_from_text(params, DIM_BOARD, "X", seed=4).board, params, seed=4, jitter=None,

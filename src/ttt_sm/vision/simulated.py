@@ -1,8 +1,10 @@
-"""A simulated camera: the twin's whiteboard photographed by a pinhole camera on a stand.
+"""A simulated camera: a board photographed by a pinhole camera on a stand.
 
 The thesis' smart camera (section 3.6.3, fig. 3.31) stands above the board
 and sees the field the arm drew.  :class:`SimulatedCamera` makes the photo
-such a camera would take of the simulated :class:`~ttt_sm.twin.whiteboard.Whiteboard`:
+such a camera would take of any :class:`Photographable` board (the digital
+twin's :class:`~ttt_sm.twin.whiteboard.Whiteboard` is one; this module does
+not import it, so vision stays beside the twin, not on top of it):
 
 * **perspective**: a pinhole camera beyond the board's far edge, looking
   down at the field (:meth:`CameraPose.beyond_far_edge`), its position,
@@ -14,8 +16,9 @@ such a camera would take of the simulated :class:`~ttt_sm.twin.whiteboard.Whiteb
 * **lighting** (:class:`Lighting`): a gradient that leaves one side dim,
   vignetting, exposure, a colour tint;
 * **optics and sensor**: Gaussian blur (focus) and noise;
-* the **arm's shadow** (optional): the links seen from a lamp, cast on the
-  board, with a soft edge;
+* the **arm's shadow** (optional): the links (a polyline of the arm's
+  joints, :class:`Shadow`) seen from a lamp, cast on the board, with a soft
+  edge;
 * the person's hand-drawn symbols and the robot's ink are whatever is on
   the board (:meth:`Whiteboard.draw_symbol`, the arm's pen).
 
@@ -27,16 +30,14 @@ the sensor noise afresh for every :meth:`SimulatedCamera.frame`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Protocol
 
 import cv2
 import numpy as np
 
 from ttt_sm.params import ArmParams
-from ttt_sm.twin.kinematics import link_points
-from ttt_sm.twin.whiteboard import Whiteboard
 
 from .camera import DEFAULT_SIZE
 from .errors import VisionError
@@ -55,6 +56,23 @@ SHADOW_DEPTH = 0.45
 SHADOW_WIDTHS_M = (0.05, 0.04, 0.035, 0.02)
 #: Softness (Gaussian sigma) of the shadow's edge on the board, m.
 SHADOW_SOFTNESS_M = 0.004
+
+
+class Photographable(Protocol):
+    """What the camera photographs: a board that draws itself seen from above.
+
+    The twin's :class:`~ttt_sm.twin.whiteboard.Whiteboard` is one.
+    """
+
+    @property
+    def extent(self) -> tuple[float, float, float, float]:
+        """(x_min, x_max, y_min, y_max) of the board, m."""
+        ...
+
+    def render(self, px_per_mm: float = 4.0, grid_mm: bool = False, region: Any = None, *,
+               view: str = "field", desired: Any = None) -> np.ndarray:
+        """The board as a BGR image; ``view="above"``: x right, y up, at ``px_per_mm``."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -240,9 +258,15 @@ class Lighting:
 
 @dataclass(frozen=True)
 class Shadow:
-    """The arm's shadow: its joint angles and the lamp that casts it."""
+    """The arm's shadow: where its links are and the lamp that casts it.
 
-    q: tuple[float, float, float, float]
+    ``links_m`` is the arm as a polyline, 5 points (x, y, z) in m: the
+    column's foot, the shoulder, the elbow, the wrist and the pen tip
+    (:func:`ttt_sm.vision.bench.shadow_of` makes it from joint angles with
+    the twin's kinematics).
+    """
+
+    links_m: tuple[tuple[float, float, float], ...]
     lamp_m: tuple[float, float, float] = LAMP_M
     depth: float = SHADOW_DEPTH
 
@@ -252,8 +276,9 @@ class SimulatedCamera:
 
     Parameters
     ----------
-    board : Whiteboard
-        The board it sees; each :meth:`frame` shows its ink at that moment.
+    board : Photographable
+        The board it sees (the twin's whiteboard); each :meth:`frame` shows
+        its ink at that moment.
     params : ArmParams
         Board geometry (and the arm's links, for the shadow).
     seed : int
@@ -276,7 +301,7 @@ class SimulatedCamera:
         The actual lighting.
     """
 
-    def __init__(self, board: Whiteboard, params: ArmParams, seed: int = 0, *,
+    def __init__(self, board: Photographable, params: ArmParams, seed: int = 0, *,
                  pose: CameraPose | None = None, jitter: CameraJitter | None = CameraJitter(),
                  lighting: Lighting | None = None,
                  shadow: Shadow | Callable[[], Shadow | None] | None = None) -> None:
@@ -345,8 +370,10 @@ class SimulatedCamera:
 
     def _cast_shadow(self, top: np.ndarray, shadow: Shadow) -> np.ndarray:
         """Darken the board render where the arm's links, seen from the lamp, fall on it."""
-        g = self.params.geometry
-        joints = np.vstack(([(-g.l_f, 0.0, 0.0), (-g.l_f, 0.0, g.L1)], link_points(shadow.q, g)))
+        joints = np.asarray(shadow.links_m, float)
+        if joints.shape != (len(SHADOW_WIDTHS_M) + 1, 3):
+            raise VisionError(f"Shadow.links_m: expected {len(SHADOW_WIDTHS_M) + 1} points (x, y, z),"
+                              f" got an array of shape {joints.shape}")
         lamp = np.asarray(shadow.lamp_m, float)
         z0 = self._surface_z
         if np.any(joints[:, 2] >= lamp[2]):
@@ -374,10 +401,3 @@ def _table_top(width: int, height: int, rng: np.random.Generator) -> np.ndarray:
                                sigmaY=1.5) * 60.0
     tex = (base[None, None, :] + (grain + streaks)[:, :, None])
     return np.clip(tex, 0, 255).astype(np.uint8)
-
-
-def shadow_of(q: Sequence[float], lamp_m: tuple[float, float, float] = LAMP_M,
-              depth: float = SHADOW_DEPTH) -> Shadow:
-    """A :class:`Shadow` for joint angles `q` (rad)."""
-    q1, q2, q3, q4 = (float(v) for v in q)
-    return Shadow((q1, q2, q3, q4), lamp_m, depth)

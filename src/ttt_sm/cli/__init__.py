@@ -11,8 +11,8 @@ strict JSON output); each other module adds its subcommands with a
 ``ttt-sm --help`` shows them:
 
 - :mod:`.commands`: play, demo, draw, tune, bench, ik, init, charts, params;
-- :mod:`.scenario`, :mod:`.debug`, :mod:`.camera`, :mod:`.vision`, :mod:`.ai`:
-  the command of that name.
+- :mod:`.scenario`, :mod:`.debug`, :mod:`.camera`, :mod:`.vision`, :mod:`.ai`,
+  :mod:`.docs`: the command of that name.
 
 The subcommand modules import only :mod:`.common` from this package, never
 this module, and nothing below the CLI imports the CLI.
@@ -25,11 +25,11 @@ import sys
 from collections.abc import Sequence
 
 from ..params import ParameterError
-from . import ai, camera, commands, debug, scenario, vision
+from . import ai, camera, commands, debug, docs, scenario, vision
 from .common import CliError
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
-SUBCOMMANDS = (commands, scenario, debug, camera, vision, ai)
+SUBCOMMANDS = (commands, scenario, debug, camera, vision, ai, docs)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -39,6 +39,17 @@ def _sha(text: str) -> str:
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
+def dot_sha256(dot_source: str) -> str:
+    """The hash :func:`svg_from_dot` stamps on an SVG drawn from ``dot_source``."""
+    return _sha(dot_source)
+
+
+def svg_dot_sha256(svg_text: str) -> str | None:
+    """The DOT hash an SVG made by :func:`svg_from_dot` carries (``None``: no stamp)."""
+    match = _SVG_HASH.search(svg_text)
+    return match.group(1) if match else None
+
+
 def run_dot(dot_source: str, fmt: str) -> bytes:
     """Render DOT with Graphviz; :class:`GraphvizMissingError` if ``dot`` is not installed."""
     exe = shutil.which("dot")

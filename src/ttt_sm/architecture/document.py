@@ -1,0 +1,216 @@
+"""``docs/architecture.md``: how the package is put together, generated from the code.
+
+The page is a list of *sections* (:data:`SECTIONS`), each a function that
+returns its Markdown and may add Graphviz pictures through the
+:class:`Pictures` it is given.  To add a section, write such a function
+(anywhere the layering contract lets this module import) and add it to
+:data:`SECTIONS`; ``ttt-sm docs export`` writes the page and its pictures,
+and ``tests/docs/test_architecture_doc.py`` fails when they are stale.
+
+The pictures are SVG files in ``docs/img/``, stamped with the hash of the
+DOT source they were drawn from (:func:`ttt_sm.runtime.export.svg_from_dot`),
+so the staleness check needs no Graphviz and does not trip over another
+Graphviz version.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..runtime.export import dot_sha256, svg_dot_sha256, svg_from_dot
+from .layers import CONTRACT, TIERS, ImportGraph, allowed, component_edges, cycles, scan
+
+PAGE = Path("docs") / "architecture.md"
+"""Where the page lives in the repository."""
+IMAGE_DIR = Path("docs") / "img"
+"""Where its pictures live."""
+IMAGE_PREFIX = "architecture_"
+
+
+@dataclass
+class Pictures:
+    """The Graphviz pictures of the page: file name -> DOT source."""
+
+    dot: dict[str, str] = field(default_factory=dict)
+
+    def add(self, name: str, dot_source: str, alt: str) -> str:
+        """Register ``docs/img/architecture_<name>.svg``; return the Markdown that shows it."""
+        filename = f"{IMAGE_PREFIX}{name}.svg"
+        if filename in self.dot:
+            raise ValueError(f"two pictures named {filename}")
+        self.dot[filename] = dot_source
+        return f"![{alt}](img/{filename})"
+
+
+Section = Callable[[Pictures], str]
+"""A section of the page: Markdown (starting with its ``##`` heading), given the page's pictures."""
+
+
+def _quote(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def layers_dot(graph: ImportGraph) -> str:
+    """The components in their tiers (top: the command line) and the imports between them, as DOT.
+
+    The command line's arrows are left out (it imports nearly every component;
+    the table lists them); every other import between components is an arrow.
+    """
+    edges = component_edges(graph)
+    lines = ["digraph layers {", "  rankdir=TB; newrank=true; nodesep=0.3; ranksep=0.55;",
+             '  node [shape=box, style="rounded,filled", fillcolor="#f4f4f4", fontname="Helvetica", fontsize=11];',
+             '  edge [color="#556b8d", arrowsize=0.6];']
+    tiers = [[c for c in CONTRACT if c.tier == t] for t in range(len(TIERS))]
+    for tier in reversed(range(len(TIERS))):
+        lines.append(f"  subgraph cluster_tier{tier} {{")
+        lines.append(f'    label={_quote(f"{tier} {TIERS[tier]}")}; labeljust=l; fontname="Helvetica"; '
+                     'fontsize=10; style=dashed; color="#aaaaaa";')
+        lines.append("    rank=same; " + " ".join(_quote(c.name) + ";" for c in tiers[tier]))
+        lines.append("  }")
+    for upper, lower in zip(tiers[1:], tiers[:-1], strict=False):  # keep the tiers stacked in order
+        lines.append(f"  {_quote(upper[0].name)} -> {_quote(lower[0].name)} [style=invis];")
+    for (a, b), n in sorted(edges.items()):
+        if a == "cli":
+            continue
+        width = 1.0 + min(n, 12) / 6
+        lines.append(f"  {_quote(a)} -> {_quote(b)} [penwidth={width:.2f}, tooltip={_quote(f'{n} imports')}];")
+    lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def layers_section(pictures: Pictures) -> str:
+    """The layering contract: the picture drawn from the real imports, the table, the circles."""
+    graph = scan()
+    edges = component_edges(graph)
+    picture = pictures.add("layers", layers_dot(graph), "components in tiers and the imports between them")
+    rows = ["| tier | component | modules | may import | imports now | what it is |", "|---|---|---|---|---|---|"]
+    for comp in sorted(CONTRACT, key=lambda c: (-c.tier, CONTRACT.index(c))):
+        may = allowed(comp)
+        may_text = ("everything below" if comp.only is None else ", ".join(may)) if may else "nothing of the package"
+        now = sorted(b for (a, b) in edges if a == comp.name)
+        mods = ", ".join(f"`{p}`" for p in comp.prefixes)
+        rows.append(f"| {comp.tier} {TIERS[comp.tier]} | **{comp.name}** | {mods} | {may_text} | "
+                    f"{', '.join(now) or '—'} | {comp.role} |")
+    found = cycles(graph)
+    circles = ("None: no module imports, even for type checking or inside a function, a module that "
+               "imports it back." if not found else
+               "Known, to be removed (the layering test names each):\n\n"
+               + "\n".join(f"- {' <-> '.join(f'`{m}`' for m in c)}" for c in found))
+    return f"""## The layers
+
+The package is cut into components stacked in tiers. A component may import
+components of lower tiers only: never one beside it in its own tier, never
+one above; where the table lists what it may import, only those. The rule
+is code, `ttt_sm.architecture.layers.CONTRACT`, and `tests/test_layers.py`
+holds the source to it with an `ast` scan of every `import` statement
+(top-level, in functions and under `TYPE_CHECKING` alike); it also feeds the
+checker a copy of the package with a wrong import, to show that it fails and
+names the file and line. A module belongs to the component with the longest
+prefix that names it (so `ttt_sm.vision.scenes` is vision staging, not
+vision).
+
+{picture}
+
+*Drawn from the imports in the source: an arrow is "imports", its width the
+number of import statements. The command line's arrows are left out: it
+imports nearly every component (the table lists them).*
+
+{chr(10).join(rows)}
+
+In words: the runtime is generic and imports no robot code; the charts use
+only the runtime; the twin uses the parameters and the `Arm` protocol, never
+the charts, the scheduler or the application; the game and the serial link
+stand alone; vision's camera and detection use only the parameters (the
+simulated camera photographs any `Photographable` board, which the twin's
+whiteboard is), while the vision bench's staging modules use the twin to draw
+the boards they photograph. The application wires them; the debugger,
+scenarios and benches are tools over it; the command line sits on top, its
+subcommand modules importing only `cli.common` from it.
+
+**Import circles.** {circles}
+"""
+
+
+def control_step_section(pictures: Pictures) -> str:
+    """One control step through the ``Arm`` interface (placeholder until the Arm protocol lands)."""
+    del pictures
+    return """## One control step
+
+<!-- placeholder: this section is to be generated from the scheduler's stages and the Arm
+protocol's methods (ttt_sm.sched.scheduler, ttt_sm.arm) once the Arm protocol is on main -->
+
+*To be generated: one control step's data flow through the `Arm` interface.*
+"""
+
+
+def conventions_section(pictures: Pictures) -> str:
+    """What every part keeps to at its edges: errors and JSON."""
+    del pictures
+    return """## Conventions at the edges
+
+- **Errors.** Bad input raises an exception that names what and where
+  (`ParameterError`, `ScenarioError`, `DebugError`, `VisionError`, ...); the
+  command line prints it as one line, `ttt-sm <command>: error: ...`, and
+  exits with status 2 (`ttt_sm.cli.common.CliError` for its own checks).
+  Names that are near a known one get a "did you mean" from
+  `ttt_sm.runtime.errors.suggest`, the one helper for it.
+- **Strict JSON.** Every `--json` document, trace line and game record is
+  written by `ttt_sm.runtime.jsonable.dumps`: NaN and infinity become `null`
+  and `allow_nan=False` makes any that slipped through an error. JSON has no
+  NaN: Python would write a bare `NaN`, which `jq`, browsers and most JSON
+  libraries refuse, so one unset datum (a chart output that is NaN until the
+  arm is initialised) would make a whole document unreadable.
+  `tests/test_strict_json.py` fails on any `json.dumps` in the package that
+  does not pass `allow_nan=False`.
+"""
+
+
+#: The sections of docs/architecture.md, in order.  Add yours here.
+SECTIONS: list[Section] = [layers_section, control_step_section, conventions_section]
+
+
+def render() -> tuple[str, dict[str, str]]:
+    """The page's Markdown and its pictures (file name -> DOT source)."""
+    pictures = Pictures()
+    body = "\n".join(section(pictures) for section in SECTIONS)
+    head = """# Architecture
+
+<!-- generated by ttt_sm.architecture.document (`ttt-sm docs export`); do not edit -->
+
+How `ttt_sm` is put together, drawn from the code: which part may use which,
+and how the parts meet. The parts themselves have their own pages in this
+folder; the thesis' charts are in [charts/](../charts/index.md).
+
+"""
+    return head + body, pictures.dot
+
+
+def export(root: Path | str = ".") -> list[Path]:
+    """Write ``docs/architecture.md`` and its pictures under the repository ``root``; return the paths."""
+    root = Path(root)
+    text, dots = render()
+    page = root / PAGE
+    page.parent.mkdir(parents=True, exist_ok=True)
+    (root / IMAGE_DIR).mkdir(parents=True, exist_ok=True)
+    page.write_text(text, encoding="utf-8")
+    written = [page]
+    for name, dot in dots.items():
+        path = root / IMAGE_DIR / name
+        path.write_text(svg_from_dot(dot), encoding="utf-8")
+        written.append(path)
+    return written
+
+
+def stale(root: Path | str = ".") -> list[str]:
+    """Files :func:`export` would write differently (pictures: by the hash of their DOT source)."""
+    root = Path(root)
+    text, dots = render()
+    page = root / PAGE
+    out = [] if page.is_file() and page.read_text(encoding="utf-8") == text else [str(page)]
+    for name, dot in dots.items():
+        path = root / IMAGE_DIR / name
+        if not path.is_file() or svg_dot_sha256(path.read_text(encoding="utf-8")) != dot_sha256(dot):
+            out.append(str(path))
+    return out

@@ -26,9 +26,9 @@ def test_docs_check_covers_charts_and_the_page(capsys):
 def test_an_edited_page_or_a_picture_of_other_code_is_stale(tmp_path):
     written = document.export(tmp_path)
     assert [p.relative_to(tmp_path).as_posix() for p in written] == [
-        "docs/architecture.md", "docs/img/architecture_layers.svg"]
+        "docs/architecture.md", "docs/img/architecture_layers.svg", "docs/img/architecture_control_step.svg"]
     assert document.stale(tmp_path) == []
-    page, svg = written
+    page, svg, _ = written
     page.write_text(page.read_text(encoding="utf-8").replace("| **twin** |", "| **Twin** |"), encoding="utf-8")
     text = svg.read_text(encoding="utf-8")
     svg.write_text(text.replace(svg_dot_sha256(text) or "", "0" * 64), encoding="utf-8")

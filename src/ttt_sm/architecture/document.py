@@ -15,7 +15,11 @@ Graphviz version.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import ast
+import functools
+import inspect
+import textwrap
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -49,7 +53,8 @@ Section = Callable[[Pictures], str]
 
 
 def _quote(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    """A DOT string; a ``\\n`` in ``text`` stays DOT's line break."""
+    return '"' + text.replace('"', '\\"') + '"'
 
 
 def layers_dot(graph: ImportGraph) -> str:
@@ -133,15 +138,165 @@ subcommand modules importing only `cli.common` from it.
 """
 
 
+@dataclass(frozen=True)
+class StageFacts:
+    """What one stage of the control step is and touches, read from its class."""
+
+    name: str
+    kind: str  # "task" or "joint"
+    doc: str
+    reads: tuple[str, ...]  # Signals fields
+    writes: tuple[str, ...]
+    arm: tuple[str, ...]  # Arm members
+    truth: bool  # reads the simulation's ground truth
+
+
+def _first_line(obj: object) -> str:
+    return (inspect.getdoc(obj) or "").strip().splitlines()[0] if inspect.getdoc(obj) else ""
+
+
+def arm_members() -> list[str]:
+    """The members of the :class:`~ttt_sm.arm.Arm` protocol, in declaration order."""
+    from ..arm import Arm
+
+    names = list(getattr(Arm, "__annotations__", {}))
+    names += [n for n in vars(Arm) if not n.startswith("_") and n not in names]
+    return names
+
+
+def _arm_uses(tree: ast.AST, members: set[str]) -> set[str]:
+    """Arm members used as ``arm.<m>`` or ``<x>.arm.<m>``."""
+    used = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and node.attr in members:
+            owner = node.value
+            name = owner.id if isinstance(owner, ast.Name) else owner.attr if isinstance(owner, ast.Attribute) else ""
+            if name == "arm":
+                used.add(node.attr)
+    return used
+
+
+def _stage_facts(stage: object, kind: str, members: set[str]) -> StageFacts:
+    cls = type(stage)
+    owner = next(c for c in cls.__mro__ if "tick" in vars(c))  # the class that defines tick
+    tree = ast.parse(textwrap.dedent(inspect.getsource(owner)))
+    reads: set[str] = set()
+    writes: set[str] = set()
+    tick = next(n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) and n.name == "tick")
+    signals = tick.args.args[1].arg
+    for node in ast.walk(tick):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == signals:
+            (writes if isinstance(node.ctx, ast.Store) else reads).add(node.attr)
+    truth = any(isinstance(n, ast.Attribute) and n.attr == "truth" for n in ast.walk(tree))
+    order = {m: k for k, m in enumerate(sorted(members))}
+    return StageFacts(cls.__name__, kind, _first_line(cls), tuple(sorted(reads)), tuple(sorted(writes)),
+                      tuple(sorted(_arm_uses(tree, members), key=order.__getitem__)), truth)
+
+
+@functools.cache
+def control_step_facts() -> tuple[int, tuple[StageFacts, ...], dict[str, tuple[str, ...]]]:
+    """The default robot's chart divider, its stages in order, and who uses each Arm member.
+
+    Built from a real :class:`~ttt_sm.app.robot.Robot` (the stages the
+    application plugs into the scheduler) and an ``ast`` scan of the modules
+    that import the Arm protocol.
+    """
+    from ..app.robot import Robot
+    from ..params import load_params
+
+    members = set(arm_members())
+    robot = Robot(load_params())
+    stages = tuple([_stage_facts(s, "task", members) for s in robot.sched.task_stages]
+                   + [_stage_facts(s, "joint", members) for s in robot.sched.joint_stages])
+    graph = scan()
+    users: dict[str, set[str]] = {m: set() for m in members}
+    for module in sorted(graph.modules):
+        if any(t == "ttt_sm.arm" or t.startswith("ttt_sm.arm.") for t in graph.targets(module)):
+            tree = ast.parse(graph.modules[module].read_text(encoding="utf-8"))
+            for m in _arm_uses(tree, members):
+                users[m].add(module.removeprefix("ttt_sm."))
+    return robot.sched.divider, stages, {m: tuple(sorted(u)) for m, u in users.items()}
+
+
+def control_step_dot(divider: int, stages: Sequence[StageFacts]) -> str:
+    """One control step as a flow: the scheduler's fixed parts around the stages the application plugs in."""
+    def node(name: str, label: str, fill: str) -> str:
+        return f'  {_quote(name)} [label={_quote(label)}, fillcolor="{fill}"];'
+
+    def stage_label(st: StageFacts) -> str:
+        arm = "\\n".join(f"arm.{m}" for m in st.arm)
+        out = f"\\nsets {', '.join(st.writes)}" if st.writes else ""
+        extra = "\\nreads ground truth\\n(simulation only)" if st.truth else ""
+        return f"{st.name}\\n({st.kind} stage){out}" + (f"\\n{arm}" if arm else "") + extra
+
+    lines = ["digraph step {", "  rankdir=LR; nodesep=0.3; ranksep=0.35;",
+             '  node [shape=box, style="rounded,filled", fontname="Helvetica", fontsize=10];',
+             '  edge [color="#556b8d", arrowsize=0.6, fontname="Helvetica", fontsize=9];']
+    chain = ["start"]
+    lines.append(node("start", f"chart step\\n(1 control step in {divider})\\nsignals.t = arm.t", "#e8eef7"))
+    for st in [s for s in stages if s.kind == "task"]:
+        lines.append(node(st.name, stage_label(st), "#fdf3dc"))
+        chain.append(st.name)
+    lines.append(node("ik", "inverse kinematics\\ntask -> q_des\\n(IKSolver.solve_pose;\\nholds on failure)",
+                      "#e8eef7"))
+    chain.append("ik")
+    for st in [s for s in stages if s.kind == "joint"]:
+        lines.append(node(st.name, stage_label(st), "#fdf3dc"))
+        chain.append(st.name)
+    lines.append(node("clamp", "clamp q_set to the\\njoint limits of\\nhomed drives", "#e8eef7"))
+    lines.append(node("set", "arm.set_setpoints\\n(q_set, fr_sw)", "#e3f1e3"))
+    lines.append(node("step", f"arm.step(1) x {divider}\\nfilters, cascade control,\\nplant (or the hardware)",
+                      "#e3f1e3"))
+    chain += ["clamp", "set", "step"]
+    for a, b in zip(chain, chain[1:], strict=False):
+        lines.append(f"  {_quote(a)} -> {_quote(b)};")
+    lines.append('  "step" -> "start" [style=dashed, label="next chart step", constraint=false];')
+    lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
 def control_step_section(pictures: Pictures) -> str:
-    """One control step through the ``Arm`` interface (placeholder until the Arm protocol lands)."""
-    del pictures
-    return """## One control step
+    """One control step through the ``Arm`` interface: the scheduler's stages and the protocol's members."""
+    from ..arm import Arm
 
-<!-- placeholder: this section is to be generated from the scheduler's stages and the Arm
-protocol's methods (ttt_sm.sched.scheduler, ttt_sm.arm) once the Arm protocol is on main -->
+    divider, stages, users = control_step_facts()
+    picture = pictures.add("control_step", control_step_dot(divider, stages), "one control step")
+    stage_rows = ["| order | stage | kind | reads | sets | Arm members | what it is |", "|---|---|---|---|---|---|---|"]
+    for k, st in enumerate(stages, 1):
+        arm = ", ".join(f"`{m}`" for m in st.arm) or "—"
+        if st.truth:
+            arm += " (and the simulation's ground truth)"
+        stage_rows.append(f"| {k} | `{st.name}` | {st.kind} | {', '.join(st.reads) or '—'} | "
+                          f"{', '.join(st.writes) or '—'} | {arm} | {st.doc} |")
+    arm_rows = ["| member | what it is | used by |", "|---|---|---|"]
+    for m in arm_members():
+        doc = _first_line(getattr(Arm, m)) if m in vars(Arm) else "The control step, s."
+        who = ", ".join(f"`{u}`" for u in users.get(m, ())) or "— (not called by the package's code)"
+        arm_rows.append(f"| `{m}` | {doc} | {who} |")
+    return f"""## One control step
 
-*To be generated: one control step's data flow through the `Arm` interface.*
+The scheduler (`ttt_sm.sched.scheduler.Scheduler`) drives an arm through
+the `Arm` protocol (`ttt_sm.arm`): the simulated arm (`ArmSim`) or, one
+day, a hardware backend. It never reads the simulation's ground truth; a
+stage that needs it (the whiteboard's ink) gets it from the application,
+apart from the protocol. Every `chart_divider`-th control step is a chart
+step: the task stages produce the tool pose, inverse kinematics turns it into
+joint setpoints, the joint stages pass or replace them, the setpoints are
+clamped to the joint limits and go to the arm; then the arm advances one
+control step (its setpoint filters, cascade controllers and plant, or the
+microcontroller).
+
+{picture}
+
+*Drawn from the stages the application plugs into the scheduler (a default
+`ttt_sm.app.robot.Robot`) and what their code reads and sets of the
+signals and calls of the arm.*
+
+{chr(10).join(stage_rows)}
+
+The `Arm` protocol, and which modules use each member:
+
+{chr(10).join(arm_rows)}
 """
 
 

@@ -1,4 +1,4 @@
-"""The control step of DESIGN.md, run on a clock.
+"""One control step, run on a clock (drawn in docs/architecture.md, "One control step").
 
 One control step: read the sensors; every `chart_divider`-th step tick the
 chart stages (task stages produce the tool pose, inverse kinematics turns it
@@ -120,7 +120,7 @@ class Record:
 
 
 class Scheduler:
-    """Runs the control step of DESIGN.md on a virtual or wall clock.
+    """Runs the control step (docs/architecture.md) on a virtual or wall clock.
 
     Parameters
     ----------

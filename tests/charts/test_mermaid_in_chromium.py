@@ -66,6 +66,33 @@ def test_every_state_is_drawn_titled_with_its_name(chart, rendered):
     assert _missing_names(structure_of(chart), drawn) == []
 
 
+def _inside(inner: dict[str, float], outer: dict[str, float]) -> bool:
+    return (inner["left"] >= outer["left"] and inner["right"] <= outer["right"]
+            and inner["top"] >= outer["top"] and inner["bottom"] <= outer["bottom"])
+
+
+@pytest.mark.parametrize("chart", ALL_CHARTS, ids=lambda c: c.__name__)
+def test_every_state_is_drawn_inside_its_compound_state_and_no_other(chart, rendered):
+    # Mermaid draws a state in the composite block of the last transition naming it:
+    # a state drawn outside its compound would tell a reader the wrong story.
+    structure = structure_of(chart)
+    boxes = {_words(box["texts"][0]): box for d in rendered[chart.__name__] if "error" not in d
+             for box in d["boxes"] if box["texts"] and box["kind"] != "note"}
+    composites = {s.id: boxes[s.label]["rect"] for s in structure.states if s.is_compound}
+    misplaced = []
+    for s in structure.states:
+        if s.history:
+            continue  # titled H or H*, not by a unique name
+        inside = {c for c, rect in composites.items() if c != s.id and _inside(boxes[s.label]["rect"], rect)}
+        ancestors, node = set(), s.parent
+        while node is not None:
+            ancestors.add(node)
+            node = structure.state(node).parent
+        if inside != ancestors:
+            misplaced.append(f"{s.id}: drawn in {sorted(inside)}, belongs in {sorted(ancestors)}")
+    assert misplaced == []
+
+
 @pytest.mark.parametrize("chart", ALL_CHARTS, ids=lambda c: c.__name__)
 def test_every_guard_and_event_is_drawn(chart, rendered):
     drawn = [d for d in rendered[chart.__name__] if "error" not in d]
@@ -93,3 +120,20 @@ def test_the_check_sees_names_replaced_by_actions_and_syntax_errors(mermaid):
     titles = [box["texts"][0] for box in drawn_old["boxes"] if box["texts"]]
     assert "entry / on_enter_turn_fwd" in titles and "turn_fwd" not in titles
     assert "error" in drawn_broken and "Parse error" in drawn_broken["error"]
+
+
+def test_the_tutorials_first_step_can_be_done_on_the_rendered_page(rendered):
+    tutorial = (REPO / "docs" / "tutorial.md").read_text()
+    step = tutorial[tutorial.index("## 1."):tutorial.index("## 2.")]
+    drawn = rendered["DriveInit1"]
+    boxes = {_words(box["texts"][0]): box for d in drawn for box in d["boxes"] if box["texts"]}
+    nesting = re.search(r"the compound state `(\w+)` holding\s+`(\w+)`, which holds (.*?);", step, re.S)
+    assert nesting, "the tutorial's first step no longer names the nesting"
+    outer, inner, held = nesting.group(1), nesting.group(2), re.findall(r"`(\w+)`", nesting.group(3))
+    assert held == ["power_on", "turn_fwd", "turn_back", "go_park", "wait_23"]
+    assert _inside(boxes[inner]["rect"], boxes[outer]["rect"])
+    assert all(_inside(boxes[name]["rect"], boxes[inner]["rect"]) for name in held)
+    edge = re.search(r"the edge `(\w+) --> (\w+) : ([^`]+)`", step)
+    assert edge and edge.group(3) in [_words(text) for d in drawn for text in d["edgeLabels"]]
+    assert "during_turn_fwd" in step
+    assert boxes["turn_fwd"]["texts"][1:] == ["entry / on_enter_turn_fwd\nduring / during_turn_fwd"]

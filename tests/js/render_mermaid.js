@@ -4,8 +4,10 @@
 // `await renderMermaid(["stateDiagram-v2 ...", ...])` returns, per diagram, either
 // {error: "Parse error on line 3 ..."} or {boxes, edgeLabels}: `boxes` are the drawn
 // states, composite states and notes, each with its label lines in drawing order
-// (a state's title first); `edgeLabels` are the texts drawn on transitions.  Only
-// text with a size on the page counts: what Mermaid laid out but did not draw is left out.
+// (a state's title first) and its rectangle on the page (`rect`: left, top, right,
+// bottom), so that a test can tell which composite state a box is drawn in;
+// `edgeLabels` are the texts drawn on transitions.  Only text with a size on the page
+// counts: what Mermaid laid out but did not draw is left out.
 
 function drawnTexts(root) {
   const texts = [];
@@ -18,6 +20,13 @@ function drawnTexts(root) {
     if (text.trim()) texts.push(text.trim());
   }
   return texts;
+}
+
+function rectOf(element) {
+  const outline = element.classList.contains("statediagram-cluster")
+    ? element.querySelector("rect.outer") || element : element;
+  const { left, top, right, bottom } = outline.getBoundingClientRect();
+  return { left, top, right, bottom };
 }
 
 function boxKind(element) {
@@ -43,6 +52,7 @@ window.renderMermaid = async function renderMermaid(diagrams) {
     const boxes = [...host.querySelectorAll("g.node, g.statediagram-cluster")].map((element) => ({
       kind: boxKind(element),
       id: element.getAttribute("data-id") || element.id,
+      rect: rectOf(element),
       texts: drawnTexts(element.classList.contains("statediagram-cluster")
         ? element.querySelector(".cluster-label") || element : element),
     }));

@@ -1,18 +1,19 @@
-"""Diagram text of a chart: Graphviz DOT, Mermaid and a Markdown page.
+"""Diagram text of a chart: Mermaid, a Markdown page, and what every diagram shares.
 
 Drawn from the chart's :class:`~.structure.ChartStructure`, not from the
 library's renderers, so that
 
-* compound states are nested clusters, tick transitions show their Stateflow
-  priority, guards and actions sit on the edges, and entry/during/exit actions
-  are listed inside the states;
-* the text is a pure function of the chart class (and, for :func:`to_dot` /
-  :func:`to_mermaid` with ``active``, of the active states): byte-identical on
-  every export, so a test can tell a stale ``charts/`` folder.
+* compound states are nested, tick transitions show their Stateflow priority,
+  guards and actions sit on the edges, and entry/during/exit actions are listed
+  inside the states (Graphviz pictures: :mod:`.dot`);
+* the text is a pure function of the chart class (and, for :func:`to_mermaid`
+  with ``active``, of the active states): byte-identical on every export, so a
+  test can tell a stale ``charts/`` folder.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from statemachine import StateChart
@@ -80,7 +81,7 @@ def edge_text(t: TransitionInfo, structure: ChartStructure) -> tuple[str, str]:
     return first, action
 
 
-def _is_within(structure: ChartStructure, state: str, ancestor: str) -> bool:
+def is_within(structure: ChartStructure, state: str, ancestor: str) -> bool:
     """Whether ``state`` is ``ancestor`` or one of its descendants."""
     parents = {s.id: s.parent for s in structure.states}
     node: str | None = state
@@ -89,113 +90,6 @@ def _is_within(structure: ChartStructure, state: str, ancestor: str) -> bool:
             return True
         node = parents[node]
     return False
-
-
-# -- DOT ---------------------------------------------------------------------
-
-
-def _q(text: str) -> str:
-    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
-    return '"' + escaped + '"'
-
-
-def _html(text: str) -> str:
-    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
-
-
-def _html_label(title: str, lines: list[str]) -> str:
-    if not lines:
-        return f"<<b>{_html(title)}</b>>"
-    body = "<br/>".join(_html(line) for line in lines)
-    return (
-        '<<table border="0" cellborder="0" cellspacing="0" cellpadding="2">'
-        f"<tr><td><b>{_html(title)}</b></td></tr><hr/>"
-        f'<tr><td align="left" balign="left">{body}</td></tr></table>>'
-    )
-
-
-def to_dot(chart: StateChart | type[StateChart], active: set[str] | None = None) -> str:
-    """Graphviz DOT of a chart, compound states as nested clusters.
-
-    Parameters
-    ----------
-    chart : TickChart class or instance
-    active : set of str, optional
-        Ids of states to highlight (see :func:`active_ids`).
-    """
-    structure = structure_of(chart)
-    active = active or set()
-    by_id = {s.id: s for s in structure.states}
-    out = [
-        f"digraph {_q(structure.name)} {{",
-        f'  graph [label=<<b>{_html(structure.name)}</b>>, labelloc="t", fontname={_q(FONT)},'
-        ' fontsize="12", rankdir="LR", compound="true", nodesep="0.35", ranksep="0.45"];',
-        f'  node [fontname={_q(FONT)}, fontsize="10", shape="box", style="rounded,filled",'
-        ' fillcolor="white", penwidth="1.5"];',
-        f'  edge [fontname={_q(FONT)}, fontsize="9"];',
-    ]
-
-    def head(state_id: str) -> str:
-        # An edge into a compound from outside ends at its initial dot, clipped at the
-        # cluster border: the arrow then meets the cluster where its story starts.
-        state = by_id[state_id]
-        return f"{state_id}__start" if state.is_compound and not state.parallel else state_id
-
-    def emit(states: list[StateInfo], indent: str, parent: StateInfo | None) -> None:
-        if parent is None or not parent.parallel:
-            initial = next((s for s in states if s.initial), None)
-            if initial is not None:
-                start = f"{parent.id}__start" if parent else "__start__"
-                out.append(f'{indent}{_q(start)} [shape="point", width="0.12", fillcolor="black", label=""];')
-                lhead = f', lhead={_q("cluster_" + initial.id)}' if initial.is_compound else ""
-                out.append(f"{indent}{_q(start)} -> {_q(head(initial.id))} [weight=\"10\"{lhead}];")
-        for state in states:
-            is_active = state.id in active
-            if state.is_compound:
-                style = "rounded,dashed" if parent is not None and parent.parallel else "rounded"
-                attrs = [f"label={_html_label(state.label, state_actions(state))}",
-                         f"style={_q(style + (',filled' if is_active else ''))}"]
-                if is_active:
-                    attrs += [f'fillcolor="{ACTIVE_CLUSTER_FILL}"', 'penwidth="2.5"']
-                out.append(f"{indent}subgraph {_q('cluster_' + state.id)} {{")
-                out.extend(f"{indent}  {a};" for a in attrs)
-                # Invisible anchor: edges to and from the compound start or end here.
-                out.append(f'{indent}  {_q(state.id)} [shape="point", style="invis", width="0",'
-                           ' height="0", label=""];')
-                emit([by_id[c] for c in state.children], indent + "  ", state)
-                out.append(f"{indent}}}")
-            elif state.history:
-                out.append(f'{indent}{_q(state.id)} [label={_q(state.label)}, shape="circle",'
-                           ' width="0.3", fixedsize="true"];')
-            else:
-                attrs = [f"label={_html_label(state.label, state_actions(state))}"]
-                if state.final:
-                    attrs.append('peripheries="2"')
-                if is_active:
-                    attrs += [f'fillcolor="{ACTIVE_FILL}"', 'penwidth="2.5"']
-                out.append(f"{indent}{_q(state.id)} [{', '.join(attrs)}];")
-
-    emit([s for s in structure.states if s.parent is None], "  ", None)
-    for t in structure.transitions:
-        first, action = edge_text(t, structure)
-        label = "\n".join(p for p in (first, action) if p)
-        target = t.target or t.source
-        attrs = [f"label={_q(label)}"] if label else []
-        head_node = target
-        if by_id[t.source].is_compound and not _is_within(structure, target, t.source):
-            attrs.append(f"ltail={_q('cluster_' + t.source)}")
-        if by_id[target].is_compound and not _is_within(structure, t.source, target):
-            attrs.append(f"lhead={_q('cluster_' + target)}")
-            head_node = head(target)
-        if t.kind == "tick":
-            attrs.append('style="solid"')
-        else:
-            attrs.append('color="#1f4e9c", fontcolor="#1f4e9c"')
-        if t.target is None:
-            attrs.append('arrowhead="none"')
-        out.append(f"  {_q(t.source)} -> {_q(head_node)} [{', '.join(attrs)}];")
-    out.append("}")
-    return "\n".join(out) + "\n"
 
 
 # -- Mermaid -------------------------------------------------------------------
@@ -208,19 +102,15 @@ def _m(text: str) -> str:
 
 
 def _scope(structure: ChartStructure, t: TransitionInfo) -> str | None:
-    """The innermost compound holding both ends of a transition strictly inside it."""
+    """The compound whose block a transition is written in: its states' common parent.
+
+    A transition written inside ``state X { }`` makes Mermaid draw both its states in
+    X: one between states of different parents (``wait_23 --> pass_pos``) is written at
+    the top level, where it moves no state.
+    """
     parents = {s.id: s.parent for s in structure.states}
-    target = t.target or t.source
-
-    def ancestors(state: str) -> list[str]:
-        chain, node = [], parents[state]
-        while node is not None:
-            chain.append(node)
-            node = parents[node]
-        return chain
-
-    of_target = set(ancestors(target))
-    return next((a for a in ancestors(t.source) if a in of_target), None)
+    source, target = parents[t.source], parents[t.target or t.source]
+    return source if source == target else None
 
 
 def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = None) -> str:
@@ -231,7 +121,9 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
     scoped: dict[str | None, list[TransitionInfo]] = {}
     for t in structure.transitions:
         scoped.setdefault(_scope(structure, t), []).append(t)
-    out = ["stateDiagram-v2", "    direction LR"]
+    # As the Graphviz pictures: a chart with sub-charts reads top down, others left to right.
+    has_subcharts = any(s.parent is None and s.is_compound for s in structure.states)
+    out = ["stateDiagram-v2", f"    direction {'TB' if has_subcharts else 'LR'}"]
     notes: list[str] = []
 
     def edges(scope: str | None, indent: str) -> None:
@@ -292,16 +184,42 @@ def _cell(value: Any) -> str:
     return text if text else "—"
 
 
-def to_markdown(chart: StateChart | type[StateChart]) -> str:
-    """A Markdown page: Mermaid diagram, data, states and transitions tables."""
+#: Under each Mermaid diagram: how to read it (Mermaid draws no legend of its own).
+MERMAID_LEGEND = (
+    "How to read it: a box is titled with the state's name; under it, its actions"
+    " (`entry /` runs when the state is entered, `during /` on every chart tick in which"
+    " the chart takes no transition, `exit /` when it is left) and the events it handles"
+    " without leaving (`button / ignore_button`). Notes beside compound states list theirs."
+    " An edge reads `event [guard] / action`: an edge with no event is a tick transition,"
+    " tried on every chart tick and taken when its guard holds; `2:` is the order in which"
+    " a state's tick transitions are tried, 1 first. `H` / `H*`: history (the sub-state"
+    " active when the compound was left; `H*` at every depth)."
+)
+
+
+def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[str, str]] = ()) -> str:
+    """A Markdown page: pictures, Mermaid diagram, data, states and transitions tables.
+
+    ``pictures`` are the chart's Graphviz pictures as (what it shows, file name),
+    the first the one to see first: with more than one, it is embedded in the page
+    and all are linked.
+    """
     structure = structure_of(chart)
     cls = chart_class(chart)
     out = [f"# {structure.name}", ""]
     if structure.doc:
         out += [line.strip() if i else line for i, line in enumerate(structure.doc.splitlines())]
         out.append("")
-    out += ["<!-- generated by ttt_sm.runtime.export; do not edit -->", "",
-            "```mermaid", to_mermaid(cls).rstrip("\n"), "```", ""]
+    out += ["<!-- generated by ttt_sm.runtime.export; do not edit -->", ""]
+    if len(pictures) > 1:
+        caption, first = pictures[0]
+        out += ["## Pictures", "", f"![{structure.name}: {caption}]({first})", ""]
+        out += [f"- [{caption}]({name})" for caption, name in pictures]
+        out.append("")
+    elif pictures:
+        out += [f"Picture with a legend: [{pictures[0][1]}]({pictures[0][1]}).", ""]
+    out += ["## Diagram", "",
+            "```mermaid", to_mermaid(cls).rstrip("\n"), "```", "", MERMAID_LEGEND, ""]
     decls = cls.declarations() if hasattr(cls, "declarations") else ()
     out += ["## Data", ""]
     if decls:

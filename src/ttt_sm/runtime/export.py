@@ -1,8 +1,10 @@
 """Write chart diagrams to files and tell when a diagrams folder is stale.
 
-For each chart ``<Name>``: ``<Name>.dot`` (Graphviz source), ``<Name>.svg`` and
-``<Name>.png`` (rendered by Graphviz ``dot``) and ``<Name>.md`` (Mermaid diagram
-and the data/state/transition tables); :func:`export_all` adds ``index.md``.
+For each chart ``<Name>`` and each of its pictures (:func:`~.dot.views`: the whole
+chart ``<Name>``; with sub-charts also ``<Name>.overview`` and one
+``<Name>.<sub-chart>`` each): ``.dot`` (Graphviz source), ``.svg`` and ``.png``
+(rendered by Graphviz ``dot``); and ``<Name>.md`` (the pictures, the Mermaid
+diagram and the data/state/transition tables); :func:`export_all` adds ``index.md``.
 
 Text files are byte-identical on re-export.  Rendered files depend on the
 installed Graphviz version, so they carry the SHA-256 of the DOT source they were
@@ -21,11 +23,13 @@ import struct
 import subprocess
 import zlib
 from collections.abc import Callable, Iterable, Sequence
+from functools import partial
 from pathlib import Path
 
 from statemachine import StateChart
 
-from .diagram import active_ids, chart_class, to_dot, to_markdown, to_mermaid
+from .diagram import active_ids, chart_class, to_markdown, to_mermaid
+from .dot import WHOLE, View, to_dot, views
 from .errors import GraphvizMissingError
 
 Chart = StateChart | type[StateChart]
@@ -73,6 +77,10 @@ def svg_from_dot(dot_source: str) -> str:
     return svg[:head] + stamp + svg[head:] if head >= 0 else stamp + svg
 
 
+def _svg_bytes(dot_source: str) -> bytes:
+    return svg_from_dot(dot_source).encode("utf-8")
+
+
 def png_from_dot(dot_source: str) -> bytes:
     """PNG bytes with a ``tEXt`` chunk holding the DOT source's hash."""
     return _png_with_text(run_dot(dot_source, "png"), _HASH_KEY, _sha(dot_source))
@@ -101,15 +109,17 @@ def _png_text(png: bytes, key: str) -> str | None:
     return None
 
 
-def render_active(chart: StateChart, fmt: str = "svg") -> str | bytes:
+def render_active(chart: StateChart, fmt: str = "svg", view: View = WHOLE) -> str | bytes:
     """The chart's diagram with its active states highlighted, now.
 
-    ``fmt`` is ``"dot"``, ``"mermaid"`` or ``"svg"`` (text) or ``"png"`` (bytes).
+    ``fmt`` is ``"dot"``, ``"mermaid"`` or ``"svg"`` (text) or ``"png"`` (bytes);
+    ``view`` one of :func:`~.dot.views` (Graphviz formats; a closed sub-chart is
+    highlighted while a state inside it is active).
     """
     active = active_ids(chart)
     if fmt == "mermaid":
         return to_mermaid(chart, active)
-    dot_source = to_dot(chart, active)
+    dot_source = to_dot(chart, active, view)
     if fmt == "dot":
         return dot_source
     if fmt == "svg":
@@ -125,29 +135,60 @@ def _check_formats(formats: Sequence[str]) -> None:
         raise ValueError(f"unknown diagram formats {unknown}; use some of {list(FORMATS)}")
 
 
+def _caption(view: View, only: bool) -> str:
+    if view.root is not None:
+        return f"sub-chart {view.root}"
+    if view.closed:
+        return "overview, sub-charts closed"
+    return "the whole chart" if only else "the whole chart, nested"
+
+
+def pictures(chart: Chart) -> list[tuple[str, str]]:
+    """The chart's SVG pictures as (what it shows, file name), the overview first."""
+    cls = chart_class(chart)
+    chart_views = views(cls)
+    return [(_caption(v, len(chart_views) == 1), v.file_stem(cls.__name__) + ".svg") for v in chart_views]
+
+
 def _expected(chart: Chart, formats: Sequence[str]) -> dict[str, tuple[str, Callable[[], bytes]]]:
     """File name -> (DOT hash or '' for text files, producer of the file's bytes)."""
     cls = chart_class(chart)
-    dot_source = to_dot(cls)
-    dot_hash = _sha(dot_source)
+    expected: dict[str, tuple[str, Callable[[], bytes]]] = {}
+    if "mermaid" in formats:
+        shown = pictures(cls) if "svg" in formats else []
+        expected[cls.__name__ + _SUFFIX["mermaid"]] = ("", lambda: to_markdown(cls, shown).encode("utf-8"))
+    for view in views(cls):
+        dot_source = to_dot(cls, view=view)
+        dot_hash = _sha(dot_source)
+        producers: dict[str, tuple[str, Callable[[], bytes]]] = {
+            "dot": ("", partial(str.encode, dot_source, "utf-8")),
+            "svg": (dot_hash, partial(_svg_bytes, dot_source)),
+            "png": (dot_hash, partial(png_from_dot, dot_source)),
+        }
+        for fmt in formats:
+            if fmt in producers:
+                expected[view.file_stem(cls.__name__) + _SUFFIX[fmt]] = producers[fmt]
+    return expected
 
-    def dot_bytes() -> bytes:
-        return dot_source.encode("utf-8")
 
-    def md_bytes() -> bytes:
-        return to_markdown(cls).encode("utf-8")
+def leftover_files(chart: Chart, out_dir: str | Path, formats: Sequence[str] = FORMATS) -> list[Path]:
+    """Pictures of a chart in ``out_dir`` that it no longer has (a sub-chart renamed or gone).
 
-    def svg_bytes() -> bytes:
-        return svg_from_dot(dot_source).encode("utf-8")
-
-    def png_bytes() -> bytes:
-        return png_from_dot(dot_source)
-
-    producers: dict[str, tuple[str, Callable[[], bytes]]] = {
-        "dot": ("", dot_bytes), "mermaid": ("", md_bytes),
-        "svg": (dot_hash, svg_bytes), "png": (dot_hash, png_bytes),
-    }
-    return {cls.__name__ + _SUFFIX[fmt]: producers[fmt] for fmt in formats}
+    Only ``<Name>.<part>.<svg|png|dot>`` files of the given formats count: nothing
+    else in the folder is touched.
+    """
+    cls = chart_class(chart)
+    expected = _expected(cls, formats)
+    out = Path(out_dir)
+    found: list[Path] = []
+    for fmt in formats:
+        if fmt == "mermaid" or not out.is_dir():
+            continue
+        for path in out.glob(f"{cls.__name__}.*{_SUFFIX[fmt]}"):
+            part = path.name[len(cls.__name__) + 1:-len(_SUFFIX[fmt])]
+            if part and "." not in part and path.name not in expected:
+                found.append(path)
+    return sorted(found)
 
 
 def export_chart(chart: Chart, out_dir: str | Path, formats: Sequence[str] = FORMATS) -> list[Path]:
@@ -163,6 +204,8 @@ def export_chart(chart: Chart, out_dir: str | Path, formats: Sequence[str] = FOR
     _check_formats(formats)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    for path in leftover_files(chart, out, formats):
+        path.unlink()
     written = []
     for name, (_hash, produce) in _expected(chart, formats).items():
         path = out / name
@@ -172,14 +215,19 @@ def export_chart(chart: Chart, out_dir: str | Path, formats: Sequence[str] = FOR
 
 
 def index_page(charts: Iterable[Chart], formats: Sequence[str] = FORMATS) -> str:
-    """``index.md``: one line per chart linking its page and pictures."""
+    """``index.md``: one entry per chart linking its page and its pictures, overview first."""
     lines = ["# Charts", "", "<!-- generated by ttt_sm.runtime.export; do not edit -->", ""]
+    pictured = [fmt for fmt in formats if fmt != "mermaid"]
     for chart in charts:
         cls = chart_class(chart)
         first = (cls.__doc__ or "").strip().splitlines()
-        links = [f"[{fmt}]({cls.__name__}{_SUFFIX[fmt]})" for fmt in formats if fmt != "mermaid"]
         page = f"[{cls.__name__}]({cls.__name__}.md)" if "mermaid" in formats else cls.__name__
-        lines.append(f"- {page} {' '.join(links)}{' — ' + first[0] if first else ''}")
+        lines.append(f"- {page}{' — ' + first[0] if first else ''}")
+        for view in views(cls):
+            stem = view.file_stem(cls.__name__)
+            links = " ".join(f"[{fmt}]({stem}{_SUFFIX[fmt]})" for fmt in pictured)
+            if links:
+                lines.append(f"  - {_caption(view, len(views(cls)) == 1)}: {links}")
     return "\n".join(lines) + "\n"
 
 
@@ -195,7 +243,8 @@ def export_all(charts: Iterable[Chart], out_dir: str | Path, formats: Sequence[s
 
 
 def stale_files(charts: Iterable[Chart], out_dir: str | Path, formats: Sequence[str] = FORMATS) -> list[str]:
-    """Files of ``out_dir`` that :func:`export_all` would write differently, or are missing.
+    """Files of ``out_dir`` that :func:`export_all` would write differently, are missing,
+    or would remove (:func:`leftover_files`).
 
     Text files are compared byte for byte; SVG/PNG by the DOT hash they carry, so
     the check needs no Graphviz.  Returns paths as strings, sorted.
@@ -220,6 +269,7 @@ def stale_files(charts: Iterable[Chart], out_dir: str | Path, formats: Sequence[
                     stale.append(str(path))
             elif path.read_bytes() != produce():
                 stale.append(str(path))
+        stale += [str(path) for path in leftover_files(chart, out, formats)]
     index = out / "index.md"
     if not index.is_file() or index.read_text(encoding="utf-8") != index_page(charts, formats):
         stale.append(str(index))

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from ttt_sm.app.control_wiring import make_control_chart
-from ttt_sm.charts.control import CHART_PERIOD_S, Control
+from ttt_sm.charts.control import Control
 from ttt_sm.params import load_params
 
 P = load_params()
@@ -66,7 +66,7 @@ def ideal_tick(c: Control, log: Log | None = None) -> None:
 
 
 def run_until(c: Control, predicate, log: Log | None = None, max_s: float = 200.0) -> None:
-    for _ in range(int(max_s / CHART_PERIOD_S)):
+    for _ in range(int(max_s / P.control.chart_dt)):
         if predicate():
             return
         ideal_tick(c, log)
@@ -90,7 +90,7 @@ def with_field(speed: float = 0.1) -> Control:
     """Waiting in wait_1 with the field drawn: started there (``start_value``), inputs set by hand."""
     app = make_control_chart(P)
     local = {d.name: getattr(app, d.name) for d in Control.declarations() if d.kind == "local"}
-    c = Control(tick_period_s=CHART_PERIOD_S, data=local, start_value="wait_1")
+    c = Control(tick_period_s=P.control.chart_dt, data=local, start_value="wait_1")
     c.x_start, c.y_start, c.z_start = START_POSE
     c.X_out, c.Y_out, c.Z_out = c.X_now, c.Y_now, c.Z_now = c.x_wait, c.y_wait, c.z_wait
     c.Pl_fld = c.initialised = True
@@ -179,7 +179,7 @@ def test_the_field_is_4_lines_parallel_to_x_and_4_parallel_to_y_15_cm_long_3_cm_
     # eq. 3.36: one coordinate changes by inc = speed * dt per tick, the other stays
     for run in lines:
         steps = np.hypot(*np.diff(run[:, :2], axis=0).T)
-        assert np.allclose(steps[:-1], c.speed * CHART_PERIOD_S)
+        assert np.allclose(steps[:-1], c.speed * P.control.chart_dt)
     # between lines the pen is lifted to z_up, and lowered again before the next
     assert len(log.points("field_pen_up")) == 8 and len(log.points("field_pen_down")) == 8
     for run in log.points("field_pen_up"):
@@ -228,7 +228,7 @@ def test_an_x_is_two_lines_at_45_and_135_degrees_in_the_right_cell(row, column):
         assert np.all((x0 < run[:, 0]) & (run[:, 0] < x1) & (y0 < run[:, 1]) & (run[:, 1] < y1))
         assert np.all(run[:, 2] == c.z_draw)
         # the pen moves at the drawing speed along the line
-        assert np.allclose(np.hypot(*np.diff(run[:, :2], axis=0).T)[:-1], c.speed * CHART_PERIOD_S)
+        assert np.allclose(np.hypot(*np.diff(run[:, :2], axis=0).T)[:-1], c.speed * P.control.chart_dt)
     cross_x = (c.h2 - c.h1) / 2
     assert cross_x == pytest.approx((x0 + x1) / 2) and cross_x + c.h1 == pytest.approx((y0 + y1) / 2)
     # the pen is lifted between the two lines
@@ -267,7 +267,7 @@ def test_an_o_is_four_arcs_each_a_bit_over_a_quarter_that_close_the_circle(row, 
         moving = arc[:, 0] if k in (1, 3) else arc[:, 1]
         assert np.all(np.diff(moving) > 0) if k in (1, 2) else np.all(np.diff(moving) < 0)
         # each arc goes on from where the last ended: no jump
-        assert np.hypot(*(arc[0, :2] - prev_end[:2])) < 1.01 * c.speed * CHART_PERIOD_S
+        assert np.hypot(*(arc[0, :2] - prev_end[:2])) < 1.01 * c.speed * P.control.chart_dt
         a = angles(np.vstack([prev_end[None, :], arc]), c.x0, c.y0)
         spans.append(a[-1] - a[0])
         prev_end = arc[-1]
@@ -325,7 +325,7 @@ def test_erasing_turns_the_sponge_down_and_wipes_the_field_in_passes_3_cm_apart(
         assert np.all(run[:, 0] == run[0, 0])  # along Y
         xs.append(run[0, 0])
         ys = run[:, 1]
-        assert min(ys) <= Y_MIN and max(ys) >= Y_MAX - c.wipe_speed * CHART_PERIOD_S  # the whole field's depth
+        assert min(ys) <= Y_MIN and max(ys) >= Y_MAX - c.wipe_speed * P.control.chart_dt  # the whole field's depth
     assert np.allclose(np.diff(xs), -0.03)
     # the strips the sponge wipes cover the field's width
     half = P.sponge.width / 2
@@ -338,14 +338,14 @@ def test_erasing_turns_the_sponge_down_and_wipes_the_field_in_passes_3_cm_apart(
 
 
 def test_erase_comes_before_the_field_and_the_field_before_the_persons_button():
-    c = Control(start_value="wait_1")
+    c = Control(tick_period_s=P.control.chart_dt, start_value="wait_1")
     c.X_out, c.Y_out, c.Z_out = c.x_wait, c.y_wait, c.z_wait
     c.erase = True
     c.symbol = 1
     c.post("button")
     c.tick()
     assert "Erase" in c.configuration_values and c.ignored_buttons == 1 and c.ctr == 0
-    c = Control(start_value="wait_1")
+    c = Control(tick_period_s=P.control.chart_dt, start_value="wait_1")
     c.X_out, c.Y_out, c.Z_out = c.x_wait, c.y_wait, c.z_wait
     c.post("button")
     c.post("draw_sine")

@@ -312,7 +312,7 @@ class GameSession:
     def _person_turn(self) -> bool:
         robot = self.robot
         robot.chart_step()  # the Game chart shows whose turn it is before the person is asked
-        self._run_until(lambda: True, 0.002, "showing the message")
+        self._run_until(lambda: True, self.params.control.chart_dt, "showing the message")
         cell = self.person.choose(self.truth, self.person_symbol)
         if cell is None:
             self.record.add(robot.t, "person_gave_up")

@@ -210,7 +210,8 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
     charts = make_init_charts(params)
     stage = DriveInitStage(params, sim, sched, charts)
     # Drive 1 may push its setpoint past a stop by its stall band (and one more step) to find it.
-    monitor = InitMonitor(params, sim, allowance_rad=charts[0].stall_lag + charts[0].inc)
+    one_step = charts[0].search_speed * params.control.chart_dt
+    monitor = InitMonitor(params, sim, allowance_rad=charts[0].stall_lag + one_step)
     sched.joint_stages = [stage, monitor]
     t0 = sim.t
     sched.run_until(lambda: stage.done or stage.failed, timeout_s)

@@ -41,14 +41,13 @@ from statemachine import State
 
 from ..runtime import Data, TickChart
 
-CHART_PERIOD_S = 0.002
-
 
 class Control(TickChart):
     """The Control block: start/stop, the field, X, O, a sine wave, erasing, finishing."""
 
-    tick_period_s = CHART_PERIOD_S
-    # for type checkers: data that actions update from their own previous value
+    timed = True  # speeds are per second: a step per tick is speed * tick_period_s
+    # for type checkers: data that actions update from their own previous value, and the period
+    tick_period_s: float
     ctr: int
     ignored_buttons: int
 
@@ -328,7 +327,7 @@ class Control(TickChart):
         """One increment of a straight move towards (tx, ty, tz) at `speed` (eq. 3.36)."""
         dx, dy, dz = self.tx - self.X_out_p, self.ty - self.Y_out_p, self.tz - self.Z_out_p
         dist = math.sqrt(dx * dx + dy * dy + dz * dz)
-        step = speed * CHART_PERIOD_S
+        step = speed * self.tick_period_s
         if dist <= step:
             self.X_out, self.Y_out, self.Z_out = self.tx, self.ty, self.tz
         else:
@@ -423,7 +422,7 @@ class Control(TickChart):
 
     def during_line_1(self) -> None:
         # eqs. 3.40-3.41: X decreases, Y follows the 45-degree line Y = X + h1
-        self.X_out = max(self.X_out_p - self.speed * CHART_PERIOD_S / math.sqrt(2), self.x_ini - self.size)
+        self.X_out = max(self.X_out_p - self.speed * self.tick_period_s / math.sqrt(2), self.x_ini - self.size)
         self.Y_out = self.X_out + self.h1
 
     def end_line_1(self) -> None:
@@ -440,7 +439,7 @@ class Control(TickChart):
 
     def during_line_2(self) -> None:
         # eqs. 3.43-3.44: Y = -X + h2; X decreases (the printed '+' would leave the cell)
-        self.X_out = max(self.X_out_p - self.speed * CHART_PERIOD_S / math.sqrt(2), self.x_ini - self.size)
+        self.X_out = max(self.X_out_p - self.speed * self.tick_period_s / math.sqrt(2), self.x_ini - self.size)
         self.Y_out = -self.X_out + self.h2
 
     # ------------------------------------------------------- Drawing_O
@@ -468,7 +467,7 @@ class Control(TickChart):
                   self.z_draw)
 
     def _arc_step(self) -> float:
-        return self.speed * CHART_PERIOD_S * math.sqrt(0.5)
+        return self.speed * self.tick_period_s * math.sqrt(0.5)
 
     def during_arc_1(self) -> None:
         # eqs. 3.48-3.49: X increases along the lower half, Y from the circle
@@ -511,7 +510,7 @@ class Control(TickChart):
 
     def during_wave(self) -> None:
         # X decreases by a set increment; Y follows the sine
-        self.X_out = max(self.X_out_p - self.speed * CHART_PERIOD_S * 0.5, self.tx)
+        self.X_out = max(self.X_out_p - self.speed * self.tick_period_s * 0.5, self.tx)
         s = (self.x0 - self.X_out) / self.sine_length
         self.Y_out = self.y0 + self.sine_amplitude * math.sin(2 * math.pi * self.sine_periods * s)
 
@@ -524,7 +523,7 @@ class Control(TickChart):
         self._move(self.z_speed * 2)
 
     def during_turn_sponge(self) -> None:
-        self.phi = min(self.phi + self.phi_rate * CHART_PERIOD_S, self.pi_2)
+        self.phi = min(self.phi + self.phi_rate * self.tick_period_s, self.pi_2)
 
     def _pass_x(self, k: int) -> float:
         return self.x11 - self.L / 2 - k * (self.cells * self.L - self.L) / (self.cells - 1)
@@ -570,13 +569,13 @@ class Control(TickChart):
 
     def during_turn_pen(self) -> None:
         self._move(self.z_speed * 2)
-        self.phi = max(self.phi - self.phi_rate * CHART_PERIOD_S, 0.0)
+        self.phi = max(self.phi - self.phi_rate * self.tick_period_s, 0.0)
 
     # ------------------------------------------------------- finishing
 
     def during_finishing(self) -> None:
         self.fr_sw = False
-        self.phi = max(self.phi - self.phi_rate * CHART_PERIOD_S, 0.0)
+        self.phi = max(self.phi - self.phi_rate * self.tick_period_s, 0.0)
 
     def during_home_lift(self) -> None:
         self._move(self.z_speed * 2)

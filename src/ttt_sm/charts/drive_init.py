@@ -19,17 +19,20 @@ changes, which tells the Encoder block where the drive really is (the
   slowly.
 
 Every angle here is in the drive's encoder coordinates, which become the true
-joint angle once `offset` is applied.  The charts import only the runtime;
-`ttt_sm.app.init_wiring` connects them to the twin.
+joint angle once `offset` is applied.  Speeds are per-second data; a chart
+turns them into its step per tick with the tick period the scheduler gives it
+(`tick_period_s`), so the drives search equally fast at any chart rate.
+The charts import only the runtime; `ttt_sm.app.init_wiring` connects them
+to the twin.
 """
 
 from __future__ import annotations
 
+import math
+
 from statemachine import HistoryState, State
 
 from ..runtime import Data, TickChart
-
-CHART_PERIOD_S = 0.002
 
 
 def _step_towards(value: float, target: float, inc: float) -> float:
@@ -45,7 +48,8 @@ class _HomeAndPass(TickChart):
     the chart's own (``on="set_home"``, ``during_pass_pos``).
     """
 
-    # for type checkers: data every DriveInit chart declares
+    # for type checkers: data every DriveInit chart declares, and its period (it is timed)
+    tick_period_s: float
     pos_in: float
     pos_out: float
     offset: float
@@ -79,7 +83,7 @@ class _IndexSearch(_HomeAndPass):
 class DriveInit1(_IndexSearch):
     """Drive 1: find the index (or a hard stop, then the index), park, wait, pass pos_in."""
 
-    tick_period_s = CHART_PERIOD_S
+    timed = True
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
@@ -96,10 +100,11 @@ class DriveInit1(_IndexSearch):
         Data("ini_23", "bool", False, "drive 1 initialised and parked: drives 2 and 3 may start"),
     )
     local = (
-        Data("inc", "rad", 0.002, "search step per chart tick (1 rad/s at 500 Hz)"),
+        Data("search_speed", "rad/s", 1.0, "how fast the setpoint turns while searching and parking"),
+        Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period"),
         Data("index_angle", "rad", 0.0, "true angle of the index switch"),
         Data("park", "rad", 0.0, "angle to wait at while drives 2 and 3 initialise"),
-        Data("still_band", "rad", 0.0005, "encoder moving less than this per tick (a quarter of inc): stalled"),
+        Data("still_speed", "rad/s", 0.25, "encoder slower than this (a quarter of search_speed): stalled"),
         Data("stall_lag", "rad", 0.06, "setpoint this far ahead of a still encoder: stalled (a start at a stop)"),
         Data("direction", "1", 1.0, "+1 while turning forward, -1 while turning back"),
         Data("moving", "bool", False, "the encoder has moved since the current turn began"),
@@ -146,7 +151,7 @@ class DriveInit1(_IndexSearch):
         """
         if (self.pos_out - self.pos_Encoder) * self.direction > self.stall_lag:
             return True
-        return self.moving and abs(self.pos_Encoder - self.enc_prev) < self.still_band
+        return self.moving and abs(self.pos_Encoder - self.enc_prev) < self.still_speed * self.tick_period_s
 
     def parked(self) -> bool:
         """Setpoint at the parking angle and the drive there too."""
@@ -155,6 +160,7 @@ class DriveInit1(_IndexSearch):
     # -- actions ------------------------------------------------------------------
 
     def on_enter_turn_fwd(self) -> None:
+        self.inc = self.search_speed * self.tick_period_s
         self.index_start = self.index
         self.pos_out = self.pos_Encoder
         self.enc_prev = self.pos_Encoder
@@ -167,7 +173,7 @@ class DriveInit1(_IndexSearch):
 
     def _watch_encoder(self) -> None:
         """Remember this tick's encoder angle, and whether the drive got under way."""
-        if abs(self.pos_Encoder - self.enc_prev) >= self.still_band:
+        if abs(self.pos_Encoder - self.enc_prev) >= self.still_speed * self.tick_period_s:
             self.moving = True
         self.enc_prev = self.pos_Encoder
 
@@ -199,7 +205,7 @@ class DriveInit1(_IndexSearch):
 class DriveInit2(_IndexSearch):
     """Drive 2: wait for drive 1, turn a set angle, turn back if the index did not pass, wait, park."""
 
-    tick_period_s = CHART_PERIOD_S
+    timed = True
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
@@ -214,7 +220,8 @@ class DriveInit2(_IndexSearch):
         Data("ini2", "bool", False, "drive 2 is initialised"),
     )
     local = (
-        Data("inc", "rad", 0.0015, "search step per chart tick (0.75 rad/s at 500 Hz)"),
+        Data("search_speed", "rad/s", 0.75, "how fast the setpoint turns while searching and parking"),
+        Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period"),
         Data("index_angle", "rad", 0.0, "true angle of the index switch"),
         Data("turn_angle", "rad", 0.6, "how far to turn one way before turning back"),
         Data("max_back", "rad", 2.0, "how far to turn back before giving up"),
@@ -242,6 +249,7 @@ class DriveInit2(_IndexSearch):
     # (index_passed, set_home and during_pass_pos: see _IndexSearch)
 
     def start_search(self) -> None:
+        self.inc = self.search_speed * self.tick_period_s
         self.index_start = self.index
         self.travel = 0.0
 
@@ -263,7 +271,7 @@ class DriveInit2(_IndexSearch):
 class DriveInit3(_HomeAndPass):
     """Drive 3: turn towards the index-and-limit switch with a shrinking increment."""
 
-    tick_period_s = CHART_PERIOD_S
+    timed = True
 
     inputs = (
         Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
@@ -279,9 +287,10 @@ class DriveInit3(_HomeAndPass):
     )
     local = (
         Data("inc", "rad", 0.0, "current step per chart tick"),
-        Data("inc_max", "rad", 0.002, "first step (1 rad/s at 500 Hz)"),
-        Data("inc_min", "rad", 0.0004, "smallest step (0.2 rad/s): how fast the switch is touched"),
-        Data("shrink", "1", 0.997, "the step is multiplied by this every tick"),
+        Data("speed_max", "rad/s", 1.0, "first speed towards the switch, and the speed of backing off"),
+        Data("speed_min", "rad/s", 0.2, "slowest speed: how fast the switch is touched"),
+        Data("slow_down_s", "s", 0.666, "the speed falls by a factor e every this many seconds"),
+        Data("shrink", "1", 1.0, "the step is multiplied by this every tick: exp(-tick period / slow_down_s)"),
         Data("index_angle", "rad", 0.0, "true angle of the index-and-limit switch"),
         Data("park", "rad", 0.0, "angle to wait at once initialised"),
         Data("max_travel", "rad", 3.5, "how far to turn before giving up"),
@@ -308,20 +317,22 @@ class DriveInit3(_HomeAndPass):
     # (set_home and during_pass_pos: see _HomeAndPass)
 
     def start_search(self) -> None:
-        self.inc = self.inc_max
+        self.inc = self.speed_max * self.tick_period_s
+        self.shrink = math.exp(-self.tick_period_s / self.slow_down_s)
         self.travel = 0.0
 
     def during_approach(self) -> None:
         self.pos_out = self.pos_out_p + self.inc
         self.travel = self.travel + self.inc
-        self.inc = max(self.inc_min, self.inc * self.shrink)
+        self.inc = max(self.speed_min * self.tick_period_s, self.inc * self.shrink)
 
     def during_leave_switch(self) -> None:
-        self.pos_out = self.pos_out_p - self.inc_min
-        self.travel = self.travel + self.inc_min
+        step = self.speed_min * self.tick_period_s
+        self.pos_out = self.pos_out_p - step
+        self.travel = self.travel + step
 
     def during_back_off(self) -> None:
-        self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc_max)
+        self.pos_out = _step_towards(self.pos_out_p, self.park, self.speed_max * self.tick_period_s)
 
     def on_enter_wait_ini2(self) -> None:
         self.ini3 = True

@@ -16,8 +16,6 @@ from statemachine import State
 
 from ..runtime import Data, TickChart, after, after_s
 
-CHART_PERIOD_S = 0.002
-
 #: The Tic-tac-toe GUI's messages (thesis section 3.7, Text box2), and the results.
 MSG_COMPILING = "Wait for the model to be compiled."
 MSG_INITIALISING = "The compilation is done wait for the manipulator to be initialized."
@@ -31,7 +29,6 @@ RESULT_MESSAGES = {1: "The manipulator wins.", 2: "You win.", 3: "Draw: the boar
 class AlgorithmActivator(TickChart):
     """Fig. 3.30: the Play trigger activates the game algorithm once per change of o_pos."""
 
-    tick_period_s = CHART_PERIOD_S
     activations: int  # for type checkers: counts up from its own value
     ignored_triggers: int
 
@@ -77,7 +74,7 @@ class AlgorithmActivator(TickChart):
 class Game(TickChart):
     """The game flow behind the Tic-tac-toe GUI: turns, drawing, result, erasing, turning off."""
 
-    tick_period_s = CHART_PERIOD_S
+    timed = True  # the result shows for 2 s of chart time (after_s)
 
     inputs = (
         Data("initialised", "bool", False, "every drive is initialised (init charts)"),

@@ -39,7 +39,7 @@ from statemachine.state import State
 from statemachine.transition import Transition
 
 from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, check_values, collect_declarations
-from .errors import ChartDefinitionError, GuardMismatchError, UnknownEventError
+from .errors import ChartDefinitionError, GuardMismatchError, TemporalLogicError, UnknownEventError
 from .guards import Guard, compile_guard
 from .structure import (
     DURING_PREFIX,
@@ -155,8 +155,9 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     Parameters
     ----------
     tick_period_s : float, optional
-        Chart time per tick in seconds (needed by ``after_s``); defaults to the
-        class attribute ``tick_period_s``.
+        Chart time per tick in seconds: the scheduler's chart period.  Needed by
+        ``after_s`` and by a chart whose actions read it (``timed``); defaults to
+        the class attribute ``tick_period_s``.
     chart_name : str, optional
         Name of this instance in traces and coverage; defaults to the class name.
     data : mapping, optional
@@ -172,6 +173,9 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     # normal in Stateflow; python-statemachine calls it a trap state by default.
     validate_trap_states = False
     tick_period_s: float | None = None
+    #: The chart's actions read ``tick_period_s`` (a per-tick step is a per-second
+    #: datum times the period): building it without a period is an error.
+    timed: ClassVar[bool] = False
     inputs: ClassVar[tuple[Data, ...]] = ()
     outputs: ClassVar[tuple[Data, ...]] = ()
     local: ClassVar[tuple[Data, ...]] = ()
@@ -214,6 +218,11 @@ class TickChart(StateChart, metaclass=TickChartMeta):
             if not tick_period_s > 0:
                 raise ValueError(f"tick_period_s must be > 0 s, got {tick_period_s!r}")
             d["tick_period_s"] = float(tick_period_s)
+        elif self.timed and self.tick_period_s is None:
+            raise TemporalLogicError(
+                f"{type(self).__name__} needs tick_period_s=... (the scheduler's chart period):"
+                " its actions turn per-second data into per-tick steps"
+            )
         d["chart_name"] = chart_name or type(self).__name__
         # Data must exist before the library resolves guards that name it.
         self.reset_data()

@@ -467,3 +467,46 @@ def test_finish_before_initialisation_waits_for_it_then_ends_where_the_arm_stand
     # nothing was commanded yet: the arm is already at its start pose
     assert set(c.configuration_values) == {"finishing", "finished"}
     assert (c.X_out, c.Y_out, c.Z_out, c.phi) == (*START_POSE, 0.0)
+
+
+# ---------------------------------------------------- what others read: outputs, not states
+
+
+def test_ready_busy_erasing_and_at_start_follow_the_states_at_every_tick():
+    """The outputs the game and the application read (never the states) say what the states say."""
+    c = powered(speed=0.1)
+    seen: set[tuple[bool, bool, bool, bool]] = set()
+
+    def tick_and_check() -> None:
+        ideal_tick(c)
+        active = c.configuration_values
+        assert c.busy == ("wait_1" not in active), active
+        assert c.ready == ("wait_1" in active and c.Pl_fld), active
+        assert c.erasing == ("Erase" in active), active
+        assert c.at_start == ("finished" in active), active
+        seen.add((c.ready, c.busy, c.erasing, c.at_start))
+
+    def until(predicate, max_s: float = 200.0) -> None:
+        for _ in range(int(max_s / P.control.chart_dt)):
+            if predicate():
+                return
+            tick_and_check()
+        raise AssertionError(f"not reached; Control is in {sorted(c.configuration_values)}")
+
+    assert (c.ready, c.busy, c.erasing, c.at_start) == (False, True, False, False)  # before the first tick
+    until(lambda: c.ready)  # the field is drawn, the arm waits
+    c.symbol = 1
+    c.post("button")
+    until(lambda: c.busy)
+    until(lambda: c.ready)  # the X is drawn
+    c.erase = True
+    until(lambda: c.erasing)
+    c.erase = False
+    until(lambda: not c.erasing)
+    until(lambda: c.ready)  # erased, and the field drawn again
+    c.finish = True
+    until(lambda: c.at_start)
+    # ready, busy, erasing, at_start: moving; waiting; waiting with the field still to draw (one tick);
+    # erasing; back at the start pose
+    assert seen == {(False, True, False, False), (True, False, False, False), (False, False, False, False),
+                    (False, True, True, False), (False, True, False, True)}

@@ -104,3 +104,29 @@ def test_two_hundred_power_on_poses_all_initialise_safely():
     assert report["limit_violations"] == 0
     assert report["board_zone_entries"] == 0
     assert report["max_offset_error_rad"] < report["one_count_rad"]
+
+
+def test_passing_and_gave_up_are_outputs_that_follow_pass_pos_and_failed():
+    """What the application reads of the init charts (never their states): `passing`, `gave_up`."""
+    robot = Robot(P, seed=0)
+    charts = robot.init_stage.charts
+
+    def consistent() -> bool:
+        for c in charts:
+            assert c.passing == ("pass_pos" in c.configuration_values)
+            assert c.gave_up == ("failed" in c.configuration_values)
+        return robot.initialised == all(c.passing for c in charts)
+
+    assert robot.run_until(lambda: not consistent() or robot.initialised, 25) and consistent()
+    # stopped after initialisation: drive 1 no longer passes its position through, and again once released
+    robot.set_input("DriveInit1", "stop", True)
+    robot.chart_step()
+    assert consistent() and not charts[0].passing and not robot.initialised
+    robot.set_input("DriveInit1", "stop", False)
+    robot.chart_step()
+    assert consistent() and charts[0].passing and robot.initialised
+    # a dead switch: the chart gives up
+    dead = Robot(P, seed=0)
+    dead.set_input("DriveInit1", "index", True, force=True)
+    assert dead.run_until(lambda: dead.init_stage.failed, 30)
+    assert dead.init_stage.charts[0].gave_up and "failed" in dead.active("DriveInit1")

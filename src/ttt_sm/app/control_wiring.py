@@ -10,7 +10,7 @@ setpoint filters.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -20,6 +20,7 @@ from ..params import ArmParams
 from ..sched.scheduler import Signals
 from ..twin.kinematics import fk_floats
 from .init_wiring import DriveInitStage
+from .wiring import Wiring, not_wired
 
 # The compiled forward kinematics' Python original: a numba call with nine
 # float arguments costs ~10 us in dispatch, the plain function ~2 us.
@@ -43,27 +44,54 @@ def make_control_chart(params: ArmParams, listeners: Sequence[object] = ()) -> C
     )
 
 
+class ToolPose:
+    """Forward kinematics of the encoder angles this chart step (the table's ``FK.X``, ``Y``, ``Z``)."""
+
+    __slots__ = ("X", "Y", "Z")
+
+    def __init__(self) -> None:
+        self.X = self.Y = self.Z = math.nan
+
+
 class ControlStage:
-    """Task stage: the Control chart between the game and inverse kinematics."""
+    """Task stage: the Control chart between the game and inverse kinematics.
+
+    The wiring table (:mod:`.wires`) says what feeds the chart and where its
+    outputs go; this stage computes the tool pose the chart reads, holds the
+    erase flag (the table's ``EraseFlag``), and passes the pose the chart
+    commands to inverse kinematics.
+    """
 
     def __init__(self, params: ArmParams, arm: Arm, init: DriveInitStage, chart: Control) -> None:
         self.params = params
         self.arm = arm
         self.init = init
         self.chart = chart
-        #: The game's request to erase (the thesis' Erase_flag); cleared once erased.
+        #: The request to erase (the thesis' Erase_flag): set by the game or `ttt-sm play`,
+        #: reset once the Control chart erases.
         self.erase_requested = False
         #: Inputs forced by a test or scenario (``Robot.set_input(..., force=True)``),
         #: applied after the wiring's own: name -> value.
         self.overrides: dict[str, object] = {}
+        self.fk = ToolPose()
         self._no_task = np.full(4, np.nan)
         self._inputs = vars(chart)  # plain attribute writes: this runs every chart step
         g = params.geometry
         self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
+        self._feed: Callable[[], None] = not_wired
+        self._outputs: Callable[[], tuple[float, float, float, float, bool, bool]] = not_wired  # type: ignore
+
+    def blocks(self) -> dict[str, object]:
+        """The objects holding the outputs of this stage's blocks (FK, EraseFlag), by block name."""
+        return {"FK": self.fk, "EraseFlag": self}
+
+    def wire(self, wiring: Wiring) -> None:
+        """Compile this stage's part of the wiring table."""
+        self._feed = wiring.feed([self.chart.chart_name])
+        self._outputs = wiring.collect("IK.X", "IK.Y", "IK.Z", "IK.phi", "Drives.fr_sw", "EraseFlag.erasing")
 
     def tick(self, signals: Signals) -> None:
         """Inputs in, chart ticked, tool pose out."""
-        c = self.chart
         arm = self.arm
         q1, q2, q3 = arm.encoder_angles()
         servo = float(signals.q_set[3])
@@ -71,17 +99,14 @@ class ControlStage:
             # no setpoint yet (the first chart step): the servo has no sensor, so
             # its pose is the angle it was last commanded
             servo = arm.servo_setpoint
-        x, y, z, _ = _fk_python(q1, q2, q3, servo, *self._geometry)
-        if self.erase_requested and "turn_pen" in c.active_ids:
-            self.erase_requested = False
-        d = self._inputs
-        d["X_now"], d["Y_now"], d["Z_now"] = x, y, z
-        d["initialised"], d["erase"] = self.init.done, self.erase_requested
+        fk = self.fk
+        fk.X, fk.Y, fk.Z, _ = _fk_python(q1, q2, q3, servo, *self._geometry)
+        self._feed()
         if self.overrides:
-            d.update(self.overrides)
-        c.tick()
-        if math.isfinite(c.X_out):
-            signals.task = [c.X_out, c.Y_out, c.Z_out, c.phi]
-        else:
-            signals.task = self._no_task
-        signals.fr_sw = bool(c.fr_sw)
+            self._inputs.update(self.overrides)
+        self.chart.tick()
+        x, y, z, phi, fr_sw, erasing = self._outputs()
+        if erasing:
+            self.erase_requested = False  # the chart took the request
+        signals.task = [x, y, z, phi] if math.isfinite(x) else self._no_task
+        signals.fr_sw = bool(fr_sw)

@@ -200,13 +200,11 @@ class DrawSession:
         self.robot.sched.joint_stages.append(self.recorder)
         self.say = progress or (lambda _m: None)
 
-    def _control_in(self, state: str) -> bool:
-        return state in self.robot.control.active_ids
-
     def run_to_wait(self, timeout_s: float) -> None:
         """Run until the Control chart waits in wait_1 (raises DrawError on timeout)."""
         r = self.robot
-        if not r.run_until(lambda: self._control_in("wait_1"), timeout_s):
+        c = r.control
+        if not r.run_until(lambda: not c.busy, timeout_s):
             raise DrawError(f"the Control chart did not reach wait_1 within {timeout_s:.0f} s "
                             f"(active: {sorted(r.active('Control'))})")
 
@@ -230,7 +228,7 @@ class DrawSession:
             c.speed = speed
         if size is not None:
             c.size = size
-        if not self._control_in("wait_1"):
+        if c.busy:
             raise DrawError("the arm is busy: draw only from wait_1")
         wall0 = time.perf_counter()
         self.recorder.record = DrawRecord()

@@ -32,6 +32,8 @@ from ..sched.scheduler import Signals
 from ..vision import MoveError, percent_process
 from .camera_link import CameraLink
 from .robot import Robot
+from .wires import GAME_WIRES
+from .wiring import Wiring, not_wired
 
 Cell = tuple[int, int]
 
@@ -133,34 +135,47 @@ class GameRecord:
 
 
 class GameStage:
-    """Task stage before the Control chart: the Game and AlgorithmActivator charts and the engine."""
+    """Task stage before the Control chart: the Game and AlgorithmActivator charts and the engine.
+
+    What feeds the two charts and where their outputs go is the wiring
+    table's (:data:`~ttt_sm.app.wires.GAME_WIRES`); this stage runs them and
+    the session's part: the erase flag set once per game, the erasing seen
+    through, the engine asked when the activator enables it.
+    """
 
     def __init__(self, session: GameSession) -> None:
         self.s = session
-        self.game_inputs = vars(session.game)  # plain attribute writes: this runs every chart step
-        self.activator_inputs = vars(session.activator)
+        self._feed_game: Callable[[], None] = not_wired
+        self._after_game: Callable[[], tuple[bool, bool, bool]] = not_wired
+        self._feed_activator: Callable[[], None] = not_wired
+        self._enable: Callable[[], bool] = not_wired
+
+    def blocks(self) -> dict[str, object]:
+        """The session holds the Session block's outputs."""
+        return {"Session": self.s}
+
+    def wire(self, wiring: Wiring) -> None:
+        """Compile this stage's part of the wiring table."""
+        s = self.s
+        self._feed_game = wiring.feed([s.game.chart_name])
+        self._after_game = wiring.collect("EraseFlag.request", "Session.erasing", "Session.field_drawn")
+        self._feed_activator = wiring.feed([s.activator.chart_name])
+        self._enable = wiring.collect("Session.enable")
 
     def tick(self, signals: Signals) -> None:
         s = self.s
-        r, c = s.robot, s.robot.control
-        active = c.active_ids
-        waiting = "wait_1" in active
-        g = s.game
-        self.game_inputs.update(initialised=r.initialised, ready=waiting and bool(c.Pl_fld),
-                                busy=not waiting, result=s.result_code, erased=s.erased_seen,
-                                play_again=False, finished="finished" in active)
-        g.tick()
-        if g.erase and not r.control_stage.erase_requested and not s.erase_started:
-            r.control_stage.erase_requested = True
+        self._feed_game()
+        s.game.tick()
+        request, erasing, field_drawn = self._after_game()
+        flag = s.robot.control_stage
+        if request and not flag.erase_requested and not s.erase_started:
+            flag.erase_requested = True
             s.erase_started = True
-        if s.erase_started and not s.erased_seen and "Erase" not in active and not c.Pl_fld:
+        if s.erase_started and not s.erased_seen and not erasing and not field_drawn:
             s.erased_seen = True
-        if g.finish:
-            c.finish = True
-        a = s.activator
-        self.activator_inputs["o_pos"] = s.o_pos
-        a.tick()
-        if a.enable:
+        self._feed_activator()
+        s.activator.tick()
+        if self._enable():
             s.robot_turn_now()
 
 
@@ -180,8 +195,6 @@ class GameSession:
         self.robot = Robot(params, seed=seed, listeners=listeners)
         self.activator = AlgorithmActivator(tick_period_s=params.control.chart_dt, listeners=listeners)
         self.game = Game(tick_period_s=params.control.chart_dt, listeners=listeners)
-        self.robot.charts.update({"AlgorithmActivator": self.activator, "Game": self.game})
-        self.robot.sched.task_stages.insert(0, GameStage(self))
         self.robot_symbol = robot_symbol
         self.person_symbol = "X" if robot_symbol == "O" else "O"
         self.person = person or SimulatedPerson(seed, self.say)
@@ -202,6 +215,9 @@ class GameSession:
         self.record = GameRecord()
         self.moves: list[dict[str, Any]] = []
         self._last_message = ""
+        #: The Session block's output `play_again`: one game per session.
+        self.play_again = False
+        self.robot.add_charts((self.activator, self.game), GAME_WIRES, GameStage(self))
         #: Building the twin (controller design, compiled kernels loaded), the charts and the camera.
         self.setup_wall_s = time.perf_counter() - setup0
 
@@ -237,8 +253,7 @@ class GameSession:
                             f"(Control: {control}, Game: {game})")
 
     def _waiting(self) -> bool:
-        c = self.robot.control
-        return "wait_1" in c.active_ids and bool(c.Pl_fld)
+        return bool(self.robot.control.ready)
 
     def _place(self, cell: Cell, symbol: str, which: str) -> None:
         i = cell_index(*cell)
@@ -283,7 +298,7 @@ class GameSession:
         self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3}.get(outcome, 3)
         self.record.add(robot.t, "result", outcome=outcome)
         self.say(f"result: {outcome}; erasing and turning off")
-        self._run_until(lambda: "off" in self.game.active_ids, 600.0, "erasing and turning off")
+        self._run_until(lambda: self.game.ended, 600.0, "erasing and turning off")
         wall = time.perf_counter() - wall0
         ink_left = robot.board.ink_area_mm2()
         winner = {self.robot_symbol: "robot", self.person_symbol: "person"}.get(outcome, outcome)

@@ -18,18 +18,20 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..arm import Arm
+from ..arm import Arm, Sensors
 from ..charts.drive_init import DriveInit1, DriveInit2, DriveInit3
 from ..params import ArmParams
 from ..sched.scheduler import Scheduler, Signals
 from ..twin.kinematics import link_points
 from ..twin.plant import ArmSim
+from .wires import BLOCKS, INIT_WIRES
+from .wiring import Wiring, not_wired, wire_stages
 
 
 def servo_init_angle(params: ArmParams) -> float:
@@ -52,79 +54,127 @@ def make_init_charts(params: ArmParams, listeners: Sequence[object] = ()) -> tup
     return c1, c2, c3
 
 
+class EncoderBlock:
+    """The thesis' Encoder blocks of drives 1-3 (fig. 3.2): what the init charts read of the arm.
+
+    Its outputs (the table's ``Encoder.index``, ``angle``, ``index_angle``)
+    are plain sequences, refreshed by :meth:`read` from the arm's readings
+    once per chart step; :attr:`applied` holds the offsets given to the arm.
+    """
+
+    def __init__(self, params: ArmParams) -> None:
+        self.rad_per_count = [d.rad_per_count for d in params.drives]
+        self.index: Sequence[bool] = (False, False, False)
+        self.angle: Sequence[float] = (0.0, 0.0, 0.0)
+        self.index_angle: Sequence[float] = (0.0, 0.0, 0.0)
+        self.applied = [0.0, 0.0, 0.0]
+
+    def read(self, sensors: Sensors, angles: Sequence[float], offsets: Sequence[float]) -> None:
+        """Index levels, encoder angles, and the angles latched at the last index edges (counts + offsets)."""
+        counts, rpc = sensors.index_count, self.rad_per_count
+        self.index = sensors.index
+        self.angle = angles
+        self.index_angle = [counts[0] * rpc[0] + offsets[0], counts[1] * rpc[1] + offsets[1],
+                            counts[2] * rpc[2] + offsets[2]]
+
+
+class JointCommand:
+    """The joint coordinates inverse kinematics gave this chart step (the table's ``IK.q_des``)."""
+
+    __slots__ = ("q_des",)
+
+    def __init__(self) -> None:
+        self.q_des: Sequence[float] = (math.nan,) * 4
+
+
 class DriveInitStage:
-    """Joint stage: the Encoder blocks and the three init charts between IK and the drives."""
+    """Joint stage: the Encoder blocks and the three init charts between IK and the drives.
+
+    Which input comes from where is the wiring table's (:mod:`.wires`); the
+    stage runs it: Encoder blocks read, inputs fed, charts ticked, offsets
+    applied, `pos_out` to the drives.  Once every drive passes its position
+    through, the Encoder blocks hold their outputs (an enabled subsystem, as
+    in Simulink): their wires are not fed, which saves reading the arm on
+    every chart step of a game.
+    """
 
     def __init__(self, params: ArmParams, arm: Arm, sched: Scheduler,
                  charts: tuple[DriveInit1, DriveInit2, DriveInit3]) -> None:
         self.arm = arm
         self.sched = sched
         self.charts = charts
-        self.rad_per_count = [d.rad_per_count for d in params.drives]
+        self.encoder = EncoderBlock(params)
+        self.ik = JointCommand()
         self.servo_init = servo_init_angle(params)
-        self.applied = [0.0, 0.0, 0.0]
         #: Inputs forced by a test or scenario, applied after the Encoder blocks: (chart index, name) -> value.
         self.overrides: dict[tuple[int, str], object] = {}
-        self.done = False  # every drive passes its commanded position through
-        # the charts' data as plain dictionaries: inputs are written every chart step
-        self._inputs = tuple(vars(c) for c in charts)
+        self.done = False  # every drive passes its commanded position through (the table's Homing.done)
         self.failed = False  # a chart gave up (a switch not found)
+        self._feed: Callable[[], None] = not_wired
+        self._feed_held: Callable[[], None] = not_wired
+        self._setpoints: Callable[[], list[float]] = not_wired  # type: ignore[assignment]
+        self._offsets: Callable[[], list[float]] = not_wired  # type: ignore[assignment]
+        self._status: Callable[[], tuple[list[bool], list[bool]]] = not_wired  # type: ignore[assignment]
+
+    def blocks(self) -> dict[str, object]:
+        """The objects holding the outputs of this stage's blocks (Encoder, IK, Homing), by block name."""
+        return {"Encoder": self.encoder, "IK": self.ik, "Homing": self}
+
+    def wire(self, wiring: Wiring) -> None:
+        """Compile this stage's part of the wiring table."""
+        names = [c.chart_name for c in self.charts]
+        self._feed = wiring.feed(names)
+        self._feed_held = wiring.feed(names, skip=("Encoder",))
+        self._setpoints = wiring.collect("Drives.q_set")
+        self._offsets = wiring.collect("Encoder.offset")
+        self._status = wiring.collect("Homing.passing", "Homing.gave_up")
 
     def _update_status(self) -> None:
-        # Reading the configuration costs microseconds: only after a transition.
-        self.done = all("pass_pos" in c.active_ids for c in self.charts)
-        self.failed = any("failed" in c.active_ids for c in self.charts)
+        passing, gave_up = self._status()
+        self.done = all(passing)
+        self.failed = any(gave_up)
 
     def tick(self, signals: Signals) -> None:
         """Encoder blocks in, charts ticked, offsets applied, pos_out out."""
         c1, c2, c3 = self.charts
         q_set = signals.q_set
-        pos_in = q_set.tolist() if type(q_set) is np.ndarray else q_set
-        # Each chart reads the others' flags as they were at the end of the last step.
-        ini_23, ini2, ini3 = c1.ini_23, c2.ini2, c3.ini3
+        pos_in: Sequence[float] = q_set.tolist() if type(q_set) is np.ndarray else q_set  # type: ignore[assignment]
+        self.ik.q_des = pos_in
         if self.done:
-            # Initialised: only pos_in and the flags matter; skip the Encoder blocks.
-            d1, d2, d3 = self._inputs
-            d1["pos_in"], d1["ini2"], d1["ini3"] = pos_in[0], ini2, ini3
-            d2["pos_in"], d2["ini1"], d2["ini3"] = pos_in[1], ini_23, ini3
-            d3["pos_in"], d3["ini1"], d3["ini2"] = pos_in[2], ini_23, ini2
-            if not self.overrides and not (d1["_queue"] or d2["_queue"] or d3["_queue"]):
+            self._feed_held()
+            if not self.overrides and not (c1._queue or c2._queue or c3._queue):
                 # the offsets are set for good: tick and pass on (every chart step of a game)
                 t1, t2, t3 = c1.tick(), c2.tick(), c3.tick()
                 if t1 or t2 or t3:
                     self._update_status()
-                signals.q_set = [c1.pos_out, c2.pos_out, c3.pos_out, pos_in[3]]
+                q = self._setpoints()
+                q.append(pos_in[3])
+                signals.q_set = q
                 return
         else:
             sensors = signals.sensors
             assert sensors is not None
-            enc = self.arm.encoder_angles()
-            offsets = self.arm.offset_estimates()
-            idx, counts, rpc = sensors.index, sensors.index_count, self.rad_per_count
-            latched = [counts[d] * rpc[d] + offsets[d] for d in range(3)]
-            # vars(...).update: the inputs are plain attributes; this skips the
-            # chart's state-name check on every assignment (a hot path).
-            vars(c1).update(pos_in=pos_in[0], index=idx[0], pos_Encoder=enc[0], index_pos=latched[0],
-                            ini2=ini2, ini3=ini3)
-            vars(c2).update(pos_in=pos_in[1], index=idx[1], index_pos=latched[1], ini1=ini_23, ini3=ini3)
-            vars(c3).update(pos_in=pos_in[2], index=idx[2], index_pos=latched[2], ini1=ini_23, ini2=ini2)
+            self.encoder.read(sensors, self.arm.encoder_angles(), self.arm.offset_estimates())
+            self._feed()
         for (d, name), value in self.overrides.items():
             setattr(self.charts[d], name, value)
         # Posted events may move a chart without a tick transition.
         moved = bool(c1._queue or c2._queue or c3._queue)
-        applied = self.applied
-        for d, chart in enumerate(self.charts):
+        for chart in self.charts:
             if chart.tick() is not None:
                 moved = True
-            if chart.offset != applied[d]:
-                self.arm.set_offset_estimate(d + 1, chart.offset)
-                applied[d] = chart.offset
+        offsets, applied = self._offsets(), self.encoder.applied
+        for d in range(3):
+            if offsets[d] != applied[d]:  # the Encoder block applies a new offset from now on
+                self.arm.set_offset_estimate(d + 1, offsets[d])
+                applied[d] = offsets[d]
                 self.sched.mark_homed(d + 1)
         if moved:
             self._update_status()
-        servo = pos_in[3] if self.done else self.servo_init
+        q = self._setpoints()
         # a list: the next stages and the scheduler read it as floats (no array round trip)
-        signals.q_set = [c1.pos_out, c2.pos_out, c3.pos_out, servo]
+        q.append(pos_in[3] if self.done else self.servo_init)
+        signals.q_set = q
 
 
 class InitMonitor:
@@ -209,6 +259,7 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
     sched = Scheduler(params, sim)
     charts = make_init_charts(params)
     stage = DriveInitStage(params, sim, sched, charts)
+    wire_stages(INIT_WIRES, {c.chart_name: c for c in charts}, [stage], BLOCKS)
     # Drive 1 may push its setpoint past a stop by its stall band (and one more step) to find it.
     one_step = charts[0].search_speed * params.control.chart_dt
     monitor = InitMonitor(params, sim, allowance_rad=charts[0].stall_lag + one_step)

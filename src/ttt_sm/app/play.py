@@ -40,17 +40,18 @@ def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
 
     say("erasing")
     robot.control_stage.erase_requested = True
-    if not robot.run_until(lambda: "Erase" in robot.active("Control"), 30.0):
+    c = robot.control
+    if not robot.run_until(lambda: c.erasing, 30.0):
         raise DrawError("the Control chart did not start erasing")
-    if not robot.run_until(lambda: "go_wait" in robot.active("Control"), 300.0):
+    if not robot.run_until(lambda: not c.erasing, 300.0):
         raise DrawError("erasing did not finish within 300 s")
     ink_left = robot.board.ink_area_mm2()
     after = robot.board.save_png(out_dir / "board_erased.png", grid_mm=True)
     say(f"erased: {ink_drawn:.0f} mm2 of ink before, {ink_left:.1f} mm2 after")
 
     say("finishing: back to the start pose")
-    robot.control.finish = True
-    if not robot.run_until(lambda: "finished" in robot.active("Control"), 120.0):
+    c.finish = True
+    if not robot.run_until(lambda: c.at_start, 120.0):
         raise DrawError("finishing did not end within 120 s")
     wall = time.perf_counter() - wall0
     say(f"finished after {robot.t:.1f} s simulated in {wall:.1f} s ({robot.t / wall:.0f}x real time)")
@@ -84,10 +85,7 @@ def game_motion(params: ArmParams, seed: int = 0, symbols: int = 12) -> dict[str
     c = robot.control
     wall0 = time.perf_counter()
 
-    def waiting() -> bool:
-        return "wait_1" in c.active_ids and c.Pl_fld
-
-    if not robot.run_until(waiting, 200.0):
+    if not robot.run_until(lambda: c.ready, 200.0):
         raise DrawError("the field was not drawn within 200 s")
     cells = [(r, col) for r in range(1, 6) for col in range(1, 6)]
     for k in range(symbols):
@@ -96,11 +94,11 @@ def game_motion(params: ArmParams, seed: int = 0, symbols: int = 12) -> dict[str
         robot.post("Control", "button")
         robot.chart_step()
         robot.chart_step()
-        if not robot.run_until(lambda: "wait_1" in c.active_ids, 60.0):
+        if not robot.run_until(lambda: not c.busy, 60.0):
             raise DrawError(f"symbol {k + 1} did not finish within 60 s")
     robot.control_stage.erase_requested = True
-    robot.run_until(lambda: "Erase" in c.active_ids, 10.0)
-    if not robot.run_until(lambda: "go_wait" in c.active_ids, 300.0):
+    robot.run_until(lambda: c.erasing, 10.0)
+    if not robot.run_until(lambda: not c.erasing, 300.0):
         raise DrawError("erasing did not finish within 300 s")
     wall = time.perf_counter() - wall0
     return {

@@ -5,8 +5,8 @@ and (later) the GUIs drive.  It knows the charts by name, steps the loop by a
 control step or a chart step, runs until a condition holds, and exposes the
 chart data and the signals of the current step without anyone reading code.
 
-It holds the three drive-initialisation charts and the Control chart; the
-game charts join it in a later issue.
+It holds the three drive-initialisation charts and the Control chart, wired
+by the table of :mod:`.wires`; a game adds its charts (:meth:`Robot.add_charts`).
 
 The charts' wiring and the scheduler talk to an :class:`~ttt_sm.arm.Arm`
 (:attr:`Robot.arm`).  Ground truth (:attr:`Robot.truth`, the simulated arm's
@@ -32,6 +32,8 @@ from ..twin.whiteboard import Whiteboard
 from .compensation import GearPlayCompensation
 from .control_wiring import ControlStage, make_control_chart
 from .init_wiring import DriveInitStage, make_init_charts, settled_pose
+from .wires import BLOCKS, ROBOT_WIRES
+from .wiring import Wire, WiredStage, wire_stages
 
 
 class BoardStage:
@@ -77,11 +79,15 @@ class Robot:
         ``q_true`` and ``tool_true`` signals); by default the simulated arm's
         own.  Without it (an arm that is no simulation) the whiteboard stays
         blank and those signals are NaN.
+    wires : sequence of Wire
+        The wiring table (default :data:`~ttt_sm.app.wires.ROBOT_WIRES`); a row
+        that does not fit the charts' declarations raises
+        :class:`~ttt_sm.app.wiring.WiringError` naming it.
     """
 
     def __init__(self, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
                  settle_s: float = 0.0, listeners: Sequence[object] = (), arm: Arm | None = None,
-                 truth: ArmTruth | None = None) -> None:
+                 truth: ArmTruth | None = None, wires: Sequence[Wire] = ROBOT_WIRES) -> None:
         self.params = params
         self.seed = seed
         #: The simulated arm when this robot built it, else None.
@@ -109,6 +115,24 @@ class Robot:
         self.control_stage = ControlStage(params, arm, self.init_stage, self.control)
         self.sched.task_stages = [self.control_stage]
         self.charts: dict[str, TickChart] = {c.chart_name: c for c in (*init, self.control)}
+        #: The wiring table this robot runs (:mod:`.wires`), checked against the charts here.
+        self.wires: tuple[Wire, ...] = tuple(wires)
+        self._wired: list[WiredStage] = [self.init_stage, self.control_stage]
+        self.wiring = wire_stages(self.wires, self.charts, self._wired, BLOCKS)
+
+    def add_charts(self, charts: Sequence[TickChart], wires: Sequence[Wire], stage: WiredStage,
+                   objects: dict[str, object] | None = None) -> None:
+        """Add charts run by a task stage that runs before the others (the game's), and their wires.
+
+        The whole table is checked again and every stage recompiled: a wire may
+        feed a chart that was there before (the Game chart's `finish` feeds Control's).
+        """
+        charts_now = {**self.charts, **{c.chart_name: c for c in charts}}
+        wired = [stage, *self._wired]
+        table = (*self.wires, *wires)
+        self.wiring = wire_stages(table, charts_now, wired, BLOCKS, objects)
+        self.charts, self._wired, self.wires = charts_now, wired, table
+        self.sched.task_stages.insert(0, stage)  # type: ignore[arg-type]
 
     # -- time ------------------------------------------------------------------
 

@@ -73,6 +73,10 @@ class Control(TickChart):
         Data("fr_sw", "bool", False, "slow setpoint filters (the step to wait_1)"),
         Data("Pl_fld", "bool", False, "playing field flag: the field has been drawn"),
         Data("ctr", "1", 0, "symbols drawn by the manipulator"),
+        Data("ready", "bool", False, "waits in wait_1 with the field drawn: a button draws now"),
+        Data("busy", "bool", True, "anything but waiting in wait_1: initialising, moving, drawing, erasing"),
+        Data("erasing", "bool", False, "in the Erase sub-chart"),
+        Data("at_start", "bool", False, "finish is done: the arm is back at its start pose (finished)"),
     )
     local = (
         Data("x11", "m", 0.075, "x of the field's upper right corner (eqs. 3.37, 3.45)"),
@@ -312,6 +316,15 @@ class Control(TickChart):
         self.fr_sw = False
         self._aim(self.X_out, self.Y_out, self.Z_out)
 
+    # what others read of the chart's state: outputs, set on entry and exit (free on quiet ticks)
+    def on_enter_wait_1(self) -> None:
+        self.busy = False
+        self.ready = bool(self.Pl_fld)
+
+    def on_exit_wait_1(self) -> None:
+        self.busy = True
+        self.ready = False
+
     def ignore_button(self) -> None:
         self.ignored_buttons = self.ignored_buttons + 1
 
@@ -517,7 +530,11 @@ class Control(TickChart):
     # ----------------------------------------------------------- Erase
 
     def on_enter_Erase(self) -> None:
+        self.erasing = True
         self._aim(self.X_out, self.Y_out, max(self.Z_out, self.z_travel))
+
+    def on_exit_Erase(self) -> None:
+        self.erasing = False
 
     def during_erase_lift(self) -> None:
         self._move(self.z_speed * 2)
@@ -591,3 +608,6 @@ class Control(TickChart):
 
     def during_go_home(self) -> None:
         self._move(self.z_speed * 2)
+
+    def on_enter_finished(self) -> None:
+        self.at_start = True

@@ -34,6 +34,12 @@ from statemachine import HistoryState, State
 
 from ..runtime import Data, TickChart
 
+#: Outputs every DriveInit chart declares: what the application reads of its state.
+_STATUS = (
+    Data("passing", "bool", False, "initialised: passes pos_in through (pass_pos)"),
+    Data("gave_up", "bool", False, "the search gave up: a switch was not found (failed)"),
+)
+
 
 def _step_towards(value: float, target: float, inc: float) -> float:
     """`value` moved towards `target` by at most `inc`."""
@@ -55,6 +61,8 @@ class _HomeAndPass(TickChart):
     offset: float
     index_pos: float
     index_angle: float
+    passing: bool
+    gave_up: bool
 
     def set_home(self) -> None:
         """The index switch changed: its latched encoder angle is `index_angle` really."""
@@ -64,6 +72,16 @@ class _HomeAndPass(TickChart):
 
     def during_pass_pos(self) -> None:
         self.pos_out = self.pos_in
+
+    # what the application reads of the chart's state: outputs, set on entry and exit
+    def on_enter_pass_pos(self) -> None:
+        self.passing = True
+
+    def on_exit_pass_pos(self) -> None:
+        self.passing = False
+
+    def on_enter_failed(self) -> None:
+        self.gave_up = True
 
 
 class _IndexSearch(_HomeAndPass):
@@ -98,6 +116,7 @@ class DriveInit1(_IndexSearch):
         Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
         Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
         Data("ini_23", "bool", False, "drive 1 initialised and parked: drives 2 and 3 may start"),
+        *_STATUS,
     )
     local = (
         Data("search_speed", "rad/s", 1.0, "how fast the setpoint turns while searching and parking"),
@@ -199,6 +218,7 @@ class DriveInit1(_IndexSearch):
         self.pos_out = self.pos_Encoder
 
     def on_enter_failed(self) -> None:
+        self.gave_up = True
         self.pos_out = self.pos_Encoder
 
 
@@ -218,6 +238,7 @@ class DriveInit2(_IndexSearch):
         Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
         Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
         Data("ini2", "bool", False, "drive 2 is initialised"),
+        *_STATUS,
     )
     local = (
         Data("search_speed", "rad/s", 0.75, "how fast the setpoint turns while searching and parking"),
@@ -284,6 +305,7 @@ class DriveInit3(_HomeAndPass):
         Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
         Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
         Data("ini3", "bool", False, "drive 3 is initialised and parked"),
+        *_STATUS,
     )
     local = (
         Data("inc", "rad", 0.0, "current step per chart tick"),

@@ -89,6 +89,7 @@ class Game(TickChart):
         Data("message", "text", MSG_COMPILING, "what the Tic-tac-toe GUI shows (thesis section 3.7)"),
         Data("erase", "bool", False, "ask the Control chart to erase the board"),
         Data("finish", "bool", False, "ask the Control chart to finish and return to its start pose"),
+        Data("ended", "bool", False, "off: the game is over and the arm back at its start pose"),
     )
     local = (
         Data("games", "1", 0, "games finished"),
@@ -144,5 +145,8 @@ class Game(TickChart):
     def on_enter_turning_off(self) -> None:
         self.message = MSG_TURNING_OFF
         self.finish = True
+
+    def on_enter_off(self) -> None:
+        self.ended = True
 
     games: int  # for type checkers: counts up from its own value

@@ -5,7 +5,7 @@ import re
 from pathlib import Path
 
 from ttt_sm.charts import ALL_CHARTS, Control
-from ttt_sm.cli.commands import REPO_CHART_FORMATS
+from ttt_sm.cli.commands import REPO_CHART_FORMATS, repo_chart_extras
 from ttt_sm.runtime.dot import subcharts, to_dot, views
 from ttt_sm.runtime.export import stale_files
 
@@ -13,7 +13,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def test_charts_folder_is_up_to_date():
-    stale = stale_files(ALL_CHARTS, REPO / "charts", REPO_CHART_FORMATS)
+    stale = stale_files(ALL_CHARTS, REPO / "charts", REPO_CHART_FORMATS, repo_chart_extras())
     assert not stale, f"regenerate with `ttt-sm charts export`: {stale}"
 
 

@@ -322,8 +322,16 @@ def conventions_section(pictures: Pictures) -> str:
 """
 
 
+def wiring_section(pictures: Pictures) -> str:
+    """How the charts are wired: the table of ``ttt_sm.app.wires``, drawn (the picture of charts/)."""
+    del pictures  # the picture is charts/wiring.svg, written and checked with the charts' diagrams
+    from ..app.wiring_diagram import wiring_section as section
+
+    return section("../charts/wiring.svg")
+
+
 #: The sections of docs/architecture.md, in order.  Add yours here.
-SECTIONS: list[Section] = [layers_section, control_step_section, conventions_section]
+SECTIONS: list[Section] = [layers_section, control_step_section, wiring_section, conventions_section]
 
 
 def render() -> tuple[str, dict[str, str]]:

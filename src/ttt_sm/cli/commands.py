@@ -11,12 +11,15 @@ import argparse
 import dataclasses
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..params import load_params
 from .common import CliError, add_command, emit, progress
+
+if TYPE_CHECKING:
+    from ..runtime.export import ExtraDiagram
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
@@ -141,6 +144,13 @@ def cmd_init(args: argparse.Namespace) -> int:
 REPO_CHART_FORMATS = ("svg", "mermaid")
 
 
+def repo_chart_extras() -> tuple[ExtraDiagram, ...]:
+    """What `charts export` draws beside the charts: how the application wires them."""
+    from ..app.wiring_diagram import wiring_diagram
+
+    return (wiring_diagram(),)
+
+
 def cmd_charts(args: argparse.Namespace) -> int:
     from ..charts import ALL_CHARTS
     from ..runtime.export import FORMATS, export_command
@@ -149,7 +159,8 @@ def cmd_charts(args: argparse.Namespace) -> int:
     unknown = [f for f in formats if f not in FORMATS]
     if unknown:
         raise CliError(f"unknown format(s) {', '.join(unknown)}; choose from {', '.join(FORMATS)}")
-    result = export_command(ALL_CHARTS, args.out, check=args.action == "check", formats=formats)
+    result = export_command(ALL_CHARTS, args.out, check=args.action == "check", formats=formats,
+                            extras=repo_chart_extras())
     if args.action == "check":
         text = "charts are up to date" if result["ok"] else \
             "stale (run `ttt-sm charts export`):\n" + "\n".join(f"  {f}" for f in result["stale"])  # type: ignore

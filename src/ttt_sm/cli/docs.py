@@ -29,7 +29,7 @@ def cmd_docs(args: argparse.Namespace) -> int:
     from ..architecture import document
     from ..charts import ALL_CHARTS
     from ..runtime.export import export_command
-    from .commands import REPO_CHART_FORMATS
+    from .commands import REPO_CHART_FORMATS, repo_chart_extras
 
     root = Path(args.root)
     if not (root / "src" / "ttt_sm").is_dir():
@@ -38,7 +38,8 @@ def cmd_docs(args: argparse.Namespace) -> int:
     if (root / "src" / "ttt_sm").resolve() != SOURCE_ROOT:
         raise CliError(f"the ttt_sm in use is {SOURCE_ROOT}, not the one in {root.resolve()}: the pages would "
                        "show other code; run the ttt-sm of that repository (its .venv/bin/ttt-sm)")
-    charts = export_command(ALL_CHARTS, root / "charts", check=args.action == "check", formats=REPO_CHART_FORMATS)
+    charts = export_command(ALL_CHARTS, root / "charts", check=args.action == "check", formats=REPO_CHART_FORMATS,
+                            extras=repo_chart_extras())
     if args.action == "check":
         stale = [*cast(list[str], charts["stale"]), *document.stale(root)]
         result: dict[str, Any] = {"root": str(root), "stale": stale, "ok": not stale}

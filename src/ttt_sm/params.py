@@ -9,7 +9,10 @@ file (keys with ``_deg`` in their name) are converted to radians here.
 
 from __future__ import annotations
 
+import functools
 import math
+import re
+import reprlib
 import tomllib
 from dataclasses import dataclass, fields
 from importlib import resources
@@ -221,93 +224,264 @@ class ArmParams:
         return (d[0].limit_max_rad, d[1].limit_max_rad, d[2].limit_max_rad, self.servo.max_rad)
 
 
-def _section(raw: dict[str, Any], cls: type, name: str, where: str) -> Any:
-    """Build dataclass `cls` from table `raw`, converting `_deg` keys."""
+#: Largest parameter file read, bytes: the packaged one is about 6 kB.
+MAX_FILE_BYTES = 1_000_000
+
+#: Limits each value must keep, SI units (a ``_deg`` key of the file is checked in radians
+#: and named in degrees).  They are sanity bounds, wide enough for any desk-sized arm and
+#: narrow enough that no product or quotient of the model overflows or divides by zero;
+#: docs/parameters.md lists them.  Relations between keys (a range that must not be empty,
+#: cut-offs below the Nyquist frequency, the field within reach) are checked after them.
+LIMITS: dict[str, tuple[float, float]] = {
+    "geometry.L1": (0.01, 2.0), "geometry.L2": (0.01, 2.0), "geometry.L3": (0.01, 2.0),
+    "geometry.L4": (0.005, 1.0), "geometry.l_f": (-0.5, 0.5),
+    "board.surface_z": (-1.0, 1.0), "board.field_center_x": (-2.0, 2.0), "board.field_center_y": (-2.0, 2.0),
+    "board.field_size": (0.02, 1.0), "board.cells": (5, 5), "board.width": (0.02, 4.0),
+    "board.depth": (0.02, 4.0), "board.zone_clearance": (0.0, 0.5), "board.zone_depth": (0.0, 1.0),
+    "pen.spring_travel": (0.0005, 0.05), "pen.holder_clearance": (0.0, 0.005),
+    "sponge.offset": (0.001, 0.2), "sponge.width": (0.001, 0.2), "sponge.compliance": (0.0, 0.05),
+    "servo.min_rad": (-2 * math.pi, 2 * math.pi), "servo.max_rad": (-2 * math.pi, 2 * math.pi),
+    "servo.pulse_min_s": (1e-5, 0.1), "servo.pulse_max_s": (1e-5, 0.1), "servo.period_s": (1e-3, 0.1),
+    "servo.rate_rad_s": (math.radians(1.0), math.radians(6000.0)), "servo.time_constant_s": (1e-4, 1.0),
+    "servo.clearance_rad": (0.0, math.radians(5.0)),
+    "masses.link2_kg": (0.0, 50.0), "masses.link2_com": (0.0, 2.0), "masses.link3_kg": (0.0, 50.0),
+    "masses.link3_com": (0.0, 2.0), "masses.tool_kg": (0.0, 50.0),
+    "control.rate_hz": (100.0, 20_000.0), "control.chart_divider": (1, 100),
+    "control.setpoint_cutoff_hz": (0.01, 10_000.0), "control.setpoint_cutoff_slow_hz": (0.01, 10_000.0),
+    "control.speed_filter_hz": (0.1, 10_000.0), "control.inner_crossover_hz": (0.1, 10_000.0),
+    "control.outer_crossover_hz": (0.01, 10_000.0), "control.gear_play_compensation": (0.0, 1.0),
+    "ik.damping": (1e-9, 10.0), "ik.tolerance": (1e-12, 1e-2), "ik.max_iterations": (1, 10_000),
+    "drive.supply_v": (0.1, 100.0), "drive.resistance_ohm": (1e-3, 1e3), "drive.inductance_h": (1e-7, 1.0),
+    "drive.torque_constant": (1e-4, 10.0), "drive.rotor_inertia": (1e-9, 1.0), "drive.motor_viscous": (0.0, 1.0),
+    "drive.motor_coulomb": (0.0, 10.0), "drive.gear_ratio": (1.0, 10_000.0), "drive.load_inertia": (1e-6, 100.0),
+    "drive.load_viscous": (0.0, 100.0), "drive.gear_clearance": (0.0, 0.1), "drive.gear_stiffness": (1.0, 1e8),
+    "drive.gear_damping": (0.0, 1e5), "drive.encoder_counts": (1, 10_000_000),
+    "drive.limit_min_rad": (-2 * math.pi, 2 * math.pi), "drive.limit_max_rad": (-2 * math.pi, 2 * math.pi),
+    "drive.index_rad": (-2 * math.pi, 2 * math.pi), "drive.park_rad": (-2 * math.pi, 2 * math.pi),
+}
+
+
+class _Where:
+    """Names a parameter file in messages, with the line of a key when the text is known."""
+
+    def __init__(self, file: str, text: str | None = None) -> None:
+        self.file = file
+        self._text = text
+        self._lines: dict[tuple[str, str], int] | None = None
+
+    def __str__(self) -> str:
+        return self.file
+
+    def at(self, table: str, key: str | None = None) -> str:
+        """``FILE:LINE`` of ``key`` in ``[table]`` (or of the table's header), else ``FILE``."""
+        if self._lines is None:
+            self._lines = _key_lines(self._text or "")
+        line = self._lines.get((table, key or ""))
+        return f"{self.file}:{line}" if line else self.file
+
+
+def _key_lines(text: str) -> dict[tuple[str, str], int]:
+    """Where each ``key =`` of each ``[table]`` is (1-based lines); ``(table, "")`` is the header."""
+    lines: dict[tuple[str, str], int] = {}
+    table = ""
+    for n, raw in enumerate(text.splitlines(), start=1):
+        s = raw.strip()
+        if s.startswith("[") and not s.startswith("[[") and "]" in s:
+            table = s[1:s.index("]")].replace(" ", "").replace('"', "")
+            lines.setdefault((table, ""), n)
+            continue
+        m = re.match(r"([A-Za-z0-9_-]+)\s*=", s)
+        if m:
+            lines.setdefault((table, m.group(1)), n)
+    return lines
+
+
+def _file_key(key: str, raw: dict[str, Any]) -> str:
+    """The key as the file spells it: ``min_deg`` for the ``min_rad`` it was converted to."""
+    deg = key.replace("_rad", "_deg")
+    return deg if key.endswith("_rad") and deg in raw else key
+
+
+def _section(raw: dict[str, Any], cls: type, name: str, where: _Where) -> Any:
+    """Build dataclass `cls` from table `raw`, converting `_deg` keys and checking the limits."""
     if not isinstance(raw, dict):
-        raise ParameterError(f"{where}: [{name}] must be a table")
+        raise ParameterError(f"{where.at(name)}: [{name}] must be a table")
     values: dict[str, Any] = {}
     wanted = {f.name: f for f in fields(cls) if f.name != "source"}
     given = dict(raw)
     for key, value in list(given.items()):
         if "_deg" in key and key.replace("_deg", "_rad") in wanted:
-            if not isinstance(value, (int, float)) or isinstance(value, bool):
-                raise ParameterError(f"{where}: [{name}] {key} must be a number, got {value!r}")
+            if not _is_number(value):
+                raise ParameterError(f"{where.at(name, key)}: [{name}] {key} must be a finite number,"
+                                     f" got {_short(value)}")
             values[key.replace("_deg", "_rad")] = math.radians(value)
             del given[key]
     for key, value in given.items():
         if key not in wanted:
-            raise ParameterError(f"{where}: [{name}] has an unknown key {key!r}")
+            raise ParameterError(f"{where.at(name, key)}: [{name}] has an unknown key {_short(key)}")
         values[key] = value
     missing = sorted(set(wanted) - set(values))
     if missing:
-        raise ParameterError(f"{where}: [{name}] is missing {', '.join(missing)}")
+        raise ParameterError(f"{where.at(name)}: [{name}] is missing {', '.join(missing)}")
+    family = name.split(".")[0]
     for key, value in values.items():
+        spelled = _file_key(key, raw)
         kind = wanted[key].type
-        if kind in ("int", int):
-            if not isinstance(value, int) or isinstance(value, bool):
-                raise ParameterError(f"{where}: [{name}] {key} must be an integer, got {value!r}")
-        elif isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ParameterError(f"{where}: [{name}] {key} must be a number, got {value!r}")
-        elif not math.isfinite(value):
-            raise ParameterError(f"{where}: [{name}] {key} must be finite, got {value!r}")
-        else:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or (
+                kind in ("int", int) and not isinstance(value, int)):
+            noun = "an integer" if kind in ("int", int) else "a number"
+            raise ParameterError(f"{where.at(name, spelled)}: [{name}] {spelled} must be {noun}, got {_short(value)}")
+        if not _is_number(value):
+            raise ParameterError(f"{where.at(name, spelled)}: [{name}] {spelled} must be finite, got {_short(value)}")
+        if kind not in ("int", int):
             values[key] = float(value)
+        lo, hi = LIMITS[f"{family}.{key}"]
+        if not lo <= values[key] <= hi:
+            deg = spelled.endswith("_deg")
+            shown, lo_s, hi_s = (math.degrees(v) if deg else v for v in (values[key], lo, hi))
+            what = "must be positive, got" if values[key] <= 0 < lo else "="
+            raise ParameterError(f"{where.at(name, spelled)}: [{name}] {spelled} {what} {shown:g}: outside"
+                                 f" {lo_s:g}..{hi_s:g}{' deg' if deg else ''} (docs/parameters.md, Limits)")
     return cls(**values)
 
 
-def _check(params: ArmParams, where: str) -> None:
-    """Reject physically meaningless values with a message naming the key."""
-    positive = {
-        "geometry": ("L1", "L2", "L3", "L4"),
-        "pen": ("spring_travel",),
-        "servo": ("rate_rad_s", "time_constant_s", "period_s"),
-        "control": ("rate_hz", "setpoint_cutoff_hz", "setpoint_cutoff_slow_hz",
-                    "speed_filter_hz", "inner_crossover_hz", "outer_crossover_hz"),
-        "ik": ("damping", "tolerance"),
-    }
-    for section, keys in positive.items():
-        obj = getattr(params, section)
-        for key in keys:
-            if getattr(obj, key) <= 0:
-                raise ParameterError(f"{where}: [{section}] {key} must be positive")
-    if params.control.chart_divider < 1 or params.ik.max_iterations < 1:
-        raise ParameterError(f"{where}: [control] chart_divider and [ik] max_iterations must be >= 1")
-    if params.servo.min_rad >= params.servo.max_rad:
-        raise ParameterError(f"{where}: [servo] min_deg must be below max_deg")
+def _is_number(value: Any) -> bool:
+    """A finite int or float (not a bool); a huge integer is not (it overflows a float)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:
+        return False
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    """``repr(value)``, cut to ``limit`` characters: a message never formats a huge value whole."""
+    text = reprlib.repr(value) if isinstance(value, (dict, list, tuple)) else repr(value)
+    return text if len(text) <= limit else text[:limit] + f"...({len(text)} characters)"
+
+
+def _check(params: ArmParams, where: _Where) -> None:
+    """Relations between keys that no single limit expresses; the message names the key and the fix."""
+    s, c, b = params.servo, params.control, params.board
+    if not s.min_rad < s.max_rad:
+        raise ParameterError(f"{where.at('servo', 'max_deg')}: [servo] min_deg must be below max_deg")
+    if not s.pulse_min_s < s.pulse_max_s <= s.period_s:
+        raise ParameterError(f"{where.at('servo', 'pulse_max_s')}: [servo] needs pulse_min_s < pulse_max_s <="
+                             f" period_s, got {s.pulse_min_s:g} s, {s.pulse_max_s:g} s, {s.period_s:g} s")
+    nyquist = c.rate_hz / 2
+    for key in ("setpoint_cutoff_hz", "setpoint_cutoff_slow_hz", "speed_filter_hz", "inner_crossover_hz",
+                "outer_crossover_hz"):
+        if getattr(c, key) >= nyquist:
+            raise ParameterError(f"{where.at('control', key)}: [control] {key} = {getattr(c, key):g} Hz must lie"
+                                 f" below the Nyquist frequency of rate_hz = {c.rate_hz:g} Hz ({nyquist:g} Hz):"
+                                 f" lower it or raise rate_hz")
+    if not c.outer_crossover_hz < c.inner_crossover_hz:
+        raise ParameterError(f"{where.at('control', 'outer_crossover_hz')}: [control] outer_crossover_hz"
+                             f" ({c.outer_crossover_hz:g} Hz) must lie below inner_crossover_hz"
+                             f" ({c.inner_crossover_hz:g} Hz): the position loop wraps the speed loop")
+    if not c.setpoint_cutoff_slow_hz <= c.setpoint_cutoff_hz:
+        raise ParameterError(f"{where.at('control', 'setpoint_cutoff_slow_hz')}: [control]"
+                             f" setpoint_cutoff_slow_hz must not exceed setpoint_cutoff_hz")
+    for key in ("width", "depth"):
+        if getattr(b, key) < b.field_size:
+            raise ParameterError(f"{where.at('board', key)}: [board] {key} ({getattr(b, key):g} m) is smaller"
+                                 f" than the field it holds (field_size = {b.field_size:g} m)")
     for i, d in enumerate(params.drives, start=1):
-        for key in ("supply_v", "resistance_ohm", "inductance_h", "torque_constant", "rotor_inertia",
-                    "gear_ratio", "load_inertia", "gear_stiffness", "encoder_counts"):
-            if getattr(d, key) <= 0:
-                raise ParameterError(f"{where}: [drive.{i}] {key} must be positive")
-        for key in ("motor_viscous", "motor_coulomb", "load_viscous", "gear_clearance", "gear_damping"):
-            if getattr(d, key) < 0:
-                raise ParameterError(f"{where}: [drive.{i}] {key} must not be negative")
+        table = f"drive.{i}"
         if not d.limit_min_rad < d.limit_max_rad:
-            raise ParameterError(f"{where}: [drive.{i}] limit_min_deg must be below limit_max_deg")
+            raise ParameterError(f"{where.at(table, 'limit_max_deg')}: [{table}] limit_min_deg must be below"
+                                 f" limit_max_deg")
         for key in ("index_rad", "park_rad"):
             if not d.limit_min_rad < getattr(d, key) < d.limit_max_rad:
-                raise ParameterError(
-                    f"{where}: [drive.{i}] {key[:-4]}_deg must lie between the limits")
+                spelled = key[:-4] + "_deg"
+                raise ParameterError(f"{where.at(table, spelled)}: [{table}] {spelled} must lie between the"
+                                     f" limits")
+    problem = reach_problem(params)
+    if problem:
+        raise ParameterError(f"{where}: {problem}")
 
 
-def parse_params(data: dict[str, Any], where: str) -> ArmParams:
-    """Build :class:`ArmParams` from a parsed TOML document; `where` names it in errors."""
+#: Heights above the working height at which the whole field must be reachable, m: the
+#: strokes themselves, the pen riding between them, and the moves onto and off the board.
+REACH_LIFTS_M = (0.0, 0.025, 0.05)
+#: Points per side of the grid over the field that the reach check solves for (15 mm apart
+#: on the default 15 cm field); the field's corners and its point nearest the base are among them.
+REACH_GRID = 11
+
+
+def reach_problem(params: ArmParams) -> str | None:
+    """Why the arm cannot work the whole field, or None: the check made when a file is loaded.
+
+    Every point of the field (an 11 x 11 grid, its corners and its point
+    nearest the base axis), from the working height up to 5 cm above it, must
+    be reachable elbow up within the joint limits, with the pen vertical
+    (phi = 0) and with the sponge facing the board (phi = 90 deg, the sponge
+    ``offset`` above the surface).  docs/parameters.md says why.
+    """
+    return _reach_problem(params.geometry, params.board, params.sponge.offset, params.joint_min, params.joint_max)
+
+
+_LIMIT_KEYS = ("[drive.1] limit_{}_deg", "[drive.2] limit_{}_deg", "[drive.3] limit_{}_deg", "[servo] {}_deg")
+
+
+@functools.lru_cache(maxsize=32)
+def _reach_problem(geometry: Geometry, board: Board, sponge_offset: float,
+                   q_min: tuple[float, ...], q_max: tuple[float, ...]) -> str | None:
+    # The closed-form inverse kinematics is the one formula (one place: twin.kinematics);
+    # imported here because the twin imports this module.
+    from .twin.kinematics import UnreachableTargetError, ik_closed_form
+
+    x0, x1, y0, y1 = board.field_bounds()
+    # Cell (1, 1) lies at +x, far from the base (+y); rows grow towards the base, columns towards -x.
+    points = [(x1, y1, "the field's corner at cell (1, 1)"), (x0, y1, "the field's corner at cell (1, 5)"),
+              (x1, y0, "the field's corner at cell (5, 1)"), (x0, y0, "the field's corner at cell (5, 5)"),
+              (min(max(-geometry.l_f, x0), x1), min(max(0.0, y0), y1), "the field's point nearest the base")]
+    steps = [k / (REACH_GRID - 1) for k in range(REACH_GRID)]
+    points += [(x0 + (x1 - x0) * u, y0 + (y1 - y0) * v, "the field's point") for u in steps for v in steps]
+    tools = ((0.0, board.surface_z, "with the pen vertical (phi = 0)"),
+             (math.pi / 2, board.surface_z + sponge_offset, "with the sponge down (phi = 90 deg)"))
+    for phi, z0, tool in tools:
+        for lift in REACH_LIFTS_M:
+            z = z0 + lift
+            for x, y, name in points:
+                place = f"{name} (x = {x:.3f} m, y = {y:.3f} m, z = {z:.3f} m) is out of reach {tool}"
+                try:
+                    q = ik_closed_form((x, y, z, phi), geometry)
+                except UnreachableTargetError as exc:
+                    return (f"{place}: {exc.residual * 1000:.0f} mm beyond what links L2 and L3 reach; move the"
+                            f" field ([board] field_center_x, field_center_y) or change [geometry]")
+                for j in range(4):
+                    if not q_min[j] <= q[j] <= q_max[j]:
+                        side, limit = ("min", q_min[j]) if q[j] < q_min[j] else ("max", q_max[j])
+                        return (f"{place}: it needs q{j + 1} = {math.degrees(q[j]):.1f} deg,"
+                                f" {math.degrees(abs(q[j] - limit)):.1f} deg beyond {_LIMIT_KEYS[j].format(side)}"
+                                f" = {math.degrees(limit):.1f}; move the field or widen the limit")
+    return None
+
+
+def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> ArmParams:
+    """Build :class:`ArmParams` from a parsed TOML document; `where` names it in errors.
+
+    With the document's `text`, messages also name the line of the key.
+    """
+    at = _Where(where, text)
     sections = {"geometry": Geometry, "board": Board, "pen": Pen, "sponge": Sponge,
                 "servo": Servo, "masses": Masses, "control": ControlParams, "ik": IKParams}
     unknown = sorted(set(data) - set(sections) - {"drive"})
     if unknown:
-        raise ParameterError(f"{where}: unknown section(s) {', '.join(unknown)}")
+        raise ParameterError(f"{where}: unknown section(s) {', '.join(str(u)[:30] for u in unknown[:5])}")
     built: dict[str, Any] = {}
     for name, cls in sections.items():
         if name not in data:
             raise ParameterError(f"{where}: missing section [{name}]")
-        built[name] = _section(data[name], cls, name, where)
+        built[name] = _section(data[name], cls, name, at)
     drives_raw = data.get("drive")
     if not isinstance(drives_raw, dict) or sorted(drives_raw) != ["1", "2", "3"]:
         raise ParameterError(f"{where}: needs exactly the tables [drive.1], [drive.2], [drive.3]")
-    drives = tuple(_section(drives_raw[k], DriveParams, f"drive.{k}", where) for k in ("1", "2", "3"))
+    drives = tuple(_section(drives_raw[k], DriveParams, f"drive.{k}", at) for k in ("1", "2", "3"))
     params = ArmParams(drives=drives, source=where, **built)  # type: ignore[arg-type]
-    _check(params, where)
+    _check(params, at)
     return params
 
 
@@ -317,21 +491,40 @@ def load_params(path: str | Path | None = None) -> ArmParams:
     Raises
     ------
     ParameterError
-        The file is missing, not TOML, or a value is missing or implausible;
-        the message names the file, the section and the key.
+        The file is missing, larger than :data:`MAX_FILE_BYTES`, not UTF-8,
+        not TOML, or a value is missing, outside its limits or leaves the
+        field out of reach; the message names the file, the line where it
+        can, the section and the key.
     """
     if path is None:
-        text = resources.files("ttt_sm.data").joinpath(DEFAULT_PARAMS_NAME).read_text()
+        text = resources.files("ttt_sm.data").joinpath(DEFAULT_PARAMS_NAME).read_text(encoding="utf-8")
         where = f"ttt_sm/data/{DEFAULT_PARAMS_NAME}"
     else:
-        p = Path(path)
-        where = str(p)
-        try:
-            text = p.read_text()
-        except OSError as exc:
-            raise ParameterError(f"{where}: cannot read parameter file ({exc.strerror})") from exc
+        where = str(path)
+        text = _read_text(Path(path), where)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{where}: not valid TOML ({exc})") from exc
-    return parse_params(data, where)
+        raise ParameterError(f"{where}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise ParameterError(f"{where}: not valid TOML (arrays or tables nested too deeply)") from None
+    return parse_params(data, where, text)
+
+
+def _read_text(path: Path, where: str) -> str:
+    """The file as UTF-8 text, read no further than :data:`MAX_FILE_BYTES` (a device or pipe may never end)."""
+    try:
+        with path.open("rb") as f:
+            raw = f.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ParameterError(f"{where}: cannot read parameter file ({exc.strerror or exc})") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ParameterError(f"{where}: more than {MAX_FILE_BYTES} bytes: not a parameter file"
+                             f" (the packaged one has about 6 kB)")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise ParameterError(f"{where}:{line}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at column {column});"
+                             f" save the file as UTF-8") from None

@@ -25,12 +25,16 @@ from typing import Any
 import control as ct
 import numpy as np
 
-from ..params import ArmParams
+from ..params import ArmParams, ParameterError
 from .control import DriveGains, Gains, check_drive, max_joint_speed, speed_filter_alpha
 
 
-class TuningError(RuntimeError):
-    """No controller meets the margin limits for a drive's model (see the message)."""
+class TuningError(ParameterError):
+    """No controller meets the margin limits for a drive's model (see the message).
+
+    A :class:`~ttt_sm.params.ParameterError`: the parameter file asks for loops
+    its drives cannot have; the message names the file and the keys to change.
+    """
 
 
 # ---- design rules ------------------------------------------------------------
@@ -195,7 +199,7 @@ def _design_inner(params: ArmParams, drive: int) -> tuple[float, float]:
             if pm >= MIN_PHASE_MARGIN_DEG and gm >= MIN_GAIN_MARGIN_DB:
                 return float(kp), float(kp * wi)
         f *= CROSSOVER_STEP
-    raise TuningError(f"drive {drive}: no speed PI keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
+    raise TuningError(f"{params.source}: drive {drive}: no speed PI keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
                       f"{MIN_GAIN_MARGIN_DB:g} dB down to 5 % of inner_crossover_hz; check [drive.{drive}] "
                       "(gear stiffness and damping, inertias) and [control] speed_filter_hz")
 
@@ -217,7 +221,7 @@ def _design_outer(params: ArmParams, drive: int, kp_w: float, ki_w: float) -> tu
         if pm >= MIN_PHASE_MARGIN_DEG and gm >= MIN_GAIN_MARGIN_DB:
             return float(kp), float(kp * wi)
         f *= CROSSOVER_STEP
-    raise TuningError(f"drive {drive}: no position gain keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
+    raise TuningError(f"{params.source}: drive {drive}: no position gain keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
                       f"{MIN_GAIN_MARGIN_DB:g} dB down to 5 % of outer_crossover_hz; lower "
                       "[control] outer_crossover_hz below the speed loop's crossover")
 

@@ -1,0 +1,42 @@
+"""Settings shared by the fuzz tests of every input surface (docs/reliability.md).
+
+Each surface has a quick property test in the default run (a few hundred
+cases, derandomized so the suite is reproducible) and a long one under the
+``soak`` marker (thousands of fresh random cases).  The property is always
+the same: the surface raises nothing but the project's own error type, and
+its message is one line that names the file, line or argument.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis.strategies import SearchStrategy
+
+#: Cases per surface in the default run, and in the soak run.
+QUICK_EXAMPLES = 200
+SOAK_EXAMPLES = 5000
+
+_COMMON: dict[str, Any] = dict(deadline=None, database=None,
+                               suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much,
+                                                      HealthCheck.data_too_large])
+
+
+def fuzz(*strategies: SearchStrategy[Any], quick: int = QUICK_EXAMPLES, soak: int = SOAK_EXAMPLES
+         ) -> Callable[[Callable[..., None]], tuple[Callable[..., None], Callable[..., None]]]:
+    """Turn a property into ``(quick_test, soak_test)``: bind both to ``test_...`` names."""
+    def wrap(check: Callable[..., None]) -> tuple[Callable[..., None], Callable[..., None]]:
+        quick_test = settings(derandomize=True, max_examples=quick, **_COMMON)(given(*strategies)(check))
+        soak_test = pytest.mark.soak(settings(max_examples=soak, **_COMMON)(given(*strategies)(check)))
+        return quick_test, soak_test
+    return wrap
+
+
+def one_line(message: str, names: str, limit: int = 400) -> None:
+    """The message is one short line and names ``names`` (a file, an argument)."""
+    assert "\n" not in message, message
+    assert len(message) <= limit, message[:200]
+    assert names in message, message

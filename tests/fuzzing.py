@@ -35,8 +35,11 @@ def fuzz(*strategies: SearchStrategy[Any], quick: int = QUICK_EXAMPLES, soak: in
     return wrap
 
 
-def one_line(message: str, names: str, limit: int = 400) -> None:
-    """The message is one short line and names ``names`` (a file, an argument)."""
+def one_line(message: str, names: str, limit: int = 1500) -> None:
+    """The message is one line (no huge value formatted into it) and names ``names`` (a file, an argument).
+
+    The limit leaves room for the lists of valid names some messages give (a chart's 50 states).
+    """
     assert "\n" not in message, message
     assert len(message) <= limit, message[:200]
     assert names in message, message

@@ -14,7 +14,7 @@ from typing import Any
 
 from ..scenario.errors import ScenarioError
 from ..scenario.loader import load_scenario, scenario_files
-from ..scenario.model import Scenario
+from ..scenario.model import Scenario, Step
 from ..scenario.runner import ScenarioResult
 from ..scenario.suite import run_scenarios
 from .common import print_json
@@ -80,10 +80,19 @@ def cmd_scenario_run(args: argparse.Namespace) -> int:
     params = load_params(args.params)
     stream = sys.stderr if args.json else sys.stdout
 
+    live = sys.stderr.isatty()  # a long step shows where it is, on a terminal only
+
     def progress(result: ScenarioResult) -> None:
+        if live:
+            print("\r\033[K", end="", file=sys.stderr, flush=True)
         print(_line(result), file=stream, flush=True)
 
-    report = run_scenarios(scenarios, params, coverage=args.coverage, trace_dir=args.trace, progress=progress)
+    def step_progress(scenario: Scenario, step: Step, t: float, end: float) -> None:
+        print(f"\r\033[K  {scenario.name}: {step.kind} at line {step.where.line}, {t:.0f} s of at most"
+              f" {end:.0f} s simulated", end="", file=sys.stderr, flush=True)
+
+    report = run_scenarios(scenarios, params, coverage=args.coverage, trace_dir=args.trace, progress=progress,
+                           step_progress=step_progress if live else None)
     if args.json:
         print_json(report.to_dict())
     else:

@@ -45,7 +45,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["FUNCTIONS", "KEYWORDS", "UNITS", "Expression", "ExprError", "Ref", "parse"]
+__all__ = ["FUNCTIONS", "KEYWORDS", "MAX_CONDITION_CHARS", "MAX_DEPTH", "UNITS", "Expression", "ExprError", "Ref",
+           "parse"]
+
+#: Longest condition, characters: checked before it is read (a condition is a line or two).
+MAX_CONDITION_CHARS = 2000
+#: Deepest nesting of a condition (brackets, calls, ``not``, ``-``, chained operators): deeper
+#: would exhaust Python's stack in the parser or the evaluator; a person writes a few levels.
+MAX_DEPTH = 40
 
 
 class ExprError(ValueError):
@@ -56,7 +63,16 @@ class ExprError(ValueError):
         self.text = text
         self.column = column
         where = f" at column {column}" if column else ""
-        super().__init__(f"{message}{where} in {text!r}" if text else message)
+        super().__init__(f"{message}{where} in {_excerpt(text, column)}" if text else message)
+
+
+def _excerpt(text: str, column: int, width: int = 40) -> str:
+    """``repr(text)``, or for a long text the part around ``column`` (a message stays one short line)."""
+    if len(text) <= 2 * width:
+        return repr(text)
+    at = max(column - 1, 0)
+    start, end = max(0, at - width), min(len(text), at + width)
+    return ("..." if start else "") + repr(text[start:end]) + ("..." if end < len(text) else "")
 
 
 @dataclass(frozen=True)
@@ -84,6 +100,14 @@ FUNCTIONS: dict[str, tuple[Callable[..., Any], int | None]] = {
 }
 #: Units a number may carry: factor to SI.
 UNITS: dict[str, float] = {"deg": math.pi / 180, "rad": 1.0, "mm": 1e-3, "m": 1.0, "ms": 1e-3, "s": 1.0}
+
+_NUMBER = (int, float)  # bool is an int: true + 1 is 2, as in Python
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:40] + "..."
+
 
 _COMPARE = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
             ">": operator.gt, ">=": operator.ge}
@@ -140,6 +164,7 @@ class _Parser:
         self.tokens = _tokenize(text)
         self.pos = 0
         self.refs: list[Ref] = []
+        self.depth = 0
 
     @property
     def tok(self) -> _Tok:
@@ -170,6 +195,12 @@ class _Parser:
             raise self.error(f"unexpected {self.tok.text!r}; expected 'and', 'or', an operator or the end")
         return node
 
+    def deeper(self) -> None:
+        """One more level of nesting; an error past :data:`MAX_DEPTH` (the stack is finite)."""
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise self.error(f"nested deeper than {MAX_DEPTH} levels")
+
     def parse_or(self) -> Node:
         items = [self.parse_and()]
         while self.take("or"):
@@ -184,7 +215,10 @@ class _Parser:
 
     def parse_not(self) -> Node:
         if self.take("not"):
-            return ("not", self.parse_not())
+            self.deeper()
+            node = ("not", self.parse_not())
+            self.depth -= 1
+            return node
         return self.parse_compare()
 
     def parse_compare(self) -> Node:
@@ -198,23 +232,34 @@ class _Parser:
 
     def parse_sum(self) -> Node:
         node = self.parse_product()
+        levels = 0  # a chain a + b + c nests to the left: each operator is a level of the tree
         while self.tok.kind == "op" and self.tok.text in ("+", "-"):
             op = self.tok.text
             self.pos += 1
+            self.deeper()
+            levels += 1
             node = ("arith", op, node, self.parse_product())
+        self.depth -= levels
         return node
 
     def parse_product(self) -> Node:
         node = self.parse_unary()
+        levels = 0
         while self.tok.kind == "op" and self.tok.text in ("*", "/"):
             op = self.tok.text
             self.pos += 1
+            self.deeper()
+            levels += 1
             node = ("arith", op, node, self.parse_unary())
+        self.depth -= levels
         return node
 
     def parse_unary(self) -> Node:
         if self.take("-"):
-            return ("neg", self.parse_unary())
+            self.deeper()
+            node = ("neg", self.parse_unary())
+            self.depth -= 1
+            return node
         return self.parse_atom()
 
     def parse_atom(self) -> Node:
@@ -233,8 +278,10 @@ class _Parser:
             self.pos += 1
             return ("const", tok.text[1:-1])
         if self.take("("):
+            self.deeper()
             node = self.parse_or()
             self.expect(")", "')'")
+            self.depth -= 1
             return node
         if tok.kind != "name":
             raise self.error(f"expected a number, a name or '(', found {self.found}")
@@ -271,10 +318,12 @@ class _Parser:
         if tok.text not in FUNCTIONS:
             raise self.error(f"unknown function {tok.text!r}; functions: {', '.join(FUNCTIONS)}", tok)
         self.expect("(", "'('")
+        self.deeper()
         args = [self.parse_or()]
         while self.take(","):
             args.append(self.parse_or())
         self.expect(")", "')' after the arguments")
+        self.depth -= 1
         arity = FUNCTIONS[tok.text][1]
         if arity is not None and len(args) != arity:
             raise self.error(f"{tok.text}() takes {arity} argument(s), got {len(args)}", tok)
@@ -295,10 +344,10 @@ def _compile(node: Node, get: Callable[[Ref], Callable[[], Any]], text: str) -> 
         f = _compile(node[1], get, text)
 
         def neg() -> Any:
-            try:
-                return -f()
-            except TypeError as exc:
-                raise ExprError(f"cannot compute '-': {exc}", text) from None
+            value = f()
+            if not isinstance(value, _NUMBER):
+                raise ExprError(f"cannot compute '-' of {type(value).__name__} {_short(value)}", text)
+            return -value
         return neg
     if kind == "not":
         f = _compile(node[1], get, text)
@@ -313,9 +362,13 @@ def _compile(node: Node, get: Callable[[Ref], Callable[[], Any]], text: str) -> 
         left, right = _compile(node[2], get, text), _compile(node[3], get, text)
 
         def arith() -> Any:
+            a, b = left(), right()
+            if not (isinstance(a, _NUMBER) and isinstance(b, _NUMBER)):  # "x" * 10**9 is a memory bomb
+                raise ExprError(f"cannot compute {node[1]!r} of {type(a).__name__} {_short(a)} and"
+                                f" {type(b).__name__} {_short(b)}: arithmetic takes numbers", text)
             try:
-                return op(left(), right())
-            except (ZeroDivisionError, TypeError) as exc:
+                return op(a, b)
+            except (ZeroDivisionError, OverflowError) as exc:
                 raise ExprError(f"cannot compute {node[1]!r}: {exc}", text) from None
         return arith
     if kind == "compare":
@@ -373,7 +426,11 @@ class Expression:
 def parse(text: str) -> Expression:
     """Parse a condition; raise :class:`ExprError` (with the column) if it is not one."""
     if not isinstance(text, str):
-        raise ExprError(f"a condition is text, got {type(text).__name__} {text!r}")
+        shown = repr(text) if len(repr(text)) <= 60 else repr(text)[:60] + "..."
+        raise ExprError(f"a condition is text, got {type(text).__name__} {shown}")
+    if len(text) > MAX_CONDITION_CHARS:
+        raise ExprError(f"a condition is at most {MAX_CONDITION_CHARS} characters, got {len(text)}",
+                        text[:40] + "...")
     parser = _Parser(text)
     tree = parser.parse()
     return Expression(text, tree, tuple(parser.refs))

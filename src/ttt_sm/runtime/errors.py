@@ -14,7 +14,9 @@ def suggest(word: object, options: Iterable[str]) -> str:
     The one name-suggestion helper of the package: the debugger and the
     scenario loader name a chart, state, event or datum the same way.
     """
-    close = difflib.get_close_matches(str(word), list(options), n=1, cutoff=0.6)
+    if not isinstance(word, str) or len(word) > 100:  # no name is that long: nothing to compare
+        return ""
+    close = difflib.get_close_matches(word, list(options), n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 

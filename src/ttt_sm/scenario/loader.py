@@ -16,6 +16,7 @@ them).
 from __future__ import annotations
 
 import math
+import reprlib
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -25,6 +26,7 @@ from ..runtime.conditions import KEYWORDS, ExprError, Expression, parse
 from ..runtime.errors import suggest
 from .errors import ScenarioError
 from .model import (
+    DEFAULT_MAX_STEP_S,
     BareCharts,
     Catalog,
     ChartRef,
@@ -45,7 +47,7 @@ from .model import (
 )
 from .source import MarkedDict, MarkedList, load_yaml, load_yaml_file
 
-TOP_KEYS = ("name", "description", "chart", "charts", "seed", "start", "steps")
+TOP_KEYS = ("name", "description", "chart", "charts", "seed", "max_step_s", "start", "steps")
 #: Step kinds, and the extra keys each allows beside its own.
 STEP_OPTIONS: dict[str, tuple[str, ...]] = {
     "set": ("force",),
@@ -62,6 +64,12 @@ MATCH_MODES = ("subsequence", "exact")
 BARE_SIGNALS: Mapping[str, int | None] = {"t": None}
 
 
+def _r(value: Any, limit: int = 60) -> str:
+    """``repr(value)`` cut to ``limit`` characters: a message never formats a huge value whole."""
+    text = reprlib.repr(value) if isinstance(value, (list, dict, tuple)) else repr(value)
+    return text if len(text) <= limit else text[:limit] + f"...({len(text)} characters)"
+
+
 def _type_name(value: Any) -> str:
     if value is None:
         return "nothing"
@@ -72,7 +80,7 @@ def _type_name(value: Any) -> str:
     if isinstance(value, (int, float)):
         return f"number {value}"
     if isinstance(value, str):
-        return f"text {value!r}"
+        return f"text {_r(value)}"
     if isinstance(value, list):
         return "a list"
     if isinstance(value, dict):
@@ -91,6 +99,7 @@ class _Checker:
         self.file = file
         self.catalog = catalog
         self.bare: BareCharts | None = None
+        self.max_step_s = DEFAULT_MAX_STEP_S
         #: The charts the steps may name: the robot's, or the bare ones.
         robot = catalog.robot_charts
         self.charts: Mapping[str, type[TickChart]] = {
@@ -127,6 +136,8 @@ class _Checker:
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise self.error(doc.line_of("seed"),
                              f"seed: expected a whole number >= 0, got {_type_name(seed)}")
+        if "max_step_s" in doc:
+            self.max_step_s = self.number(doc, "max_step_s", "max_step_s", bounded=False)
         self.bare = self.bare_charts(doc)
         if self.bare is not None:
             self.charts = self.bare.charts
@@ -140,7 +151,7 @@ class _Checker:
         steps = tuple(self.step(item, line) for item, line in zip(steps_data, steps_data.item_lines,
                                                                       strict=True))
         return Scenario(name=name, file=self.file, steps=steps, description=description, seed=seed,
-                        start=start, where=Where(self.file, doc.line), bare=self.bare)
+                        start=start, where=Where(self.file, doc.line), bare=self.bare, max_step_s=self.max_step_s)
 
     def bare_charts(self, doc: MarkedDict) -> BareCharts | None:
         """The charts to run alone, or None for the robot.
@@ -171,10 +182,10 @@ class _Checker:
         charts: dict[str, type[TickChart]] = {}
         for name, chart, n_line in pairs:
             if not isinstance(chart, str) or chart not in known:
-                raise self.error(n_line, f"{key}: unknown chart {chart!r}{suggest(chart, known)};"
+                raise self.error(n_line, f"{key}: unknown chart {_r(chart)}{suggest(chart, known)};"
                                          f" charts: {', '.join(known)}")
             if not isinstance(name, str) or not name.isidentifier() or name in KEYWORDS:
-                raise self.error(n_line, f"charts: {name!r} cannot name a chart in a condition: use letters,"
+                raise self.error(n_line, f"charts: {_r(name)} cannot name a chart in a condition: use letters,"
                                          " digits and _")
             if name in known and name != chart:
                 raise self.error(n_line, f"charts: {name} is the name of a chart: name the {chart} otherwise")
@@ -187,7 +198,7 @@ class _Checker:
         allowed = tuple(allowed)
         for key in mapping:
             if key not in allowed:
-                raise self.error(mapping.key_lines[key], f"{what}: unknown key {key!r}{suggest(key, allowed)};"
+                raise self.error(mapping.key_lines[key], f"{what}: unknown key {_r(key)}{suggest(key, allowed)};"
                                                          f" keys: {', '.join(allowed)}")
 
     def text(self, mapping: MarkedDict, key: str) -> str:
@@ -196,7 +207,8 @@ class _Checker:
             raise self.error(mapping.line_of(key), f"{key}: expected text, got {_type_name(value)}")
         return value.strip()
 
-    def number(self, mapping: MarkedDict, key: str, what: str, positive: bool = True) -> float:
+    def number(self, mapping: MarkedDict, key: str, what: str, positive: bool = True, bounded: bool = True) -> float:
+        """A number of seconds; ``bounded``: at most ``max_step_s`` (simulated time a step may run)."""
         value = mapping[key]
         line = mapping.line_of(key)
         if not _is_number(value):
@@ -205,6 +217,10 @@ class _Checker:
             raise self.error(line, f"{what}: {key} must be > 0, got {value}")
         if not positive and value < 0:
             raise self.error(line, f"{what}: {key} must be >= 0, got {value}")
+        if bounded and value > self.max_step_s:
+            raise self.error(line, f"{what}: {key} {value:g} s is beyond {self.max_step_s:g} s of simulated time,"
+                                   f" the longest a step may run; if it is meant, put 'max_step_s: {value:g}'"
+                                   " at the top of the file")
         return float(value)
 
     def start(self, data: Any, line: int) -> Start:
@@ -217,7 +233,7 @@ class _Checker:
             q = data["q_deg"]
             if not isinstance(q, list) or len(q) not in (3, 4) or not all(_is_number(v) for v in q):
                 raise self.error(data.line_of("q_deg"), "start: q_deg expected a list of 3 or 4 joint"
-                                                        f" angles in degrees (q1, q2, q3[, q4]), got {q!r}")
+                                                        f" angles in degrees (q1, q2, q3[, q4]), got {_r(q)}")
             q_deg = tuple(float(v) for v in q) + ((0.0,) if len(q) == 3 else ())
         settle = self.number(data, "settle_s", "start", positive=False) if "settle_s" in data else 0.0
         return Start(q_deg=q_deg, settle_s=settle, where=Where(self.file, data.line))
@@ -231,11 +247,11 @@ class _Checker:
         kinds = [k for k in item if k in STEP_OPTIONS]
         if not kinds:
             key = next(iter(item))
-            raise self.error(item.key_lines[key], f"unknown step kind {key!r}{suggest(key, STEP_OPTIONS)};"
+            raise self.error(item.key_lines[key], f"unknown step kind {_r(key)}{suggest(key, STEP_OPTIONS)};"
                                                   f" step kinds: {', '.join(STEP_OPTIONS)}")
         if len(kinds) > 1:
-            raise self.error(item.key_lines[kinds[1]], f"one step, two actions ({kinds[0]!r} and"
-                                                       f" {kinds[1]!r}): start a new step with '- '")
+            raise self.error(item.key_lines[kinds[1]], f"one step, two actions ({_r(kinds[0])} and"
+                                                       f" {_r(kinds[1])}): start a new step with '- '")
         kind = kinds[0]
         self.keys(item, (kind, *STEP_OPTIONS[kind]), kind)
         where = Where(self.file, item.key_lines[kind])
@@ -291,7 +307,7 @@ class _Checker:
         events = self.charts[chart].structure().user_events
         if event not in events:
             listed = ", ".join(events) or "(none: all its transitions are tick transitions)"
-            raise self.error(value.line_of("event"), f"post: {chart} handles no event {event!r}"
+            raise self.error(value.line_of("event"), f"post: {chart} handles no event {_r(event)}"
                                                      f"{suggest(event, events)}; events: {listed}")
         data = value.get("data", {})
         if not isinstance(data, dict) or not all(isinstance(k, str) and k.isidentifier() for k in data):
@@ -393,7 +409,7 @@ class _Checker:
                                    f" {', '.join(charts)}); run it alone: put 'chart: {name}' at the top"
                                    " of the file")
         if not isinstance(name, str) or name not in charts:
-            raise self.error(line, f"{what}: unknown chart {name!r}{suggest(name, charts)};"
+            raise self.error(line, f"{what}: unknown chart {_r(name)}{suggest(name, charts)};"
                                    f" charts: {', '.join(charts)}")
         return name
 
@@ -402,7 +418,7 @@ class _Checker:
         states = states if states is not None else chart_states(self.charts[chart])
         if not isinstance(name, str) or name not in states:
             real = [s for s, k in states.items() if k != "history"]
-            raise self.error(line, f"{what}: {chart} has no state {name!r}{suggest(name, real)};"
+            raise self.error(line, f"{what}: {chart} has no state {_r(name)}{suggest(name, real)};"
                                    f" states: {', '.join(real)}")
         if states[name] == "history":
             raise self.error(line, f"{what}: {chart}.{name} is a history pseudo-state: it is never entered"
@@ -426,7 +442,7 @@ class _Checker:
             if name in data:
                 problem = f"{chart}.{name} is an {data[name]}, not an input"
             else:
-                problem = f"{chart} has no input {name!r}{suggest(name, inputs)}"
+                problem = f"{chart} has no input {_r(name)}{suggest(name, inputs)}"
             raise self.error(line, f"{what}: {problem}; inputs: {', '.join(inputs)}")
         return ChartRef(chart, name)
 
@@ -440,7 +456,7 @@ class _Checker:
         return expr
 
     def expr_ref(self, ref: Any, expr: Expression, line: int, what: str) -> None:
-        at = f" in {expr.text!r}"
+        at = f" in {_r(expr.text, 120)}"
         if ref.chart is not None:
             self.chart_name(ref.chart, line, what)
             cls = self.charts[ref.chart]
@@ -450,7 +466,7 @@ class _Checker:
                                        f" active{at}")
             if ref.name not in data and ref.name not in states:
                 names = [*data, *(s for s, k in states.items() if k != "history")]
-                raise self.error(line, f"{what}: {ref.chart} has no datum or state {ref.name!r}"
+                raise self.error(line, f"{what}: {ref.chart} has no datum or state {_r(ref.name)}"
                                        f"{suggest(ref.name, names)}{at}; data: {', '.join(data)}")
             if ref.index is not None:
                 raise self.error(line, f"{what}: {ref.chart}.{ref.name} is not a list: no [{ref.index}]{at}")
@@ -461,7 +477,7 @@ class _Checker:
                                    f" without the arm: a condition reads the charts' data and states, and"
                                    f" t (chart time){at}")
         if ref.name not in signals:
-            raise self.error(line, f"{what}: unknown name {ref.name!r}{suggest(ref.name, signals)}{at};"
+            raise self.error(line, f"{what}: unknown name {_r(ref.name)}{suggest(ref.name, signals)}{at};"
                                    f" a chart datum is Chart.name; signals: {', '.join(signals)}")
         size = signals[ref.name]
         if size is None and ref.index is not None:

@@ -175,6 +175,12 @@ class BareCharts:
         return ", ".join(n if n == c.__name__ else f"{n} ({c.__name__})" for n, c in self.charts.items())
 
 
+#: The longest a step may run unless the file raises it with ``max_step_s:``, seconds of
+#: simulated time (a ``run``, a ``run_until``'s ``timeout_s``, an ``expect``'s ``within_s`` or
+#: ``for_s``, the start's ``settle_s``): a typo like ``timeout_s: 1e12`` would never end.
+DEFAULT_MAX_STEP_S = 600.0
+
+
 @dataclass(frozen=True)
 class Scenario:
     """A loaded, checked scenario file; ``bare`` is set for a bare-chart scenario."""
@@ -187,6 +193,8 @@ class Scenario:
     start: Start = Start()
     where: Where | None = None
     bare: BareCharts | None = None
+    #: The longest any step may run, seconds of simulated time (``max_step_s:`` raises it).
+    max_step_s: float = DEFAULT_MAX_STEP_S
 
 
 @dataclass(frozen=True)

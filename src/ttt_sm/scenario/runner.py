@@ -47,6 +47,12 @@ from .model import (
     chart_states,
 )
 
+#: A long step reports how far it is every this many seconds of simulated time.
+PROGRESS_EVERY_S = 5.0
+
+#: ``progress(scenario, step, t, t_end)``: a long step is at simulated time ``t`` of at most ``t_end``.
+StepProgress = Callable[[Scenario, Step, float, float], None]
+
 
 class RobotLike(Protocol):
     """What the runner needs from a robot (:class:`~ttt_sm.app.robot.Robot` has it all)."""
@@ -240,8 +246,11 @@ def _subsequence_gap(expected: Sequence[str], actual: Sequence[str]) -> str | No
 class _Run:
     """The steps of one scenario on one robot."""
 
-    def __init__(self, scenario: Scenario, robot: RobotLike, log: StateLog) -> None:
+    def __init__(self, scenario: Scenario, robot: RobotLike, log: StateLog,
+                 progress: StepProgress | None = None) -> None:
         self.scenario = scenario
+        self.progress = progress
+        self.step: Step | None = None
         self.robot = robot
         self.log = log
         self.chart_dt = robot.params.control.chart_dt
@@ -257,6 +266,7 @@ class _Run:
     def run(self) -> None:
         for step in self.scenario.steps:
             self.steps_run += 1
+            self.step = step
             try:
                 getattr(self, f"do_{step.kind}")(step)
             except _Stop:
@@ -274,8 +284,26 @@ class _Run:
             raise _Stop
 
     def advance(self, timeout_s: float, until: Callable[[], bool] | None = None) -> bool:
-        """Run chart steps until `until()` holds (checked after each) or `timeout_s` passes."""
+        """Run chart steps until `until()` holds (checked after each) or `timeout_s` passes.
+
+        A long advance calls ``progress`` every :data:`PROGRESS_EVERY_S` of simulated time.
+        """
+        if timeout_s > self.scenario.max_step_s * (1 + 1e-9):
+            assert self.step is not None
+            self.fail(self.step, f"{self.step.kind}: {_seconds(timeout_s)} is beyond"
+                                 f" {_seconds(self.scenario.max_step_s)} of simulated time, the longest a step"
+                                 f" may run; if it is meant, put 'max_step_s: {timeout_s:g}' at the top of the file",
+                      stop=True)
+        every = max(1, int(round(PROGRESS_EVERY_S / self.chart_dt)))
+        calls = 0
+        end = self.robot.t + timeout_s
+
         def predicate() -> bool:
+            nonlocal calls
+            calls += 1
+            if self.progress is not None and calls % every == 0:
+                assert self.step is not None
+                self.progress(self.scenario, self.step, self.robot.t, end)
             if self.pending_sets:
                 self.check_pending_sets()
             return until() if until is not None else False
@@ -453,7 +481,8 @@ def _check_start(scenario: Scenario, params: ArmParams) -> str | None:
 
 def run_scenario(scenario: Scenario, params: ArmParams, *, coverage: Coverage | None = None,
                  listeners: Sequence[object] = (),
-                 robot_factory: RobotFactory | None = None) -> ScenarioResult:
+                 robot_factory: RobotFactory | None = None,
+                 progress: StepProgress | None = None) -> ScenarioResult:
     """Run one loaded scenario on a new robot.
 
     Parameters
@@ -470,6 +499,10 @@ def run_scenario(scenario: Scenario, params: ArmParams, *, coverage: Coverage | 
     robot_factory : callable, optional
         Builds the robot (tests use a stand-in); by default the simulated arm, or
         for a bare-chart scenario its charts alone (:class:`ChartsOnly`).
+    progress : callable, optional
+        ``progress(scenario, step, t, t_end)``, called every
+        :data:`PROGRESS_EVERY_S` of simulated time while a step runs (the
+        CLI shows it on a terminal).
     """
     wall0 = time.perf_counter()
     start_where = scenario.start.where or scenario.where or Where(scenario.file, 0)
@@ -483,7 +516,7 @@ def run_scenario(scenario: Scenario, params: ArmParams, *, coverage: Coverage | 
     log.record_initial(robot.charts.values())
     if coverage is not None:
         coverage.observe(*robot.charts.values())
-    run = _Run(scenario, robot, log)
+    run = _Run(scenario, robot, log, progress)
     run.run()
     return ScenarioResult(scenario.name, scenario.file, tuple(run.failures), float(robot.t),
                           time.perf_counter() - wall0, run.steps_run, len(scenario.steps))

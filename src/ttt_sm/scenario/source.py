@@ -8,6 +8,12 @@ refuses a key given twice in one mapping, which plain YAML silently accepts
 (the second ``set:`` of a step would hide the first), and reads booleans as
 YAML 1.2 does: only ``true`` and ``false`` (``on``, ``off``, ``yes``, ``no``
 stay text: they may be state names).
+
+It refuses what could make a small file take the machine down (limits in
+docs/reliability.md): files over :data:`MAX_FILE_BYTES`, aliases (``*name``:
+ten lines of them expand to a billion values, the "billion laughs"), and
+nesting deeper than :data:`MAX_NESTING` levels (it would exhaust Python's
+stack).  Text that is not UTF-8 is named by line and column.
 """
 
 from __future__ import annotations
@@ -19,6 +25,11 @@ from typing import Any
 import yaml
 
 from .errors import ScenarioError
+
+#: Largest scenario file read, bytes (the longest packaged one has about 3 kB).
+MAX_FILE_BYTES = 1_000_000
+#: Deepest nesting of mappings and lists in a scenario file (the format needs 4).
+MAX_NESTING = 40
 
 
 class MarkedDict(dict[Any, Any]):
@@ -45,7 +56,24 @@ def _line(node: yaml.Node) -> int:
 
 
 class MarkedLoader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` that keeps line numbers and refuses duplicate keys."""
+    """``yaml.SafeLoader`` that keeps line numbers and refuses duplicate keys, aliases and deep nesting."""
+
+    _depth = 0
+
+    def compose_node(self, parent: yaml.Node | None, index: Any) -> yaml.Node:  # type: ignore[override]
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent):
+            raise ScenarioError(self.name, event.start_mark.line + 1,
+                                f"YAML aliases (*{_cut(event.anchor)}) are not allowed in a scenario: write each"
+                                " value out (aliases can expand a small file to gigabytes)")
+        self._depth += 1
+        if self._depth > MAX_NESTING:
+            raise ScenarioError(self.name, event.start_mark.line + 1,
+                                f"nested deeper than {MAX_NESTING} levels: not a scenario")
+        try:
+            return super().compose_node(parent, index)  # type: ignore[no-any-return]
+        finally:
+            self._depth -= 1
 
     def construct_marked_map(self, node: yaml.MappingNode) -> Any:
         data = MarkedDict()
@@ -88,12 +116,22 @@ MarkedLoader.yaml_implicit_resolvers = {
 MarkedLoader.add_implicit_resolver(_BOOL, re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
 
 
+def _cut(text: Any, limit: int = 40) -> str:
+    text = str(text)
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
 def load_yaml(text: str, file: str) -> Any:
     """Parse YAML text safely; a syntax error becomes a :class:`ScenarioError` at its line."""
-    loader = MarkedLoader(text)
+    try:
+        loader = MarkedLoader(text)
+    except yaml.reader.ReaderError as exc:  # a character YAML does not allow, found before parsing
+        raise _reader_error(exc, text, file) from None
     loader.name = file
     try:
         return loader.get_single_data()
+    except yaml.reader.ReaderError as exc:
+        raise _reader_error(exc, text, file) from None
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         problem = exc.problem or exc.context or "not valid YAML"
@@ -106,16 +144,34 @@ def load_yaml(text: str, file: str) -> Any:
         line = mark.line + 1 if mark is not None else 0
         raise ScenarioError(file, line, f"not valid YAML: {problem}") from None
     except yaml.YAMLError as exc:
-        raise ScenarioError(file, 0, f"not valid YAML: {exc}") from None
+        raise ScenarioError(file, 0, f"not valid YAML: {_cut(exc, 200)}") from None
     finally:
         loader.dispose()
 
 
+def _reader_error(exc: yaml.reader.ReaderError, text: str, file: str) -> ScenarioError:
+    at = exc.position
+    line = text.count("\n", 0, at) + 1
+    column = at - (text.rfind("\n", 0, at) + 1) + 1
+    return ScenarioError(file, line, f"not valid YAML: character #x{exc.character:04x} at column {column}:"
+                                     " special characters are not allowed")
+
+
 def load_yaml_file(path: str | Path) -> Any:
-    """Read and parse a YAML file (see :func:`load_yaml`)."""
+    """Read and parse a YAML file (see :func:`load_yaml`): at most :data:`MAX_FILE_BYTES`, UTF-8."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        with path.open("rb") as f:
+            raw = f.read(MAX_FILE_BYTES + 1)  # a device or a pipe may never end
     except OSError as exc:
         raise ScenarioError(str(path), 0, f"cannot read the file: {exc.strerror or exc}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ScenarioError(str(path), 0, f"more than {MAX_FILE_BYTES} bytes: not a scenario file")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise ScenarioError(str(path), line, f"not UTF-8 text (byte 0x{raw[exc.start]:02x} at column {column});"
+                                             " save the file as UTF-8") from None
     return load_yaml(text, str(path))

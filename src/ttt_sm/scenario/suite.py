@@ -11,7 +11,7 @@ from typing import Any
 from ..params import ArmParams
 from ..runtime.listeners import Coverage, CoverageReport, Trace
 from .model import Scenario
-from .runner import ScenarioResult, run_scenario
+from .runner import ScenarioResult, StepProgress, run_scenario
 
 
 @dataclass(frozen=True)
@@ -59,18 +59,22 @@ def coverage_dict(report: CoverageReport) -> dict[str, Any]:
 
 def run_scenarios(scenarios: Iterable[Scenario], params: ArmParams, *, coverage: bool = False,
                   trace_dir: str | Path | None = None,
-                  progress: Callable[[ScenarioResult], None] | None = None) -> RunReport:
+                  progress: Callable[[ScenarioResult], None] | None = None,
+                  step_progress: StepProgress | None = None) -> RunReport:
     """Run scenarios one after another; with ``coverage``, one report for them all.
 
     ``trace_dir`` writes each scenario's transitions as JSON Lines,
-    ``<file stem>.jsonl``, to see what the charts did.
+    ``<file stem>.jsonl``, to see what the charts did.  ``progress`` hears of
+    each finished scenario, ``step_progress`` of a long step on its way
+    (see :func:`~.runner.run_scenario`).
     """
     wall0 = time.perf_counter()
     cov = Coverage() if coverage else None
     results = []
     for scenario in scenarios:
         trace = Trace() if trace_dir is not None else None
-        result = run_scenario(scenario, params, coverage=cov, listeners=[trace] if trace else [])
+        result = run_scenario(scenario, params, coverage=cov, listeners=[trace] if trace else [],
+                              progress=step_progress)
         if trace is not None and trace_dir is not None:
             trace.write_jsonl(Path(trace_dir) / f"{Path(scenario.file).stem}.jsonl")
         results.append(result)

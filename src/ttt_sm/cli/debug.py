@@ -24,6 +24,8 @@ def register(sub: Any) -> argparse.ArgumentParser:
                     help="joint angles before power-on, degrees (default: the twin's rest pose)")
     sp.add_argument("--settle", metavar="SECONDS", type=float, default=0.0,
                     help="let the unpowered arm settle under gravity first (default 0)")
+    sp.add_argument("--max-run", metavar="SECONDS", type=float, default=None,
+                    help="the longest one command (run, next, step, tick) may run, simulated seconds (default 600)")
     sp.add_argument("--commands", metavar="FILE", default=None,
                     help="run the commands in FILE ('-': standard input) and quit;"
                          " standard input is read the same way when it is not a terminal")
@@ -46,16 +48,22 @@ def parse_start(text: str) -> tuple[float, ...]:
 
 def cmd_debug(args: argparse.Namespace) -> int:
     """Build the robot, then run the REPL: scripted (file or pipe) or interactive."""
-    from ..debug.debugger import Debugger
+    from ..debug.debugger import DEFAULT_MAX_RUN_S, Debugger
     from ..debug.shell import DebugShell
     from ..params import load_params
 
+    max_run = DEFAULT_MAX_RUN_S if args.max_run is None else args.max_run
+    if not (math.isfinite(max_run) and max_run > 0):
+        raise CliError(f"--max-run must be a positive number of seconds, got {args.max_run}")
     params = load_params(getattr(args, "params", None))
     try:
         q_start = parse_start(args.start) if args.start else None
-        if args.settle < 0 or not math.isfinite(args.settle):
+        if not args.settle >= 0 or not math.isfinite(args.settle):
             raise ValueError(f"--settle must be >= 0 seconds, got {args.settle}")
-        dbg = Debugger.build(params, seed=args.seed, q_start=q_start, settle_s=args.settle)
+        if args.settle > max_run:
+            raise ValueError(f"--settle: {args.settle:g} s is beyond {max_run:g} s of simulated time, the longest"
+                             " one command runs (raise it with --max-run)")
+        dbg = Debugger.build(params, seed=args.seed, q_start=q_start, settle_s=args.settle, max_run_s=max_run)
     except ValueError as exc:  # a bad pose (SimError), a bad option
         raise CliError(str(exc)) from exc
     shell = DebugShell(dbg)

@@ -24,7 +24,7 @@ import math
 import signal
 import threading
 from collections import deque
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -41,6 +41,12 @@ from .names import RobotNames, datum_decl, parse_input_value
 from .records import Action, StopKind, StopReason
 from .replay import Recipe, ReplayResult, RobotRecipe, differences, fingerprint
 
+#: The longest one command (run, next, step, tick) may run unless raised, seconds of
+#: simulated time: a typo like ``run 1e12`` would never end.  ``ttt-sm debug --max-run``.
+DEFAULT_MAX_RUN_S = 600.0
+#: A long run tells :attr:`Debugger.progress` where it is every this many simulated seconds.
+PROGRESS_EVERY_S = 5.0
+
 
 class Debugger:
     """Step through a :class:`Robot`'s charts: the API under ``ttt-sm debug`` (and a GUI).
@@ -53,12 +59,23 @@ class Debugger:
         How to build the same robot again, for :meth:`replay`.  By default it
         is read from the robot when it has not run yet (parameters, seed and
         the pose it was powered on in); :meth:`build` records it too.
+    max_run_s : float
+        The longest one command may run, seconds of simulated time
+        (:data:`DEFAULT_MAX_RUN_S`); longer is refused before a step is taken.
     """
 
-    def __init__(self, robot: Robot, recipe: Recipe | None = None) -> None:
+    def __init__(self, robot: Robot, recipe: Recipe | None = None, *,
+                 max_run_s: float = DEFAULT_MAX_RUN_S) -> None:
         if recipe is None and robot.steps == 0:
             recipe = RobotRecipe.of(robot)
+        if not (isinstance(max_run_s, (int, float)) and math.isfinite(max_run_s) and max_run_s > 0):
+            raise DebugError(f"max_run_s must be a positive number of seconds, got {max_run_s!r}")
         self.recipe = recipe
+        self.max_run_s = float(max_run_s)
+        #: ``progress(t, t_end)``, called every :data:`PROGRESS_EVERY_S` of simulated time while a
+        #: command runs (the REPL shows it on a terminal); None: silent.
+        self.progress: Callable[[float, float], None] | None = None
+        self._furthest_steps = robot.steps
         self.breakpoints: list[Breakpoint] = []
         self.listener = BreakListener(self.breakpoints)
         self.actions: list[Action] = []
@@ -72,11 +89,11 @@ class Debugger:
 
     @classmethod
     def build(cls, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
-              settle_s: float = 0.0) -> Debugger:
+              settle_s: float = 0.0, *, max_run_s: float = DEFAULT_MAX_RUN_S) -> Debugger:
         """A debugger on a new robot, with its recipe for :meth:`replay`."""
         recipe = RobotRecipe(params, seed, None if q_start is None else tuple(float(v) for v in q_start),
                              settle_s)
-        return cls(recipe.build(), recipe)
+        return cls(recipe.build(), recipe, max_run_s=max_run_s)
 
     def _attach(self, robot: Robot) -> None:
         self.robot = robot
@@ -163,11 +180,14 @@ class Debugger:
     def step(self, n: int = 1) -> StopReason:
         """Run ``n`` control steps (fewer if a breakpoint hits)."""
         _check_count(n, "step")
+        self._check_bound(n * self._dt, "step", f"{n} control steps ({n * self._dt:g} s)")
         return self._advance(n, end="done")
 
     def tick(self, n: int = 1) -> StopReason:
         """Run up to and through the next ``n`` chart ticks (fewer if a breakpoint hits)."""
         _check_count(n, "tick")
+        seconds = n * self._divider * self._dt
+        self._check_bound(seconds, "tick", f"{n} chart ticks ({seconds:g} s)")
         return self._advance((n + 1) * self._divider, ticks=n, end="done")
 
     def next(self, timeout_s: float = 10.0) -> StopReason:
@@ -181,7 +201,13 @@ class Debugger:
     def _steps_for(self, seconds: float, what: str) -> int:
         if not (isinstance(seconds, (int, float)) and math.isfinite(seconds) and seconds > 0):
             raise DebugError(f"{what}: the time must be a positive number of seconds, got {seconds!r}")
+        self._check_bound(seconds, what, f"{seconds:g} s")
         return max(1, int(round(seconds / self._dt)))
+
+    def _check_bound(self, seconds: float, what: str, asked: str) -> None:
+        if seconds > self.max_run_s * (1 + 1e-9):
+            raise DebugError(f"{what}: {asked} is beyond {self.max_run_s:g} s of simulated time, the longest one"
+                             f" command runs (start the debugger with --max-run SECONDS to allow more)")
 
     def _advance(self, max_steps: int, *, ticks: int | None = None, until_transition: bool = False,
                  end: StopKind = "timeout") -> StopReason:
@@ -196,8 +222,10 @@ class Debugger:
         kind: StopKind = end
         when = [bp for bp in self.breakpoints if bp.enabled and bp.kind == "when"]
         watch_events = any(bp.enabled and bp.kind == "event" for bp in self.breakpoints)
+        report_every = max(1, int(round(PROGRESS_EVERY_S / self._dt)))
+        t_end = robot.t + max_steps * self._dt
         with self._sigint_pauses():
-            for _ in range(max_steps):
+            for done in range(1, max_steps + 1):
                 ticking = robot.steps % divider == 0
                 pending = [[e for e, _ in c.pending_events] for c in charts] \
                     if ticking and watch_events else None
@@ -223,6 +251,8 @@ class Debugger:
                 if self._pause.is_set():
                     kind = "paused"
                     break
+                if self.progress is not None and done % report_every == 0:
+                    self.progress(robot.t, t_end)
         self._remember()
         return StopReason(kind, robot.t, robot.steps, robot.chart_ticks, tuple(listener.hits),
                           tuple(self.trace.records[first:]))
@@ -319,7 +349,10 @@ class Debugger:
 
     def save_trace(self, path: str | Path) -> Path:
         """Write every transition of the session so far as JSON Lines."""
-        return self.trace.write_jsonl(path)
+        try:
+            return self.trace.write_jsonl(path)
+        except OSError as exc:
+            raise DebugError(f"trace save: cannot write {str(path)!r}: {exc.strerror or exc}") from None
 
     def diagram(self, chart: str, path: str | Path | None = None) -> Path:
         """Write the chart's diagram with its active states highlighted.
@@ -341,11 +374,14 @@ class Debugger:
             picture = render_active(c, fmt)
         except GraphvizMissingError as exc:
             raise DebugError(str(exc)) from None
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(picture, bytes):
-            path.write_bytes(picture)
-        else:
-            path.write_text(picture, encoding="utf-8")
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            if isinstance(picture, bytes):
+                path.write_bytes(picture)
+            else:
+                path.write_text(picture, encoding="utf-8")
+        except OSError as exc:
+            raise DebugError(f"diagram: cannot write {str(path)!r}: {exc.strerror or exc}") from None
         return path
 
     # -- replay ------------------------------------------------------------------
@@ -356,6 +392,7 @@ class Debugger:
 
     def _remember(self) -> None:
         self._fingerprints[self.robot.steps] = self.fingerprint()
+        self._furthest_steps = max(self._furthest_steps, self.robot.steps)
 
     def steps_of_tick(self, tick: int) -> int:
         """The control step count right after chart tick ``tick`` (0: power-on)."""
@@ -372,6 +409,10 @@ class Debugger:
         """
         if not isinstance(tick, int) or tick < 0:
             raise DebugError(f"replay: the chart tick must be a whole number >= 0, got {tick!r}")
+        if self.steps_of_tick(tick) > self._furthest_steps:
+            furthest = (self._furthest_steps + self._divider - 1) // self._divider
+            raise DebugError(f"replay: chart tick {tick} lies beyond where this session has been (chart tick"
+                             f" {furthest}); replay goes back, run goes forward")
         return self.replay_to_step(self.steps_of_tick(tick))
 
     def replay_to_step(self, steps: int) -> ReplayResult:
@@ -381,6 +422,9 @@ class Debugger:
                              " pass recipe=RobotRecipe(params, seed, q_start, settle_s)")
         if not isinstance(steps, int) or steps < 0:
             raise DebugError(f"replay: the step must be a whole number >= 0, got {steps!r}")
+        if steps > self._furthest_steps:
+            raise DebugError(f"replay: control step {steps} lies beyond where this session has been (step"
+                             f" {self._furthest_steps}); replay goes back, run goes forward")
         target = steps
         kept = [a for a in self.actions if a.steps <= target]
         dropped = len(self.actions) - len(kept)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
@@ -43,6 +44,8 @@ def parse_input_value(decl: Data, label: str, text: str) -> Any:
     except ValueError:
         raise DebugError(f"{label} ({decl.unit}): {text!r} is not a number"
                          f" (units: {', '.join(UNITS)})") from None
+    if not math.isfinite(value):
+        raise DebugError(f"{label} ({decl.unit}): {text!r} is not a finite number")
     if isinstance(decl.default, int) and not isinstance(decl.default, bool) and value.is_integer():
         return int(value)
     return value

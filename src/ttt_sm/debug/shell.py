@@ -24,6 +24,8 @@ from .debugger import Debugger
 from .errors import DebugError
 
 PROMPT = "(ttt-sm) "
+#: What a command may raise for a request it cannot take: printed as one ``error:`` line.
+USER_ERRORS = (DebugError, RobotError, UnknownEventError, UnknownDataError)
 _REPEATABLE = ("step", "tick", "next")
 _SHOW = ("charts", "data", "signals", "trace", "breakpoints", "inputs", "snapshot")
 
@@ -66,10 +68,14 @@ class DebugShell(cmd.Cmd):
         self.dbg = debugger
         self.errors = 0
         self.scripted = False
+        self._progress_shown = False
 
     # -- plumbing -----------------------------------------------------------------
 
     def say(self, *lines: str) -> None:
+        if self._progress_shown:  # a run's progress line is replaced by what comes next
+            self.stdout.write("\r\033[K")
+            self._progress_shown = False
         for line in lines:
             self.stdout.write(line + "\n")
         self.stdout.flush()
@@ -84,7 +90,7 @@ class DebugShell(cmd.Cmd):
             return self.emptyline() if not self.scripted else False
         try:
             return bool(super().onecmd(line))
-        except (DebugError, RobotError, UnknownEventError, UnknownDataError) as exc:
+        except USER_ERRORS as exc:
             self.error(str(exc))
         except Exception as exc:  # a bug in a chart action: say it, keep the session
             self.error(f"{type(exc).__name__}: {exc}")
@@ -133,8 +139,18 @@ class DebugShell(cmd.Cmd):
                 return
         self.say("(end of commands)")
 
+    def show_progress(self, t: float, t_end: float) -> None:
+        """A long run's progress, on one line that the next output replaces (on a terminal)."""
+        self.stdout.write(f"\r  t = {t:.0f} s of at most {t_end:.0f} s simulated (Ctrl-C pauses)")
+        self.stdout.flush()
+        self._progress_shown = True
+
     def interact(self) -> None:
-        """Read commands from the terminal until ``quit`` or Ctrl-D; Ctrl-C at the prompt is ignored."""
+        """Read commands from the terminal until ``quit`` or Ctrl-D; Ctrl-C at the prompt is ignored.
+
+        A long run shows its progress every few simulated seconds.
+        """
+        self.dbg.progress = self.show_progress
         while True:
             try:
                 self.cmdloop()
@@ -297,7 +313,10 @@ class DebugShell(cmd.Cmd):
 
     def do_post(self, arg: str) -> None:
         """post CHART EVENT [NAME=VALUE ...]: post an event, handled at the chart's next tick."""
-        words = shlex.split(arg)
+        try:
+            words = shlex.split(arg)
+        except ValueError as exc:  # an unclosed quote
+            raise DebugError(f"post: {exc} in {arg!r}") from None
         if len(words) < 2:
             raise DebugError("post: expected CHART EVENT, e.g. post Homing stop")
         data: dict[str, Any] = {}

@@ -97,26 +97,6 @@ def line_of(path, start: str) -> int:
     return next(n for n, line in enumerate(path.read_text().splitlines(), 1) if line.startswith(start))
 
 
-def test_a_field_out_of_reach_is_refused_at_load_naming_corner_tool_and_distance(tmp_path):
-    f = write_variant(tmp_path, "field_center_y = 0.25", "field_center_y = 0.6")
-    with pytest.raises(ParameterError) as info:
-        load_params(f)
-    message = str(info.value)
-    assert message.startswith(f"{f}: ")
-    assert "the field's corner at cell (1, 1)" in message
-    assert "with the pen vertical (phi = 0)" in message
-    assert re.search(r": \d+ mm beyond what links L2 and L3 reach", message)
-    assert "field_center_y" in message
-
-
-def test_a_field_the_pen_reaches_but_the_sponge_does_not_is_refused(tmp_path):
-    # the near edge at y = 45 mm: the pen reaches it, the sponge would need the servo past 150 deg
-    f = write_variant(tmp_path, "field_center_y = 0.25", "field_center_y = 0.12")
-    with pytest.raises(ParameterError, match=r"with the sponge down \(phi = 90 deg\): it needs q4 = 1[5-6]\d\.\d deg,"
-                                             r" \d+\.\d deg beyond \[servo\] max_deg = 150\.0"):
-        load_params(f)
-
-
 def test_every_documented_limit_is_checked_and_named_with_its_line(tmp_path):
     f = write_variant(tmp_path, "gear_play_compensation = 1.0", "gear_play_compensation = 5")
     with pytest.raises(ParameterError) as info:

@@ -9,7 +9,6 @@ file (keys with ``_deg`` in their name) are converted to radians here.
 
 from __future__ import annotations
 
-import functools
 import math
 import re
 import reprlib
@@ -397,67 +396,6 @@ def _check(params: ArmParams, where: _Where) -> None:
                 spelled = key[:-4] + "_deg"
                 raise ParameterError(f"{where.at(table, spelled)}: [{table}] {spelled} must lie between the"
                                      f" limits")
-    problem = reach_problem(params)
-    if problem:
-        raise ParameterError(f"{where}: {problem}")
-
-
-#: Heights above the working height at which the whole field must be reachable, m: the
-#: strokes themselves, the pen riding between them, and the moves onto and off the board.
-REACH_LIFTS_M = (0.0, 0.025, 0.05)
-#: Points per side of the grid over the field that the reach check solves for (15 mm apart
-#: on the default 15 cm field); the field's corners and its point nearest the base are among them.
-REACH_GRID = 11
-
-
-def reach_problem(params: ArmParams) -> str | None:
-    """Why the arm cannot work the whole field, or None: the check made when a file is loaded.
-
-    Every point of the field (an 11 x 11 grid, its corners and its point
-    nearest the base axis), from the working height up to 5 cm above it, must
-    be reachable elbow up within the joint limits, with the pen vertical
-    (phi = 0) and with the sponge facing the board (phi = 90 deg, the sponge
-    ``offset`` above the surface).  docs/parameters.md says why.
-    """
-    return _reach_problem(params.geometry, params.board, params.sponge.offset, params.joint_min, params.joint_max)
-
-
-_LIMIT_KEYS = ("[drive.1] limit_{}_deg", "[drive.2] limit_{}_deg", "[drive.3] limit_{}_deg", "[servo] {}_deg")
-
-
-@functools.lru_cache(maxsize=32)
-def _reach_problem(geometry: Geometry, board: Board, sponge_offset: float,
-                   q_min: tuple[float, ...], q_max: tuple[float, ...]) -> str | None:
-    # The closed-form inverse kinematics is the one formula (one place: twin.kinematics);
-    # imported here because the twin imports this module.
-    from .twin.kinematics import UnreachableTargetError, ik_closed_form
-
-    x0, x1, y0, y1 = board.field_bounds()
-    # Cell (1, 1) lies at +x, far from the base (+y); rows grow towards the base, columns towards -x.
-    points = [(x1, y1, "the field's corner at cell (1, 1)"), (x0, y1, "the field's corner at cell (1, 5)"),
-              (x1, y0, "the field's corner at cell (5, 1)"), (x0, y0, "the field's corner at cell (5, 5)"),
-              (min(max(-geometry.l_f, x0), x1), min(max(0.0, y0), y1), "the field's point nearest the base")]
-    steps = [k / (REACH_GRID - 1) for k in range(REACH_GRID)]
-    points += [(x0 + (x1 - x0) * u, y0 + (y1 - y0) * v, "the field's point") for u in steps for v in steps]
-    tools = ((0.0, board.surface_z, "with the pen vertical (phi = 0)"),
-             (math.pi / 2, board.surface_z + sponge_offset, "with the sponge down (phi = 90 deg)"))
-    for phi, z0, tool in tools:
-        for lift in REACH_LIFTS_M:
-            z = z0 + lift
-            for x, y, name in points:
-                place = f"{name} (x = {x:.3f} m, y = {y:.3f} m, z = {z:.3f} m) is out of reach {tool}"
-                try:
-                    q = ik_closed_form((x, y, z, phi), geometry)
-                except UnreachableTargetError as exc:
-                    return (f"{place}: {exc.residual * 1000:.0f} mm beyond what links L2 and L3 reach; move the"
-                            f" field ([board] field_center_x, field_center_y) or change [geometry]")
-                for j in range(4):
-                    if not q_min[j] <= q[j] <= q_max[j]:
-                        side, limit = ("min", q_min[j]) if q[j] < q_min[j] else ("max", q_max[j])
-                        return (f"{place}: it needs q{j + 1} = {math.degrees(q[j]):.1f} deg,"
-                                f" {math.degrees(abs(q[j] - limit)):.1f} deg beyond {_LIMIT_KEYS[j].format(side)}"
-                                f" = {math.degrees(limit):.1f}; move the field or widen the limit")
-    return None
 
 
 def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> ArmParams:

@@ -232,7 +232,10 @@ def test_solver_from_a_nearby_start_finds_the_closed_form_solution(target: np.nd
     oracle = ik_closed_form(target, GEOM)
     assume(abs(math.sin(oracle[2])) > 0.05)  # away from full reach, the elbow-up solution is unique nearby
     result = IKSolver(PARAMS).solve(target, q0=oracle + np.array(offset))
-    np.testing.assert_allclose(result.q, oracle, atol=1e-4)
+    # The solver stops at |e| <= TOL (m and rad mixed), which bounds the joints only to TOL / sigma_min(J):
+    # 3.7e-4 rad at (0.06, 0.35) m, where the found q is 1.4e-4 rad from the closed form.
+    atol = max(1e-4, TOL / np.linalg.svd(jacobian(oracle, GEOM), compute_uv=False).min())
+    np.testing.assert_allclose(result.q, oracle, atol=atol)
 
 
 def test_warm_start_continues_from_the_last_solution() -> None:

@@ -29,6 +29,7 @@ from ..sched.scheduler import Scheduler, Signals, Stage
 from ..twin.plant import ArmSim
 from ..twin.truth import ArmTruth
 from ..twin.whiteboard import Whiteboard
+from ..twin.workspace import check_reach
 from .compensation import GearPlayCompensation
 from .control_wiring import ControlStage, make_control_chart
 from .init_wiring import DriveInitStage, make_init_charts, settled_pose
@@ -88,6 +89,7 @@ class Robot:
     def __init__(self, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
                  settle_s: float = 0.0, listeners: Sequence[object] = (), arm: Arm | None = None,
                  truth: ArmTruth | None = None, wires: Sequence[Wire] = ROBOT_WIRES) -> None:
+        check_reach(params)  # a field out of reach would be drawn as nothing, silently
         self.params = params
         self.seed = seed
         #: The simulated arm when this robot built it, else None.

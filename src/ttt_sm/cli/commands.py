@@ -15,17 +15,25 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..params import load_params
+from ..params import ArmParams
 from .common import CliError, add_command, emit, progress
 
 if TYPE_CHECKING:
     from ..runtime.export import ExtraDiagram
 
 
+def load_arm(path: str | None) -> ArmParams:
+    """The parameter file, checked for reach (:func:`ttt_sm.twin.workspace.load_arm`); the twin is
+    imported when a command runs, not when the CLI starts."""
+    from ..twin.workspace import load_arm as load
+
+    return load(path)
+
+
 def cmd_demo(args: argparse.Namespace) -> int:
     from ..app.play import run_play
 
-    params = load_params(args.params)
+    params = load_arm(args.params)
     result = run_play(params, seed=args.seed, out_dir=Path(args.out), progress=progress(True))
     lines = [f"  {k}: {v}" for k, v in result.items() if k != "drawings"]
     emit(result, args.json, "demo:\n" + "\n".join(lines))
@@ -35,7 +43,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
 def cmd_play(args: argparse.Namespace) -> int:
     from ..app.game import GameError, GameSession, SimulatedPerson, TerminalPerson
 
-    params = load_params(args.params)
+    params = load_arm(args.params)
     say = progress(True)
     opponent = args.opponent
     if opponent == "auto":
@@ -65,7 +73,7 @@ def cmd_play(args: argparse.Namespace) -> int:
 def cmd_draw(args: argparse.Namespace) -> int:
     from ..app.drawing import DrawError, DrawSession, check_request
 
-    params = load_params(args.params)
+    params = load_arm(args.params)
     speed = None if args.speed is None else args.speed / 1000
     size = None if args.size is None else args.size / 1000
     try:
@@ -83,7 +91,7 @@ def cmd_draw(args: argparse.Namespace) -> int:
 def cmd_tune(args: argparse.Namespace) -> int:
     from ..twin.tuning import tune_report
 
-    params = load_params(args.params)
+    params = load_arm(args.params)
     rows = tune_report(params, Path(args.out))
     header = f"{'drive':>5} {'step':>5} {'rise s':>7} {'settle s':>8} {'overshoot %':>11} " \
              f"{'e(0.5s)':>9} {'static':>9} {'PM in':>6} {'PM out':>6} {'GM out dB':>9}"
@@ -99,7 +107,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     from ..bench import run_bench
 
-    params = load_params(args.params)
+    params = load_arm(args.params)
     only = [s.strip() for s in args.only.split(",")] if args.only else None
     try:
         result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=Path(args.out),
@@ -113,7 +121,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def cmd_ik(args: argparse.Namespace) -> int:
     from ..twin.kinematics import IKSolver, fk
 
-    params = load_params(args.params)
+    params = load_arm(args.params)
     target = np.array([args.x / 1000, args.y / 1000, args.z / 1000, np.radians(args.phi)])
     solver = IKSolver(params)
     res = solver.solve(target)
@@ -131,7 +139,7 @@ def cmd_init(args: argparse.Namespace) -> int:
 
     if args.starts < 1:
         raise CliError(f"--starts must be at least 1, got {args.starts}")
-    params = load_params(args.params)
+    params = load_arm(args.params)
     report = init_report(params, args.starts, seed=args.seed)
     text = "\n".join(f"  {k}: {v}" for k, v in report.items())
     emit(report, args.json, f"init from {args.starts} random power-on poses:\n{text}")
@@ -171,7 +179,7 @@ def cmd_charts(args: argparse.Namespace) -> int:
 
 
 def cmd_params(args: argparse.Namespace) -> int:
-    params = load_params(args.params)
+    params = load_arm(args.params)
     emit(dataclasses.asdict(params), args.json)
     return 0
 

@@ -50,12 +50,12 @@ def cmd_debug(args: argparse.Namespace) -> int:
     """Build the robot, then run the REPL: scripted (file or pipe) or interactive."""
     from ..debug.debugger import DEFAULT_MAX_RUN_S, Debugger
     from ..debug.shell import DebugShell
-    from ..params import load_params
+    from ..twin.workspace import load_arm
 
     max_run = DEFAULT_MAX_RUN_S if args.max_run is None else args.max_run
     if not (math.isfinite(max_run) and max_run > 0):
         raise CliError(f"--max-run must be a positive number of seconds, got {args.max_run}")
-    params = load_params(getattr(args, "params", None))
+    params = load_arm(getattr(args, "params", None))
     try:
         q_start = parse_start(args.start) if args.start else None
         if not args.settle >= 0 or not math.isfinite(args.settle):

@@ -72,12 +72,12 @@ def _line(result: ScenarioResult) -> str:
 
 def cmd_scenario_run(args: argparse.Namespace) -> int:
     """Load every file first, then run them; exit 0 / 1 (a scenario failed) / 2 (a file is wrong)."""
-    from ..params import load_params
+    from ..twin.workspace import load_arm
 
     scenarios, errors = _load_all(args.files)
     if errors:
         return _report_errors(errors, args.json)
-    params = load_params(args.params)
+    params = load_arm(args.params)
     stream = sys.stderr if args.json else sys.stdout
 
     live = sys.stderr.isatty()  # a long step shows where it is, on a terminal only

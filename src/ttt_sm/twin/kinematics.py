@@ -64,6 +64,15 @@ class NonFiniteTargetError(IKError):
         super().__init__(f"{what} must be finite, got {list(values)}; check the chart outputs")
 
 
+def _pose_text(target: tuple[float, ...]) -> str:
+    """``x=... m, y=... m, z=... m, phi=... deg``; a huge value in powers of ten, not 300 digits."""
+    x, y, z, phi = target
+
+    def num(v: float, places: int) -> str:
+        return f"{v:.{places}f}" if abs(v) < 1e6 else f"{v:.4g}"
+    return f"x={num(x, 4)} m, y={num(y, 4)} m, z={num(z, 4)} m, phi={num(math.degrees(phi), 1)} deg"
+
+
 class UnreachableTargetError(IKError):
     """No joint angles reach a target: it lies outside the workspace.
 
@@ -74,9 +83,8 @@ class UnreachableTargetError(IKError):
     def __init__(self, target: Any, residual: float, detail: str = "") -> None:
         self.target = tuple(float(v) for v in target)
         self.residual = float(residual)
-        x, y, z, phi = self.target
         super().__init__(
-            f"target x={x:.4f} m, y={y:.4f} m, z={z:.4f} m, phi={math.degrees(phi):.1f} deg is "
+            f"target {_pose_text(self.target)} is "
             f"unreachable: best residual {self.residual:.3g}{'; ' + detail if detail else ''}; "
             f"move it towards the field or check the geometry in the parameter file")
 
@@ -88,9 +96,8 @@ class JointLimitError(IKError):
         self.target = tuple(float(v) for v in target)
         self.joint = joint
         self.angle = float(angle)
-        x, y, z, phi = self.target
         super().__init__(
-            f"target x={x:.4f} m, y={y:.4f} m, z={z:.4f} m, phi={math.degrees(phi):.1f} deg needs "
+            f"target {_pose_text(self.target)} needs "
             f"q{joint} = {math.degrees(angle):.1f} deg, outside its limits "
             f"[{math.degrees(lo):.1f}, {math.degrees(hi):.1f}] deg")
 
@@ -160,7 +167,11 @@ fk_floats = _fk_floats
 
 def _as_shape4(values: Any, what: str) -> np.ndarray:
     """`values` as a float vector of shape (4,), not yet checked for NaN."""
-    v = np.asarray(values, dtype=float)
+    try:
+        v = np.asarray(values, dtype=float)
+    except (TypeError, ValueError, OverflowError):  # text, None, an integer beyond floats
+        shown = repr(values) if len(repr(values)) <= 60 else repr(values)[:60] + "..."
+        raise IKError(f"{what} must be 4 numbers, got {shown}") from None
     if v.shape != (4,):
         raise IKError(f"{what} must have 4 values, got shape {v.shape}")
     return v

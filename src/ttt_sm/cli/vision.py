@@ -1,8 +1,10 @@
 """``ttt-sm vision``: read a photo of the board, make simulated photos, measure the detector.
 
-``ttt-sm vision detect IMAGE [--view far_edge] [--overlay OUT.png] [--json]``
+``ttt-sm vision detect IMAGE [--view far_edge] [--robot-marks TEXT] [--overlay OUT.png] [--json]``
 locates the field in a photo and prints the cells (as the image shows them
-and in board order) with their ink percentages.
+and in board order) with their ink percentages.  A photo turned against the
+view (its perspective shows it) or mirrored (the robot's marks, when given,
+show it) is refused: read, it would put every symbol in the wrong cell.
 
 ``ttt-sm vision render OUT.png [--seed N] [--board TEXT] [--robot X|O]
 [--shadow] [--dim D] [--json]`` saves a simulated camera photo of a random
@@ -25,7 +27,7 @@ from typing import Any
 import cv2
 
 from ..vision.errors import VisionError
-from ..vision.orientation import VIEW_NAMES, board_text, board_values
+from ..vision.orientation import VIEW_NAMES, board_text, board_values, check_orientation, check_robot_marks
 from .common import print_json
 
 
@@ -40,6 +42,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
     d.add_argument("image", metavar="IMAGE", help="photo of the board (PNG, JPEG, ...)")
     d.add_argument("--view", choices=VIEW_NAMES, default="far_edge",
                    help="where the camera stands, for the board order (default far_edge: beyond the far edge)")
+    d.add_argument("--robot-marks", metavar="TEXT", default=None,
+                   help="the robot's marks, 25 characters in board order (X or O where it drew, . elsewhere):"
+                        " checks that the photo is neither turned nor mirrored")
     d.add_argument("--overlay", metavar="PNG", default=None, help="also save the photo with the located field")
     d.add_argument("--json", action="store_true", help="print one JSON document")
     d.set_defaults(func=cmd_vision_detect)
@@ -59,11 +64,32 @@ def register(sub: Any) -> argparse.ArgumentParser:
 
     b = actions.add_parser("bench", help="accuracy and time per frame on simulated photos",
                            description="Detect the cells of simulated photos: accuracy and time per frame.")
-    b.add_argument("--photos", type=int, default=200, help="number of photos (default 200)")
+    b.add_argument("--photos", type=int, default=200, help=f"number of photos, 1..{MAX_PHOTOS} (default 200)")
     b.add_argument("--seed", type=int, default=0, help="seed of the photo series (default 0)")
     b.add_argument("--json", action="store_true", help="print one JSON document")
     b.set_defaults(func=cmd_vision_bench)
     return sp
+
+
+#: Most photos one ``vision bench`` takes (about 50 ms each).
+MAX_PHOTOS = 10_000
+
+
+def _picture_path(path: str, what: str) -> Path:
+    """`path` if OpenCV can write a picture there (by its extension), else a VisionError naming `what`."""
+    if not cv2.haveImageWriter(path):
+        suffix = Path(path).suffix or "(none)"
+        raise VisionError(f"{what} {path!r}: cannot write a picture with the extension {suffix!r}; use .png or .jpg")
+    return Path(path)
+
+
+def _write_picture(path: Path, image: Any, what: str) -> None:
+    try:
+        ok = cv2.imwrite(str(path), image)
+    except cv2.error:
+        ok = False
+    if not ok:
+        raise VisionError(f"{what} {str(path)!r}: could not write the picture (does the folder exist?)")
 
 
 def _fail(exc: Exception) -> int:
@@ -78,24 +104,30 @@ def cmd_vision_detect(args: argparse.Namespace) -> int:
     from ..vision.pictures import overlay
 
     try:
+        out = _picture_path(args.overlay, "--overlay") if args.overlay else None
         image = read_image(args.image)
         det = detect(image)
+        note = check_orientation(det.grid, args.view, str(args.image))
+        if args.robot_marks is not None:
+            check_robot_marks(det.cells, args.view, args.robot_marks.upper(), str(args.image))
+            note += "; the robot's marks are where it drew them"
+        if out is not None:
+            _write_picture(out, overlay(image, det), "--overlay")
     except VisionError as exc:
         return _fail(exc)
     data = det.to_dict()
     data["image"] = str(args.image)
     data["view"] = args.view
+    data["orientation"] = note
     data["board"] = board_text(det.cells, args.view)
     data["board_percentages"] = [round(v, 2) for v in board_values(det.percentages, args.view)]
-    if args.overlay:
-        if not cv2.imwrite(str(args.overlay), overlay(image, det)):
-            return _fail(VisionError(f"{args.overlay}: could not write the picture (does the folder exist?)"))
-        data["overlay"] = str(args.overlay)
+    if out is not None:
+        data["overlay"] = str(out)
     if args.json:
         print_json(data)
         return 0
     board = data["board"]
-    print(f"{args.image}: field found in {det.time_ms:.1f} ms (fit {det.grid.rms_cells:.3f} cells RMS)")
+    print(f"{args.image}: field found in {det.time_ms:.1f} ms (fit {det.grid.rms_cells:.3f} cells RMS); {note}")
     print("as the image shows it      board (row 1 first, view " + args.view + ")")
     for k in range(5):
         row = det.cells[5 * k:5 * k + 5]
@@ -108,13 +140,14 @@ def cmd_vision_render(args: argparse.Namespace) -> int:
     """Save a simulated photo; exit 0, or 2 on a bad argument."""
     import numpy as np
 
-    from ..params import load_params
+    from ..twin.workspace import load_arm
     from ..vision.bench import random_shadow
     from ..vision.scenes import random_scene, scene_from_text
     from ..vision.simulated import Lighting, SimulatedCamera
 
-    params = load_params(args.params)
+    params = load_arm(args.params)
     try:
+        out = _picture_path(args.out, "OUT")
         scene = (scene_from_text(params, args.board, args.robot, args.seed) if args.board is not None
                  else random_scene(params, args.seed))
         rng = np.random.default_rng(args.seed + 1)
@@ -126,11 +159,9 @@ def cmd_vision_render(args: argparse.Namespace) -> int:
         cam = SimulatedCamera(scene.board, params, seed=args.seed, lighting=lighting,
                               shadow=random_shadow(params, rng) if args.shadow else None)
         image = cam.frame()
+        _write_picture(out, image, "OUT")
     except ValueError as exc:
         return _fail(exc)
-    out = Path(args.out)
-    if not cv2.imwrite(str(out), image):
-        return _fail(VisionError(f"{out}: could not write the picture (does the folder exist?)"))
     data = {"out": str(out), "board": scene.text, "robot_symbol": scene.robot_symbol, "view": cam.view(),
             "dim": round(cam.lighting.dim, 3), "roll_deg": round(cam.pose.roll_deg, 2),
             "position_m": [round(v, 4) for v in cam.pose.position_m]}
@@ -144,12 +175,12 @@ def cmd_vision_render(args: argparse.Namespace) -> int:
 
 def cmd_vision_bench(args: argparse.Namespace) -> int:
     """Run the vision benchmark; exit 0 if every cell was read right, 1 if not."""
-    from ..params import load_params
+    from ..twin.workspace import load_arm
     from ..vision.bench import bench_vision
 
-    if args.photos < 1:
-        return _fail(VisionError(f"--photos must be at least 1, got {args.photos}"))
-    params = load_params(args.params)
+    if not 1 <= args.photos <= MAX_PHOTOS:
+        return _fail(VisionError(f"--photos must lie in 1..{MAX_PHOTOS}, got {args.photos}"))
+    params = load_arm(args.params)
 
     def say(msg: str) -> None:
         print(msg, file=sys.stderr, flush=True)

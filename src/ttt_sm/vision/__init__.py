@@ -20,20 +20,31 @@ from .errors import (
     GridNotFoundError,
     ImageError,
     MoveError,
+    OrientationError,
+    PictureTurnedError,
     RobotCellMarkedError,
     SymbolVanishedError,
     TooManyMovesError,
     VisionError,
 )
 from .grid import Grid, locate_grid
-from .orientation import board_cell, board_text, board_values, image_cell, image_text
+from .orientation import (
+    board_cell,
+    board_text,
+    board_values,
+    check_orientation,
+    check_robot_marks,
+    image_cell,
+    image_text,
+)
 from .percent import PersonMoves, percent_process, read_moves, robot_ink_after_move
 
 __all__ = [
     "Camera", "ImageFileCamera", "OpenCVCamera", "check_image", "read_image",
     "Detection", "detect", "Grid", "locate_grid",
-    "board_cell", "board_text", "board_values", "image_cell", "image_text",
+    "board_cell", "board_text", "board_values", "image_cell", "image_text", "check_orientation", "check_robot_marks",
     "PersonMoves", "percent_process", "read_moves", "robot_ink_after_move",
     "VisionError", "ImageError", "GridNotFoundError", "CameraError",
-    "MoveError", "TooManyMovesError", "RobotCellMarkedError", "SymbolVanishedError",
+    "MoveError", "TooManyMovesError", "RobotCellMarkedError", "SymbolVanishedError", "OrientationError",
+    "PictureTurnedError",
 ]

@@ -8,6 +8,7 @@ place that decides whether an array is a usable frame.
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
@@ -22,6 +23,10 @@ DEFAULT_SIZE = (640, 480)
 #: Smallest and largest frames :func:`check_image` accepts (width, height), pixels.
 MIN_SIZE = (320, 240)
 MAX_SIZE = (4096, 3072)
+#: Largest image file read, bytes: an uncompressed BMP of MAX_SIZE is 38 MB.
+MAX_FILE_BYTES = 64 * 2**20
+#: The formats :func:`read_image` reads: their headers give the size before anything is decoded.
+IMAGE_FORMATS = "PNG, JPEG, BMP, WebP, PPM/PGM"
 
 
 @runtime_checkable
@@ -72,15 +77,104 @@ def check_image(image: Any, what: str = "image") -> np.ndarray:
 
 
 def read_image(path: str | Path) -> np.ndarray:
-    """Read an image file as BGR uint8, or :class:`ImageError` naming the file and the problem."""
+    """Read an image file as BGR uint8, or :class:`ImageError` naming the file and the problem.
+
+    The size is read from the file's header (:func:`image_size`) and checked
+    before anything is decoded: a 20000 x 20000 PNG of a few hundred kB would
+    take 1.2 GB as pixels.  Files over :data:`MAX_FILE_BYTES` are not read.
+    """
     p = Path(path)
     if not p.is_file():
-        raise ImageError(f"{p}: no such file")
-    data = np.fromfile(str(p), np.uint8)
-    image = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+        raise ImageError(f"{p}: no such file" if not p.exists() else f"{p}: not a file")
+    try:
+        with p.open("rb") as f:
+            data = f.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ImageError(f"{p}: cannot read the file ({exc.strerror or exc})") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise ImageError(f"{p}: more than {MAX_FILE_BYTES // 2**20} MB: not a camera photo")
+    if not data:
+        raise ImageError(f"{p}: not an image: the file is empty")
+    width, height = image_size(data, str(p))
+    _check_size(width, height, str(p))
+    try:
+        image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+    except cv2.error as exc:
+        raise ImageError(f"{p}: OpenCV cannot decode it ({str(exc).strip().splitlines()[-1][:80]})") from None
     if image is None:
-        raise ImageError(f"{p}: not an image OpenCV can read (PNG, JPEG, BMP, ...)")
+        raise ImageError(f"{p}: not an image OpenCV can decode (damaged or cut short?)")
     return check_image(image, str(p))
+
+
+def _check_size(width: int, height: int, what: str) -> None:
+    if not (MIN_SIZE[0] <= width <= MAX_SIZE[0] and MIN_SIZE[1] <= height <= MAX_SIZE[1]):
+        raise ImageError(f"{what}: {width} x {height} pixels is the wrong size: width and height must lie within "
+                         f"{MIN_SIZE[0]} x {MIN_SIZE[1]} .. {MAX_SIZE[0]} x {MAX_SIZE[1]} (640 x 480 expected)")
+
+
+def image_size(data: bytes, what: str = "image") -> tuple[int, int]:
+    """(width, height) of an image from its header alone; :class:`ImageError` if the format is not one of
+    :data:`IMAGE_FORMATS` or the header is cut short."""
+    try:
+        if data.startswith(b"\x89PNG\r\n\x1a\n"):
+            if data[12:16] != b"IHDR":
+                raise struct.error
+            width, height = struct.unpack(">II", data[16:24])
+            return width, height
+        if data.startswith(b"\xff\xd8"):
+            return _jpeg_size(data)
+        if data.startswith(b"BM"):
+            width, height = struct.unpack("<ii", data[18:26])
+            return abs(width), abs(height)
+        if data.startswith(b"RIFF") and data[8:12] == b"WEBP":
+            return _webp_size(data)
+        if data[:1] == b"P" and data[1:2] in b"123456" and len(data) > 2:
+            return _pnm_size(data)
+    except (struct.error, IndexError, ValueError):
+        kind = {b"\x89P": "PNG", b"\xff\xd8": "JPEG", b"BM": "BMP", b"RI": "WebP"}.get(data[:2], "PPM/PGM")
+        raise ImageError(f"{what}: a {kind} file cut short before its size, or damaged") from None
+    raise ImageError(f"{what}: not an image this program reads ({IMAGE_FORMATS})")
+
+
+def _jpeg_size(data: bytes) -> tuple[int, int]:
+    i = 2
+    while True:
+        i = data.index(b"\xff", i)  # ValueError at the end of the data: cut short
+        while data[i] == 0xFF:
+            i += 1
+        marker = data[i]
+        i += 1
+        if marker in (0xD8, 0x01) or 0xD0 <= marker <= 0xD7:  # markers without a length
+            continue
+        length = struct.unpack(">H", data[i:i + 2])[0]
+        if 0xC0 <= marker <= 0xCF and marker not in (0xC4, 0xC8, 0xCC):  # a frame header (SOFn)
+            height, width = struct.unpack(">HH", data[i + 3:i + 7])
+            return width, height
+        if marker == 0xD9 or length < 2:
+            raise ValueError("no frame header")
+        i += length
+
+
+def _webp_size(data: bytes) -> tuple[int, int]:
+    kind = data[12:16]
+    if kind == b"VP8 ":
+        width, height = struct.unpack("<HH", data[26:30])
+        return width & 0x3FFF, height & 0x3FFF
+    if kind == b"VP8L":
+        bits = int.from_bytes(data[21:25], "little")
+        return (bits & 0x3FFF) + 1, ((bits >> 14) & 0x3FFF) + 1
+    if kind == b"VP8X":
+        return int.from_bytes(data[24:27], "little") + 1, int.from_bytes(data[27:30], "little") + 1
+    raise ValueError("unknown WebP chunk")
+
+
+def _pnm_size(data: bytes) -> tuple[int, int]:
+    words: list[bytes] = []
+    for line in data[2:256].split(b"\n"):
+        words += line.split(b"#")[0].split()
+        if len(words) >= 2:
+            return int(words[0]), int(words[1])
+    raise ValueError("no size")
 
 
 class ImageFileCamera:

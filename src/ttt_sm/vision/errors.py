@@ -27,6 +27,11 @@ class CameraError(VisionError):
     """A camera could not be opened or did not deliver a frame."""
 
 
+class OrientationError(VisionError):
+    """A photo is turned or mirrored against the camera placement (its ``view``): reading it would
+    put every symbol in the wrong cell."""
+
+
 def _cells_text(cells: Iterable[Cell]) -> str:
     return ", ".join(f"({r}, {c})" for r, c in cells)
 
@@ -80,3 +85,16 @@ class SymbolVanishedError(MoveError):
             f"symbol(s) disappeared from cell(s) {_cells_text(cells)}",
             cells,
             f"The symbol in {_cells_text(cells)} has disappeared. Please redraw it (or restart the game).")
+
+
+class PictureTurnedError(MoveError, OrientationError):
+    """The symbols on the board are where a turned or mirrored camera picture would put them."""
+
+    def __init__(self, cells: Iterable[Cell]) -> None:
+        cells = tuple(cells)
+        super().__init__(
+            f"the marks of cells {_cells_text(cells)} are seen where a turned or mirrored camera picture would"
+            " put them; the camera's picture is turned or mirrored",
+            cells,
+            "My marks appear where a turned or mirrored camera picture would put them. Please fix the camera"
+            " (its mounting or its mirror setting), then play on.")

@@ -21,14 +21,40 @@ the robot (:meth:`~ttt_sm.vision.simulated.CameraPose.beyond_far_edge`):
 view ``"far_edge"``.  A real camera on a stand over the board is
 ``"above"`` if the robot is at the bottom of its picture, ``"far_edge"`` if
 at the top.
+
+A photo turned or mirrored would be read as a turned or mirrored board,
+every symbol in the wrong cell.  Two things tell the orientation:
+
+* the **perspective** (:func:`check_orientation`): a camera beyond the far
+  edge, looking down at a slant, sees the field's near side wider than its
+  far side (1.16-1.22 times on the simulated camera, whatever its jitter),
+  at the bottom of the picture.  A photo turned by 90 or 180 deg puts that
+  side elsewhere.  A mirror keeps it at the bottom, and a camera straight
+  above sees no perspective;
+* the **robot's own marks** (:func:`check_robot_marks`, and
+  :func:`~ttt_sm.vision.percent.percent_process` in a game): the robot knows
+  where it drew; if the photo shows its marks where a turn or a mirror
+  would put them, the photo is turned or mirrored.
 """
 
 from __future__ import annotations
 
-from .errors import VisionError
+from collections.abc import Callable, Iterable
+
+from .errors import OrientationError, VisionError
 
 N = 5
 VIEW_NAMES = ("far_edge", "above", "field")
+#: Where the side of the field nearest the camera lies in the picture, per view; None: the
+#: camera looks straight down (or the view is a drawing convention), no side is nearer.
+NEAR_SIDE: dict[str, str | None] = {"far_edge": "bottom", "above": None, "field": None}
+#: In a view with perspective, the near side is at least this many times as wide as the far side
+#: (the simulated camera: 1.16-1.22); less, and which way the photo is turned cannot be told.
+MIN_PERSPECTIVE = 1.08
+_OPPOSITE = {"top": "bottom", "bottom": "top", "left": "right", "right": "left"}
+#: What to do when the near side is on another side than the view says (the view's side: bottom).
+_TURN_BACK = {"left": "turn it 90 deg counter-clockwise", "right": "turn it 90 deg clockwise",
+              "top": "turn it 180 deg"}
 
 
 def _check(view: str) -> None:
@@ -82,3 +108,134 @@ def board_values(values: list[float] | tuple[float, ...], view: str = "far_edge"
 def image_text(board: str, view: str = "far_edge") -> str:
     """Reorder 25 board-order characters into image order (the inverse of :func:`board_text`)."""
     return board_text(board, view)  # every view's mapping is an involution
+
+
+def perspective(corners: Iterable[Iterable[float]]) -> tuple[str, float]:
+    """The side of the field that looks widest (``top``, ``bottom``, ``left``, ``right``) and how many
+    times as wide as the side opposite; `corners` as :attr:`~ttt_sm.vision.grid.Grid.corners`
+    (top left, top right, bottom right, bottom left, pixels)."""
+    (x0, y0), (x1, y1), (x2, y2), (x3, y3) = ((float(x), float(y)) for x, y in corners)
+
+    def length(ax: float, ay: float, bx: float, by: float) -> float:
+        return float(((ax - bx) ** 2 + (ay - by) ** 2) ** 0.5)
+
+    sides = {"top": length(x0, y0, x1, y1), "right": length(x1, y1, x2, y2),
+             "bottom": length(x2, y2, x3, y3), "left": length(x3, y3, x0, y0)}
+    widest = max(sides, key=lambda k: sides[k] / max(sides[_OPPOSITE[k]], 1e-9))
+    return widest, sides[widest] / max(sides[_OPPOSITE[widest]], 1e-9)
+
+
+def check_orientation(grid: object, view: str, what: str = "photo") -> str:
+    """Check by its perspective that a photo is not turned against `view`; a note of what was checked.
+
+    Parameters
+    ----------
+    grid : Grid
+        The located field (``Detection.grid``); only its ``corners`` are read.
+    view : str
+        Where the camera stands (:data:`VIEW_NAMES`).
+    what : str
+        How to name the photo in the message (its file name).
+
+    Returns
+    -------
+    str
+        ``orientation checked: ...`` or, for a view without perspective,
+        ``orientation not checked: ...`` saying why and what would check it.
+
+    Raises
+    ------
+    OrientationError
+        The field's near side is not where `view` puts it (the photo is
+        turned), or the perspective is too weak to tell.
+    """
+    _check(view)
+    near = NEAR_SIDE[view]
+    if near is None:
+        return (f"orientation not checked: in view {view!r} no side of the field is nearer the camera, so a"
+                f" turned or mirrored photo looks the same; the robot's marks check it (--robot-marks)")
+    side, ratio = perspective(grid.corners)  # type: ignore[attr-defined]
+    if ratio < MIN_PERSPECTIVE:
+        raise OrientationError(
+            f"{what}: cannot tell which way the photo is turned: the field's sides differ by only"
+            f" {100 * (ratio - 1):.0f} %, where a camera {_WHERE[view]} sees its near side at least"
+            f" {100 * (MIN_PERSPECTIVE - 1):.0f} % wider; if the camera looks straight down, give --view above")
+    if side != near:
+        raise OrientationError(
+            f"{what}: the photo is turned: the field's near side (the widest, {ratio:.2f} times its far side)"
+            f" is at the {side} of the picture, where a camera {_WHERE[view]} sees it at the {near};"
+            f" {_TURN_BACK[side]}, or give the --view of the camera")
+    return f"orientation checked: the field's near side is at the {side}, {ratio:.2f} times as wide as its far side"
+
+
+_WHERE = {"far_edge": "beyond the far edge"}
+
+#: What may have happened to a photo, and how to undo it on a 5 x 5 grid of image cells
+#: (0-based row, column of the photo as it should be -> where that cell is in the photo given).
+CHANGES: dict[str, Callable[[int, int], tuple[int, int]]] = {
+    "mirrored left-right": lambda r, c: (r, N - 1 - c),
+    "mirrored top-bottom": lambda r, c: (N - 1 - r, c),
+    "turned 90 deg clockwise": lambda r, c: (c, N - 1 - r),
+    "turned 90 deg counter-clockwise": lambda r, c: (N - 1 - c, r),
+    "turned 180 deg": lambda r, c: (N - 1 - r, N - 1 - c),
+    "mirrored across its diagonal": lambda r, c: (c, r),
+    "mirrored across its other diagonal": lambda r, c: (N - 1 - c, N - 1 - r),
+}
+
+
+def _undo(cells: str, change: Callable[[int, int], tuple[int, int]]) -> str:
+    out = []
+    for r in range(N):
+        for c in range(N):
+            rr, cc = change(r, c)
+            out.append(cells[rr * N + cc])
+    return "".join(out)
+
+
+def _shows(board: str, marks: str) -> list[tuple[int, int]]:
+    """The board cells of `marks` (``X``/``O``) that `board` does not show (``#`` shows either)."""
+    return [divmod(k, N) for k, m in enumerate(marks) if m != EMPTY and board[k] not in (m, "#")]
+
+
+EMPTY = "."
+
+
+def check_robot_marks(cells: str, view: str, robot_marks: str, what: str = "photo") -> None:
+    """Check that the robot's own marks are where it drew them in a detection.
+
+    Parameters
+    ----------
+    cells : str
+        ``Detection.cells``: 25 characters in image order.
+    view : str
+        Where the camera stands (:data:`VIEW_NAMES`).
+    robot_marks : str
+        25 characters in board order: the robot's ``X`` or ``O`` where it
+        drew, ``.`` elsewhere.
+    what : str
+        How to name the photo in the message.
+
+    Raises
+    ------
+    OrientationError
+        The marks are seen where a turn or a mirror of the photo would put
+        them (the message names which).
+    VisionError
+        Some marks are not seen, and no turn or mirror explains it.
+    """
+    _check(view)
+    if len(cells) != N * N or len(robot_marks) != N * N or set(robot_marks) - {"X", "O", EMPTY}:
+        raise VisionError(f"{what}: expected 25 detected cells and 25 robot marks ('X', 'O' or '.')")
+    missing = _shows(board_text(cells, view), robot_marks)
+    if not missing:
+        return
+    explains = [name for name, change in CHANGES.items()
+                if not _shows(board_text(_undo(cells, change), view), robot_marks)]
+    if explains:
+        raise OrientationError(
+            f"{what}: the robot's marks show the photo {' or '.join(explains)}: they are where that would put"
+            f" them, not where the robot drew them; fix the camera (a mirror setting?) or the photo")
+    shown = ", ".join(f"({r + 1}, {c + 1})" for r, c in missing)
+    raise VisionError(f"{what}: the robot's marks are not all seen: board cell(s) {shown} should hold"
+                      f" {robot_marks[missing[0][0] * N + missing[0][1]]} and no turn or mirror of the photo"
+                      f" explains it")

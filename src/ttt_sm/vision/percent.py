@@ -11,7 +11,10 @@ message the game can show the person:
   the robot's own symbol read, or the cell reads the person's symbol) ->
   :class:`~ttt_sm.vision.errors.RobotCellMarkedError`;
 * a symbol (the robot's or the person's) that is no longer seen ->
-  :class:`~ttt_sm.vision.errors.SymbolVanishedError`.
+  :class:`~ttt_sm.vision.errors.SymbolVanishedError`, unless every symbol
+  is seen where a turned or mirrored picture would put it ->
+  :class:`~ttt_sm.vision.errors.PictureTurnedError` (the camera is wrong,
+  not the person).
 
 Everything is in board order (row 1, column 1 first): map a detection with
 :func:`read_moves` or :mod:`ttt_sm.vision.orientation`.
@@ -23,8 +26,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from .detection import OCCUPIED_PCT, Detection
-from .errors import RobotCellMarkedError, SymbolVanishedError, TooManyMovesError, VisionError
-from .orientation import board_text, board_values
+from .errors import PictureTurnedError, RobotCellMarkedError, SymbolVanishedError, TooManyMovesError, VisionError
+from .orientation import CHANGES, board_text, board_values
 
 Cell = tuple[int, int]
 N = 5
@@ -104,6 +107,8 @@ def percent_process(percentages: Sequence[float], robot_cells: Iterable[Cell],
     occupied = {divmod(k, N) for k in range(N * N) if float(percentages[k]) > occupied_pct}
     occupied = {(r + 1, c + 1) for r, c in occupied}
     gone = sorted((robot | person) - occupied)
+    if gone and len(robot | person) >= 2 and _turned(robot | person, occupied):
+        raise PictureTurnedError(sorted(robot | person))
     if gone:
         raise SymbolVanishedError(gone)
     marked = set()
@@ -123,6 +128,14 @@ def percent_process(percentages: Sequence[float], robot_cells: Iterable[Cell],
         raise TooManyMovesError(new)
     cells = tuple(sorted(person | set(new)))
     return PersonMoves(cells, new[0] if new else None)
+
+
+def _turned(marks: set[Cell], occupied: set[Cell]) -> bool:
+    """Whether a turn or a mirror of the picture (not none) would show every mark on an occupied cell."""
+    for change in CHANGES.values():
+        if all(tuple(v + 1 for v in change(r - 1, c - 1)) in occupied for r, c in marks):
+            return True
+    return False
 
 
 def read_moves(detection: Detection, robot_cells: Iterable[Cell], person_cells: Iterable[Cell] = (), *,

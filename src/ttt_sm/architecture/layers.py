@@ -15,7 +15,7 @@ and line.  ``tests/test_layers.py`` runs it on the package, and
 
 Why a checker of our own rather than import-linter: the contract needs
 three things at once, tiers, per-component ``only`` lists and module-level
-circles including ``TYPE_CHECKING`` imports, and the whole checker is ~150
+circles including ``TYPE_CHECKING`` imports, and the whole checker is ~250
 lines of standard library that the tests can point at a synthetic package;
 it adds no dependency to the package or to CI.
 """

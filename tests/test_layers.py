@@ -30,7 +30,8 @@ def test_the_layers_hold(graph):
     assert problems == [], "the layering contract is broken:\n" + "\n".join(problems)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 9 item 4: the twin/plant <-> twin/tuning circle is being removed")
+@pytest.mark.xfail(strict=True, reason="issue 9 item 4: the twin/plant <-> twin/tuning circle is being removed; "
+                   "once it is gone this passes: delete PLANT_TUNING, its uses and this test (tests/test_layers.py)")
 def test_the_plant_tuning_circle_is_gone(graph):
     assert PLANT_TUNING not in {frozenset(c) for c in cycles(graph)}
 

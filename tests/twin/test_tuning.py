@@ -12,6 +12,8 @@ from ttt_sm.params import load_params
 from ttt_sm.twin.control import setpoint_filter_matrices
 from ttt_sm.twin.plant import ArmSim
 from ttt_sm.twin.tuning import (
+    REPORT_COLUMNS,
+    SETTLING_BAND,
     STATIC_WINDOW_S,
     STEP_POSES,
     STEP_RAD,
@@ -19,6 +21,8 @@ from ttt_sm.twin.tuning import (
     drive_plant,
     loop_margins,
     loop_models,
+    report_text,
+    step_figure,
     step_response,
     tune_report,
 )
@@ -129,3 +133,46 @@ def test_tune_report_has_exactly_the_keys_and_writes_plots(params, tmp_path):
         assert png.stat().st_size < 150_000
         assert r["settling_time_s"] <= 0.5 and r["overshoot_pct"] <= 5.0 and r["static_error_rad"] <= 1e-4
         assert r["inner_phase_margin_deg"] >= 45.0 and r["outer_phase_margin_deg"] >= 45.0
+
+
+def _artist(ax, gid):
+    (found,) = [a for a in (*ax.patches, *ax.lines) if a.get_gid() == gid]
+    return found
+
+
+def test_the_step_plot_draws_the_band_the_settling_time_is_measured_against(params, gains):
+    m = step_response(params, gains, 3, STEP_RAD[3])
+    assert m.settling_band_rad == SETTLING_BAND * STEP_RAD[3]
+    response, error = step_figure(m).axes
+    target = m.setpoint[0]
+    band = _artist(response, "settling_band")  # around the setpoint, in rad
+    assert band.get_y() == pytest.approx(target - m.settling_band_rad)
+    assert band.get_height() == pytest.approx(2 * m.settling_band_rad)
+    assert _artist(response, "settling_time").get_xdata()[0] == m.settling_time_s
+    # on the error axis: the settling time is where the drawn |error| last leaves the drawn band
+    top = _artist(error, "settling_band_error")
+    top = top.get_y() + top.get_height()
+    assert top == pytest.approx(m.settling_band_rad)
+    (curve,) = [ln for ln in error.lines if ln.get_label().startswith("|error|")]
+    t, e = curve.get_xdata(), curve.get_ydata()
+    last_out = np.flatnonzero(e > top)[-1]
+    assert t[last_out + 1] == pytest.approx(m.settling_time_s)
+    # the old plot drew a +-1e-4 rad line under the settling time; no line may stand for the band but the band
+    assert all(not ln.get_label().startswith("target") for ln in (*response.lines, *error.lines))
+
+
+def test_the_tune_table_says_what_every_column_is():
+    rows = [{"drive": 1, "step_rad": 1.0, "rise_time_s": 0.3, "settling_time_s": 0.39, "overshoot_pct": 0.0,
+             "error_at_0_5s_rad": 1e-4, "static_error_rad": 1e-5, "inner_phase_margin_deg": 59.2,
+             "outer_phase_margin_deg": 81.5, "outer_gain_margin_db": 20.4, "plot": "step_drive1.png"}]
+    text = report_text(rows)
+    lines = text.splitlines()
+    assert lines[0].split() == "drive step rise s settle s overshoot % e(0.5s) static PM in PM out GM out dB".split()
+    assert lines[1].split() == ["1", "1.00", "0.300", "0.390", "0.00", "1.00e-04", "1.00e-05", "59.2", "81.5",
+                                "20.4"]
+    assert {key for key, *_ in REPORT_COLUMNS} | {"plot"} == REPORT_KEYS
+    for _, header, _, _, meaning in REPORT_COLUMNS:
+        assert f"  {header}  " in text and meaning in text
+    assert "  PM in" in text and "phase margin of the inner (speed) loop" in text
+    assert "  GM out dB" in text and "gain margin of the outer (position) loop" in text
+    assert "  e(0.5s)" in text and "0.5 s after the step" in text

@@ -89,18 +89,11 @@ def cmd_draw(args: argparse.Namespace) -> int:
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
-    from ..twin.tuning import tune_report
+    from ..twin.tuning import report_text, tune_report
 
     params = load_arm(args.params)
     rows = tune_report(params, Path(args.out))
-    header = f"{'drive':>5} {'step':>5} {'rise s':>7} {'settle s':>8} {'overshoot %':>11} " \
-             f"{'e(0.5s)':>9} {'static':>9} {'PM in':>6} {'PM out':>6} {'GM out dB':>9}"
-    body = [f"{r['drive']:>5} {r['step_rad']:>5.2f} {r['rise_time_s']:>7.3f} {r['settling_time_s']:>8.3f} "
-            f"{r['overshoot_pct']:>11.2f} {r['error_at_0_5s_rad']:>9.2e} {r['static_error_rad']:>9.2e} "
-            f"{r['inner_phase_margin_deg']:>6.1f} {r['outer_phase_margin_deg']:>6.1f} "
-            f"{r['outer_gain_margin_db']:>9.1f}" for r in rows]
-    plots = [f"plot: {r['plot']}" for r in rows if r.get("plot")]
-    emit(rows, args.json, "\n".join([header, *body, *plots]))
+    emit(rows, args.json, report_text(rows))
     return 0
 
 

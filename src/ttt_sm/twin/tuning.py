@@ -20,13 +20,16 @@ import math
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import control as ct
 import numpy as np
 
 from ..params import ArmParams, ParameterError
 from .control import DriveGains, Gains, check_drive, max_joint_speed, speed_filter_alpha
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
 class TuningError(ParameterError):
@@ -274,6 +277,15 @@ STATIC_WINDOW_S = 0.3
 SETTLING_BAND = 0.02
 
 
+def settling_band_rad(step_rad: float) -> float:
+    """Half-width of the settling band for a step of `step_rad`: ``SETTLING_BAND`` of it, rad.
+
+    The one definition both :func:`step_response` (``settling_time_s``) and
+    :func:`plot_step` (the band it draws) use.
+    """
+    return SETTLING_BAND * abs(step_rad)
+
+
 @dataclass(frozen=True, eq=False)
 class StepMetrics:
     """A step response of one drive on the nonlinear twin, measured on the encoder.
@@ -298,6 +310,11 @@ class StepMetrics:
     encoder: np.ndarray
     load: np.ndarray
     rad_per_count: float
+
+    @property
+    def settling_band_rad(self) -> float:
+        """Half-width of the band ``settling_time_s`` is measured against, rad."""
+        return settling_band_rad(self.step_rad)
 
 
 def step_response(params: ArmParams, gains: Gains, drive: int, step_rad: float, seconds: float = 1.5,
@@ -329,7 +346,7 @@ def step_response(params: ArmParams, gains: Gains, drive: int, step_rad: float, 
     enc = tr.q_encoder[:, d]
     err = target[d] - enc
     frac = (enc - start) / step_rad
-    band = SETTLING_BAND * abs(step_rad)
+    band = settling_band_rad(step_rad)
     outside = np.flatnonzero(np.abs(err) > band)
     settling = float(t[outside[-1] + 1]) if outside.size and outside[-1] + 1 < len(t) else (
         0.0 if not outside.size else math.inf)
@@ -346,36 +363,77 @@ def step_response(params: ArmParams, gains: Gains, drive: int, step_rad: float, 
     )
 
 
-def plot_step(m: StepMetrics, path: Path) -> Path:
-    """Draw a step response like thesis figs. 3.7-3.9: response left, error zoomed right."""
+def step_figure(m: StepMetrics) -> Figure:
+    """A step response like thesis figs. 3.7-3.9, with every metric of :class:`StepMetrics` drawn.
+
+    Left: the raw step setpoint and the encoder angle, the settling band
+    (``settling_band_rad``, the one ``settling_time_s`` uses) around the
+    setpoint, the 10 % and 90 % points of the rise time and the settling
+    time.  Right: |setpoint - encoder| on a log scale, so that the slew (a
+    radian), the band (hundredths) and the static error (an encoder count,
+    1e-5 rad) show on one axis, with the same band, the error at 0.5 s, the
+    window of the static error and one encoder count.
+    """
     from matplotlib.figure import Figure  # no pyplot: no global backend state
 
-    t = np.concatenate([[-0.05, 0.0], m.t])
+    band = m.settling_band_rad
     start = m.setpoint[0] - m.step_rad
-    sp = np.concatenate([[start, m.setpoint[0]], m.setpoint])
-    enc = np.concatenate([[start, start], m.encoder])
-    fig = Figure(figsize=(9.0, 3.4), dpi=80)
+    target = m.setpoint[0]
+    # the hold before the step, then the step itself at t = 0
+    t = np.concatenate([[-0.05, 0.0, 0.0], m.t])
+    sp = np.concatenate([[start, start, target], m.setpoint])
+    enc = np.concatenate([[start, start, start], m.encoder])
+    fig = Figure(figsize=(11.0, 4.4), dpi=80)
     a1, a2 = fig.subplots(1, 2)
-    a1.plot(t, sp, "k--", lw=1.0, label="desired (raw step)")
-    a1.plot(t, enc, "C0", lw=1.2, label="actual (encoder)")
-    a1.set_xlabel("time (s)")
-    a1.set_ylabel(f"q{m.drive} (rad)")
-    a1.set_title(f"drive {m.drive}: step {m.step_rad:g} rad")
+    fig.suptitle(f"Drive {m.drive}: a {m.step_rad:g} rad step of the position setpoint on the simulated arm "
+                 "(friction, gear clearance, gravity, encoder counts)", fontsize=11)
+
+    a1.axhspan(target - band, target + band, color="C2", alpha=0.25, lw=0, gid="settling_band",
+               label=f"settling band: setpoint ± {SETTLING_BAND * 100:g} % of the step (± {band:.3g} rad)")
+    a1.plot(t, sp, "k--", lw=1.0, label="setpoint (the raw step)")
+    a1.plot(t, enc, "C0", lw=1.4, label="encoder angle (what the controller sees)")
+    frac = (m.encoder - start) / m.step_rad
+    for level in (0.1, 0.9):
+        if np.any(frac >= level):
+            i = int(np.argmax(frac >= level))
+            a1.plot(m.t[i], m.encoder[i], "o", color="C1", ms=5,
+                    label=f"10 % and 90 % of the step: rise time {m.rise_time_s:.3f} s" if level == 0.1 else None)
+    a1.axvline(m.settling_time_s, color="C2", ls="-", lw=1.2, gid="settling_time",
+               label=f"settled: |error| last leaves the band at {m.settling_time_s:.3f} s")
+    a1.set_xlabel("time after the step (s)")
+    a1.set_ylabel(f"joint {m.drive} angle q{m.drive} (rad)")
+    a1.set_title(f"Response (overshoot {m.overshoot_pct:.2f} % of the step)", fontsize=10)
     a1.legend(loc="lower right", fontsize=8)
     a1.grid(alpha=0.3)
-    err = m.setpoint - m.encoder
-    zoom = max(4.0 * m.static_error_rad, 6.0 * m.rad_per_count, 1.5e-4)
-    a2.plot(m.t, err, "C3", lw=1.0)
-    a2.axhline(1e-4, color="k", ls=":", lw=0.8)
-    a2.axhline(-1e-4, color="k", ls=":", lw=0.8, label="target +-1e-4 rad")
-    a2.set_ylim(-zoom, zoom)
+
+    err = np.abs(m.setpoint - m.encoder)
+    floor = 0.1 * m.rad_per_count  # an error of exactly 0 has no logarithm
+    a2.semilogy(m.t, np.maximum(err, floor), "C3", lw=1.1, label="|error| = |setpoint - encoder angle|")
+    a2.axhspan(floor, band, color="C2", alpha=0.25, lw=0, gid="settling_band_error",
+               label=f"inside the settling band (< {band:.3g} rad)")
+    a2.axvline(m.settling_time_s, color="C2", lw=1.2, label=f"settling time {m.settling_time_s:.3f} s")
+    i05 = int(np.argmin(np.abs(m.t - 0.5)))
+    a2.plot(m.t[i05], max(err[i05], floor), "s", color="k", ms=5,
+            label=f"error at 0.5 s (the thesis' number): {m.error_at_0_5s_rad:.1e} rad")
+    a2.axvspan(m.t[-1] - STATIC_WINDOW_S, m.t[-1], color="0.6", alpha=0.25, lw=0,
+               label=f"last {STATIC_WINDOW_S:g} s: static error = largest |error| there, "
+                     f"{m.static_error_rad:.1e} rad")
+    a2.axhline(m.rad_per_count, color="k", ls=":", lw=0.9,
+               label=f"one encoder count ({m.rad_per_count:.1e} rad): the finest step it can see")
+    a2.set_ylim(floor, 2.0 * abs(m.step_rad))
     a2.set_xlim(0.0, m.t[-1])
-    a2.set_xlabel("time (s)")
-    a2.set_ylabel("error (rad)")
-    a2.set_title(f"settles {m.settling_time_s:.3f} s, static {m.static_error_rad:.1e} rad", fontsize=10)
-    a2.legend(loc="upper right", fontsize=8)
-    a2.grid(alpha=0.3)
+    a2.set_xlabel("time after the step (s)")
+    a2.set_ylabel("|error| (rad, log scale)")
+    a2.set_title("Error: slew, settling band, static error", fontsize=10)
+    a2.legend(loc="upper right", fontsize=7.5)
+    a2.grid(alpha=0.3, which="both")
     fig.tight_layout()
+    return fig
+
+
+def plot_step(m: StepMetrics, path: Path) -> Path:
+    """Write :func:`step_figure` of a step response to a PNG file; returns the path."""
+    fig = step_figure(m)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path)
     return path
@@ -447,7 +505,36 @@ def tune_report(params: ArmParams, out_dir: Path | str) -> list[dict[str, Any]]:
     return rows
 
 
+#: The columns of :func:`report_text`: report key, header, width, number format, what it is.
+REPORT_COLUMNS: tuple[tuple[str, str, int, str, str], ...] = (
+    ("drive", "drive", 5, "d", "drive 1 turns the base (q1), drives 2 and 3 the pitch joints (q2, q3)"),
+    ("step_rad", "step", 5, ".2f", "size of the setpoint step, rad"),
+    ("rise_time_s", "rise s", 7, ".3f", "rise time: from 10 % to 90 % of the step, s"),
+    ("settling_time_s", "settle s", 8, ".3f",
+     f"settling time: when |error| last left the band of {SETTLING_BAND * 100:g} % of the step, s"),
+    ("overshoot_pct", "overshoot %", 11, ".2f", "largest excursion past the setpoint, % of the step"),
+    ("error_at_0_5s_rad", "e(0.5s)", 9, ".2e", "|error| 0.5 s after the step, rad (the thesis' figs. 3.7-3.9)"),
+    ("static_error_rad", "static", 9, ".2e",
+     f"static error: largest |error| over the last {STATIC_WINDOW_S:g} s of the run, rad"),
+    ("inner_phase_margin_deg", "PM in", 6, ".1f", "phase margin of the inner (speed) loop, deg"),
+    ("outer_phase_margin_deg", "PM out", 6, ".1f", "phase margin of the outer (position) loop, deg"),
+    ("outer_gain_margin_db", "GM out dB", 9, ".1f", "gain margin of the outer (position) loop, dB"),
+)
+
+
+def report_text(rows: list[dict[str, Any]]) -> str:
+    """:func:`tune_report`'s rows as a table, a line per column saying what it is, and the plots."""
+    header = " ".join(f"{name:>{w}}" for _, name, w, _, _ in REPORT_COLUMNS)
+    body = [" ".join(f"{r[key]:>{w}{fmt}}" for key, _, w, fmt, _ in REPORT_COLUMNS) for r in rows]
+    width = max(len(name) for _, name, _, _, _ in REPORT_COLUMNS)
+    legend = ["", "columns (error = setpoint - encoder angle):",
+              *(f"  {name:<{width}}  {meaning}" for _, name, _, _, meaning in REPORT_COLUMNS)]
+    plots = [f"plot (every column but the margins drawn): {r['plot']}" for r in rows if r.get("plot")]
+    return "\n".join([header, *body, *legend, "", *plots])
+
+
 __all__ = [
     "TuningError", "drive_plant", "speed_estimator", "loop_models", "loop_margins", "design_gains",
-    "StepMetrics", "step_response", "plot_step", "plot_loops", "tune_report", "STEP_POSES", "STEP_RAD",
+    "StepMetrics", "step_response", "settling_band_rad", "step_figure", "plot_step", "plot_loops", "tune_report",
+    "report_text", "REPORT_COLUMNS", "STEP_POSES", "STEP_RAD",
 ]

@@ -16,7 +16,9 @@ import numpy as np
 import pytest
 
 from ttt_sm.app.drawing import DrawError, DrawResult, DrawSession
+from ttt_sm.app.path_plot import PEN_UP_LABEL, PathData, path_figure, state_spans
 from ttt_sm.params import load_params
+from ttt_sm.twin.board_picture import FIELD_MARGIN_M, PX_PER_MM
 from ttt_sm.twin.kinematics import fk
 
 P = load_params()
@@ -28,12 +30,13 @@ class Drawn:
     """What the module's session drew and measured."""
 
     def __init__(self, session: DrawSession, results: dict[str, DrawResult], ink_before_erase: dict,
-                 png: Path, ink_after_erase_mm2: float) -> None:
+                 png: Path, ink_after_erase_mm2: float, o_path: PathData) -> None:
         self.session = session
         self.results = results
         self.ink_before_erase = ink_before_erase
         self.png = png
         self.ink_after_erase_mm2 = ink_after_erase_mm2
+        self.o_path = o_path
 
 
 @pytest.fixture(scope="module")
@@ -47,6 +50,7 @@ def drawn(tmp_path_factory: pytest.TempPathFactory) -> Drawn:
         "X": session.draw("X", *X_CELL),
         "O": session.draw("O", *O_CELL, out_dir=out),
     }
+    o_path = session.path_data()  # before the sponge cuts the O's stroke
     board = session.robot.board
     ink = {"field": board.ink_area_mm2(FIELD),
            **{cell: board.cell_ink_fraction(*cell) for r in range(1, 6) for cell in [(r, c) for c in range(1, 6)]}}
@@ -55,7 +59,7 @@ def drawn(tmp_path_factory: pytest.TempPathFactory) -> Drawn:
     assert robot.run_until(lambda: "Erase" in robot.active("Control"), 5.0)
     assert robot.run_until(lambda: "wait_1" in robot.active("Control"), 120.0)
     assert results["O"].board_png is not None
-    return Drawn(session, results, ink, Path(results["O"].board_png), board.ink_area_mm2(FIELD))
+    return Drawn(session, results, ink, Path(results["O"].board_png), board.ink_area_mm2(FIELD), o_path)
 
 
 @pytest.mark.parametrize("kind", ["field", "X", "O"])
@@ -90,18 +94,64 @@ def test_erasing_leaves_no_ink_on_the_field(drawn):
     assert contact.pen_collision_count == 0 and not contact.sponge_touching
 
 
-def test_the_board_png_is_written_and_opencv_reads_it(drawn):
+def test_the_board_picture_is_written_and_opencv_reads_it(drawn):
     image = cv2.imread(str(drawn.png))
     assert image is not None and image.ndim == 3 and image.shape[2] == 3
-    board = drawn.session.robot.board
-    assert image.shape[:2] == board.render(grid_mm=True).shape[:2]
-    # the robot's dark blue ink is there (the millimetre paper is light)
-    assert np.count_nonzero(image.sum(axis=2) < 300) > 1000
+    # cropped to the field (150 mm and its margins at PX_PER_MM), not the whole 300 x 240 mm board
+    side_px = (P.board.field_size * 1e3 + 2 * FIELD_MARGIN_M * 1e3) * PX_PER_MM
+    assert side_px < image.shape[1] < side_px + 200 and side_px < image.shape[0] < side_px + 250
+    # the robot's dark blue ink is there: the field, the X and the O
+    blue = (image[:, :, 0] > 80) & (image[:, :, 2] < 60)
+    assert np.count_nonzero(blue) > 8 * 150 * PX_PER_MM * 2
+    assert Path(drawn.results["O"].board_png).name == f"board_O_r{O_CELL[0]}c{O_CELL[1]}.png"
 
 
 def test_the_paths_plot_is_written(drawn):
     plot = drawn.results["O"].plot_png
     assert plot is not None and cv2.imread(plot) is not None
+    assert Path(plot).stat().st_size < 250_000
+
+
+def test_the_path_plot_draws_the_numbers_the_drawing_reports(drawn):
+    r, d = drawn.results["O"], drawn.o_path
+    errors = np.concatenate([err for _, _, err in d.strokes]) * 1e3
+    assert round(float(errors.max()), 4) == r.max_error_mm
+    assert round(float(np.sqrt(np.mean(errors ** 2))), 4) == r.rms_error_mm
+    assert sum(len(pts) for pts, _, _ in d.strokes) == r.ink_points
+    assert round(float(np.nanmax(d.tip_vs_encoders_m)) * 1e3, 4) == r.fk_vs_true_max_mm
+    fig = path_figure(d, "O")
+    xy, strip, height, error = fig.axes
+    drawn_err = np.concatenate([ln.get_ydata() for ln in error.lines if ln.get_gid() == "ink_error"])
+    assert drawn_err.max() == pytest.approx(r.max_error_mm, abs=1e-4)
+    (enc,) = [ln for ln in error.lines if ln.get_gid() == "encoders_vs_true"]
+    assert np.nanmax(enc.get_ydata()) == pytest.approx(r.fk_vs_true_max_mm, abs=1e-4)
+    # the X-Y view: the desired pen-down path in black, travel dashed and labelled as such
+    labels = {ln.get_label(): ln for ln in xy.lines if not ln.get_label().startswith("_")}
+    assert labels[PEN_UP_LABEL].get_linestyle() == "--"
+    down = [ln for ln in xy.lines if ln.get_color() == "k" and ln.get_linestyle() == "-"]
+    assert len(down) == len(d.runs) == 1  # an O is one stroke
+    np.testing.assert_allclose(np.column_stack(down[0].get_data()), d.runs[0] * 1e3)
+    # the jump of the desired pose (to the waiting pose, smoothed by the filters) is explained
+    assert any("jumps to the waiting pose" in a.get_text() for a in height.texts)
+
+
+def test_the_path_plot_bands_show_the_control_states_that_drew_the_ink(drawn):
+    d = drawn.o_path
+    spans = state_spans(d.states, float(d.t[-1]))
+    labels = [label for _, _, label in spans]
+    assert labels[0] == "Drawing_O.o_to_start" and labels[-1] == "start_stop.go_wait"
+    assert d.states[-1][1] == "start_stop.wait_1"  # where the drawing ended: entered at the last sample
+    assert [lb for lb in labels if ".arc_" in lb] == [f"Drawing_O.arc_{k}" for k in (1, 2, 3, 4)]
+    assert "start_stop.go_wait" in labels
+    # every point of ink was laid while the O's sub-chart was active, lowering, drawing or lifting
+    for _, times, _ in d.strokes:
+        for t in times:
+            (label,) = [lb for a, b, lb in spans if a <= t < b]
+            assert label.startswith("Drawing_O.o_pen") or label.startswith("Drawing_O.arc_"), (t, label)
+    # the strip draws exactly those spans
+    strip = path_figure(d, "O").axes[1]
+    bands = [p.get_gid() for p in strip.patches]
+    assert bands == [f"state:{lb}" for lb in labels]
 
 
 @pytest.mark.parametrize("kind, row, column, speed, size, named", [

@@ -8,8 +8,10 @@ tip leaves.  :func:`draw` commands one drawing through the Control chart
 `rms_error_mm` / `max_error_mm` (true ink against the desired pen-down
 path), `fk_vs_true_max_mm` (what clearance and model error hide from the
 encoders), `closure_gap_mm` for an O, the longest pen-lift/lower tail, and
-the duration.  It writes the board PNG and the desired/FK/true plot along X,
-Y and Z over time (figs. 3.15-3.18).
+the duration.  It writes the board picture (:mod:`ttt_sm.twin.board_picture`)
+and the path plot (:mod:`.path_plot`: the path seen from above, the pen's
+height, the error along the path and the Control chart's states over time;
+figs. 3.15-3.20).
 """
 
 from __future__ import annotations
@@ -26,7 +28,9 @@ import numpy as np
 from ..params import ArmParams
 from ..sched.scheduler import Signals
 from ..sched.trajectory import distance_to_path, simplify_polyline
+from ..twin.board_picture import save_board_picture
 from ..twin.kinematics import fk
+from .path_plot import PathData, save_path_plot
 from .robot import Robot
 
 KINDS = ("field", "X", "O", "sine")
@@ -45,6 +49,40 @@ class DrawRecord:
     fk_encoder: list[tuple[float, float, float]] = field(default_factory=list)
     fk_true: list[tuple[float, float, float]] = field(default_factory=list)
     tip: list[tuple[float, float]] = field(default_factory=list)  # NaN while the pen is lifted
+
+
+class ActiveStateLog:
+    """python-statemachine listener: when each leaf state of a chart became active, by a clock.
+
+    For labelling plots only (which sub-chart drew what): it reads state names,
+    so nothing may decide anything by it.
+    """
+
+    def __init__(self, clock: Callable[[], float]) -> None:
+        self.clock = clock
+        #: (time, ``"parent.leaf"``) at each change of the active leaf, oldest first.
+        self.changes: list[tuple[float, str]] = []
+
+    def observe(self, chart: Any) -> ActiveStateLog:
+        """Attach to a chart and note the leaf active now."""
+        chart.add_listener(self)
+        self._note(chart)
+        return self
+
+    def after_transition(self, machine: Any) -> None:
+        self._note(machine)
+
+    def _note(self, machine: Any) -> None:
+        leaves = [s for s in machine.configuration if not s.states]
+        label = ", ".join(f"{s.parent.id}.{s.id}" if s.parent is not None else s.id for s in leaves)
+        if not self.changes or self.changes[-1][1] != label:
+            self.changes.append((self.clock(), label))
+
+    def between(self, t0: float, t1: float) -> list[tuple[float, str]]:
+        """The changes in [t0, t1], led by the state already active at t0 (stamped t0)."""
+        before = [c for c in self.changes if c[0] <= t0]
+        inside = [c for c in self.changes if t0 < c[0] <= t1]
+        return ([(t0, before[-1][1])] if before else []) + inside
 
 
 class RecordStage:
@@ -198,7 +236,10 @@ class DrawSession:
         self.robot = Robot(params, seed=seed)
         self.recorder = RecordStage(self.robot)
         self.robot.sched.joint_stages.append(self.recorder)
+        #: The Control chart's active sub-state over time, for the path plot's bands.
+        self.control_states = ActiveStateLog(lambda: self.robot.t).observe(self.robot.control)
         self.say = progress or (lambda _m: None)
+        self._last: tuple[float, int] | None = None  # the last drawing's start time and first stroke
 
     def run_to_wait(self, timeout_s: float) -> None:
         """Run until the Control chart waits in wait_1 (raises DrawError on timeout)."""
@@ -249,6 +290,7 @@ class DrawSession:
         r.chart_step()
         self.run_to_wait(300.0)
         self.recorder.on = False
+        self._last = (t0, strokes_before)
         result = self._measure(kind, row, column, t0, strokes_before, wall0)
         if out_dir is not None:
             result = self._write(result, out_dir)
@@ -286,28 +328,51 @@ class DrawSession:
     def _write(self, result: DrawResult, out_dir: Path) -> DrawResult:
         out_dir.mkdir(parents=True, exist_ok=True)
         name = result.kind + (f"_r{result.row}c{result.column}" if result.row else "")
-        board_png = self.robot.board.save_png(out_dir / f"board_{name}.png", grid_mm=True)
-        plot_png = out_dir / f"paths_{name}.png"
-        plot_paths(self.recorder.record, plot_png, title=f"{result.kind}: desired, FK of encoders, true")
+        what = _what(result)
+        seed = self.robot.seed
+        board_png = save_board_picture(
+            self.robot.board, out_dir / f"board_{name}.png", f"{what}, drawn by the robot on the simulated whiteboard",
+            f"ttt-sm draw {result.kind}" + (f" --row {result.row} --column {result.column}" if result.row else "")
+            + f" --speed {result.speed_mm_s:g}" + (f" --size {result.size_mm:g}" if result.size_mm else "")
+            + f" --seed {seed}: the whole board as it is after this drawing")
+        t0 = self._last[0] if self._last else self.robot.t
+        plot_png = save_path_plot(
+            self.path_data(), out_dir / f"paths_{name}.png", f"{what}: where the pen went",
+            f"{result.speed_mm_s:g} mm/s, seed {seed}, commanded at t = {t0:.2f} s of simulated time, "
+            f"{result.duration_s:.1f} s to the waiting pose again; ink against the desired path: "
+            f"rms {result.rms_error_mm:.3f} mm, max {result.max_error_mm:.3f} mm")
         return DrawResult(**{**asdict(result), "board_png": str(board_png), "plot_png": str(plot_png)})
 
+    def path_data(self) -> PathData:
+        """The last drawing's record as the path plot's data (see :mod:`.path_plot`).
 
-def plot_paths(rec: DrawRecord, path: Path, title: str) -> None:
-    """Desired, forward kinematics of the encoders and true tool, along X, Y, Z over time."""
-    from matplotlib.figure import Figure
+        Take it before anything else touches the board: the ink is read from
+        the board's strokes, which a sponge pass cuts.
+        """
+        if self._last is None:
+            raise DrawError("nothing drawn yet: path_data describes the last drawing")
+        t0, strokes_before = self._last
+        rec = self.recorder.record
+        params = self.params
+        desired = np.asarray(rec.desired)
+        runs = _pen_down_runs(desired, params.board.surface_z)
+        strokes = [s for s in self.robot.board.strokes[strokes_before:] if s.author == "robot"]
+        tip = np.asarray(rec.tip)
+        enc = np.asarray(rec.fk_encoder)
+        t = np.asarray(rec.t)
+        return PathData(
+            t=t, desired=desired, fk_encoder=enc, fk_true=np.asarray(rec.fk_true),
+            strokes=[(s.points, s.times, _distance_to_runs(s.points, runs)) for s in strokes],
+            runs=runs, tip_vs_encoders_m=np.hypot(*(enc[:, :2] - tip).T),
+            states=self.control_states.between(t0, float(t[-1])),
+            surface_z=params.board.surface_z, field_bounds=params.board.field_bounds(),
+            cell_size=params.board.cell_size, cells=params.board.cells,
+        )
 
-    t = np.asarray(rec.t)
-    desired, enc, true = (np.asarray(a) * 1e3 for a in (rec.desired, rec.fk_encoder, rec.fk_true))
-    fig = Figure(figsize=(9, 7))
-    axes = fig.subplots(3, 1, sharex=True)
-    for i, (ax, name) in enumerate(zip(axes, "XYZ", strict=True)):
-        ax.plot(t, desired[:, i], "k--", lw=1, label="desired")
-        ax.plot(t, enc[:, i], lw=1, label="FK of encoders")
-        ax.plot(t, true[:, i], lw=1, label="true (sensor)")
-        ax.set_ylabel(f"{name} (mm)")
-        ax.grid(alpha=0.3)
-    axes[0].legend(loc="best", fontsize=8)
-    axes[0].set_title(title)
-    axes[-1].set_xlabel("time (s)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=80)
+
+def _what(result: DrawResult) -> str:
+    if result.kind == "field":
+        return "The playing field"
+    if result.kind == "sine":
+        return "The sine wave of thesis section 3.5.3"
+    return f"An {result.kind} in cell ({result.row}, {result.column})"

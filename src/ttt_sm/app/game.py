@@ -29,6 +29,7 @@ from ..params import ArmParams
 from ..runtime.jsonable import dumps
 from ..runtime.listeners import Trace
 from ..sched.scheduler import Signals
+from ..twin.board_picture import save_board_picture
 from ..vision import MoveError, percent_process
 from .camera_link import CameraLink
 from .robot import Robot
@@ -391,7 +392,14 @@ class GameSession:
             if self.trace is not None:
                 for rec in self.trace.records:
                     f.write(dumps({"event": "transition", **asdict(rec)}) + "\n")
-        png = self.robot.board.save_png(out_dir / "board_final.png", grid_mm=True)
+        robot = self.robot
+        ink = robot.board.ink_area_mm2()
+        png = save_board_picture(
+            robot.board, out_dir / "board_final.png",
+            f"The whiteboard when the game was saved, {len(self.moves)} moves played"
+            + ("" if ink else ": erased, no ink left"),
+            f"the robot plays {self.robot_symbol} (blue ink), the person {self.person_symbol} (black ink); "
+            f"seed {robot.seed}, simulated time {robot.t:.1f} s, {ink:.0f} mm² of ink on the board")
         return {"record": str(record), "board_png": str(png)}
 
     def close(self) -> None:

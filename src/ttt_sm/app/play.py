@@ -4,7 +4,7 @@ For now (the game itself comes with the game issue): the drives initialise
 with their charts, the Control chart moves above the board, draws the
 playing field, an X and an O, erases the board, and finishes back at its
 start pose.  Every drawing is measured as in thesis section 3.5, and the
-board is saved as PNG before and after erasing.
+board is saved as a picture (:mod:`ttt_sm.twin.board_picture`) before and after erasing.
 """
 
 from __future__ import annotations
@@ -16,7 +16,15 @@ from pathlib import Path
 from typing import Any
 
 from ..params import ArmParams
+from ..twin.board_picture import save_board_picture
 from .drawing import DrawError, DrawSession
+
+#: What the demo draws, in order: (kind, row, column).
+DEMO_DRAWINGS = (("field", 3, 3), ("X", 2, 2), ("O", 3, 3))
+
+
+def _what(kind: str, row: int, column: int) -> str:
+    return "the field" if kind == "field" else f"an {kind} in cell ({row}, {column})"
 
 
 def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
@@ -29,12 +37,14 @@ def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
     t_ready = session.start()
     out_dir.mkdir(parents=True, exist_ok=True)
     drawings = []
-    for kind, row, column in (("field", 3, 3), ("X", 2, 2), ("O", 3, 3)):
+    for kind, row, column in DEMO_DRAWINGS:
         d = session.draw(kind, row, column)
         drawings.append(d)
         say(f"  {d.kind}: rms {d.rms_error_mm:.3f} mm, max {d.max_error_mm:.3f} mm, {d.duration_s:.1f} s"
             + (f", closes within {d.closure_gap_mm:.2f} mm" if d.kind == "O" else ""))
-    before = robot.board.save_png(out_dir / "board_drawn.png", grid_mm=True)
+    before = save_board_picture(robot.board, out_dir / "board_drawn.png",
+                                "The whiteboard after " + ", ".join(_what(*d) for d in DEMO_DRAWINGS),
+                                f"ttt-sm demo, seed {seed}: what the true pen tip inked; next, the sponge erases it")
     ink_drawn = robot.board.ink_area_mm2()
     say(f"board saved: {before}")
 
@@ -46,7 +56,9 @@ def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
     if not robot.run_until(lambda: not c.erasing, 300.0):
         raise DrawError("erasing did not finish within 300 s")
     ink_left = robot.board.ink_area_mm2()
-    after = robot.board.save_png(out_dir / "board_erased.png", grid_mm=True)
+    after = save_board_picture(robot.board, out_dir / "board_erased.png", "The whiteboard after erasing",
+                               f"ttt-sm demo, seed {seed}: {ink_drawn:.0f} mm² of ink before, "
+                               f"{ink_left:.1f} mm² left after the sponge's passes")
     say(f"erased: {ink_drawn:.0f} mm2 of ink before, {ink_left:.1f} mm2 after")
 
     say("finishing: back to the start pose")

@@ -12,6 +12,7 @@ from ttt_sm.params import load_params
 from ttt_sm.twin.control import setpoint_filter_matrices
 from ttt_sm.twin.plant import ArmSim
 from ttt_sm.twin.tuning import (
+    LOOPS_PNG,
     REPORT_COLUMNS,
     SETTLING_BAND,
     STATIC_WINDOW_S,
@@ -21,6 +22,7 @@ from ttt_sm.twin.tuning import (
     drive_plant,
     loop_margins,
     loop_models,
+    loops_figure,
     report_text,
     step_figure,
     step_response,
@@ -133,6 +135,7 @@ def test_tune_report_has_exactly_the_keys_and_writes_plots(params, tmp_path):
         assert png.stat().st_size < 150_000
         assert r["settling_time_s"] <= 0.5 and r["overshoot_pct"] <= 5.0 and r["static_error_rad"] <= 1e-4
         assert r["inner_phase_margin_deg"] >= 45.0 and r["outer_phase_margin_deg"] >= 45.0
+    assert (tmp_path / LOOPS_PNG).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def _artist(ax, gid):
@@ -176,3 +179,22 @@ def test_the_tune_table_says_what_every_column_is():
     assert "  PM in" in text and "phase margin of the inner (speed) loop" in text
     assert "  GM out dB" in text and "gain margin of the outer (position) loop" in text
     assert "  e(0.5s)" in text and "0.5 s after the step" in text
+
+
+def test_the_bode_plot_draws_the_margins_the_design_reports(params, gains):
+    (inner_mag, outer_mag), (inner_ph, outer_ph) = np.reshape(loops_figure(params, gains).axes, (2, 2))
+    for drive in (1, 2, 3):
+        g = gains.drive(drive)
+        for col, (mag, ph, pm, gm) in enumerate(((inner_mag, inner_ph, g.inner_phase_margin_deg,
+                                                  g.inner_gain_margin_db),
+                                                 (outer_mag, outer_ph, g.outer_phase_margin_deg,
+                                                  g.outer_gain_margin_db))):
+            (pm_bar,) = [ln for ln in ph.lines if ln.get_gid() == f"pm_drive{drive}_{col}"]
+            low, high = sorted(pm_bar.get_ydata())
+            assert high - low == pytest.approx(pm)  # the phase margin, standing on -180 deg
+            assert low == pytest.approx(-180.0, abs=1.0)
+            (gm_bar,) = [ln for ln in mag.lines if ln.get_gid() == f"gm_drive{drive}_{col}"]
+            low, high = sorted(gm_bar.get_ydata())
+            assert high - low == pytest.approx(gm) and high == pytest.approx(0.0, abs=0.3)
+            assert any(f"drive {drive}: phase margin {pm:.0f}°" in t.get_text()
+                       for t in ph.get_legend().get_texts())

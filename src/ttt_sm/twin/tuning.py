@@ -173,14 +173,31 @@ def loop_margins(loop: ct.StateSpace) -> tuple[float, float, float]:
     (the gear resonance can cross |L| = 1 a second time); the crossover is
     the first frequency where |L| falls through 1.
     """
+    pm, gm_db, _, _, fc = _margins(loop)
+    return pm, gm_db, fc
+
+
+def margin_points(loop: ct.StateSpace) -> tuple[float, float, float, float]:
+    """Where :func:`loop_margins` reads the margins: (phase margin deg, at Hz, gain margin dB, at Hz).
+
+    The phase margin at its gain crossover (|L| = 1), the gain margin at its
+    phase crossover (-180 deg), both control.margin's; NaN where there is none.
+    """
+    pm, gm_db, f_pm, f_gm, _ = _margins(loop)
+    return pm, f_pm, gm_db, f_gm
+
+
+def _margins(loop: ct.StateSpace) -> tuple[float, float, float, float, float]:
+    """(pm deg, gm dB, f at pm Hz, f at gm Hz, first crossover Hz) with control.margin on a dense FRD."""
     omega = _freq_grid(loop.dt)
     resp = _response(loop, omega)
     frd = ct.frd(resp, omega)
-    gm, pm, _wpc, _wgc = ct.margin(frd)
+    gm, pm, wpc, wgc = ct.margin(frd)
     gm_db = math.inf if not np.isfinite(gm) else 20.0 * math.log10(gm)
     below = np.flatnonzero(np.abs(resp) < 1.0)
     wc = float(omega[below[0]]) if below.size else math.nan
-    return float(pm), float(gm_db), wc / (2 * math.pi)
+    hz = 1 / (2 * math.pi)
+    return float(pm), float(gm_db), float(wgc) * hz, float(wpc) * hz, wc * hz
 
 
 def _design_inner(params: ArmParams, drive: int) -> tuple[float, float]:
@@ -439,48 +456,91 @@ def plot_step(m: StepMetrics, path: Path) -> Path:
     return path
 
 
-def plot_loops(params: ArmParams, gains: Gains, path: Path) -> Path:
-    """Bode plots of every drive's inner and outer open loop (compliant gear; inner also rigid)."""
+def loops_figure(params: ArmParams, gains: Gains) -> Figure:
+    """Bode plots of every drive's inner and outer open loop, with the margins drawn where they are read.
+
+    Compliant gear model; the inner loop also with a rigid gear (dotted).  On
+    each curve a dot marks the crossover (|L| = 1); in the phase plot a bar
+    from -180 deg up to the curve is the phase margin there, in the
+    magnitude plot a bar from the curve up to 0 dB at the -180 deg crossing
+    is the gain margin.
+    """
     from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
 
     omega = _freq_grid(params.control.dt)[1000:]
     f = omega / (2 * math.pi)
-    fig = Figure(figsize=(9.0, 5.4), dpi=80)
+    fig = Figure(figsize=(12.0, 8.4), dpi=80)
     axes = fig.subplots(2, 2, sharex=True)
+    fig.subplots_adjust(left=0.07, right=0.985, top=0.9, bottom=0.25, hspace=0.1, wspace=0.14)
+    fig.suptitle("Open loops of the drives' cascades, sampled at 1 ms, as the design model has them "
+                 "(docs/tuning.md)", fontsize=12)
+    names = ("inner loop L_w: speed PI, broken at the PWM duty", "outer loop L_q: position P, the inner loop closed")
     for drive in (1, 2, 3):
         g = gains.drive(drive)
         inner, outer = loop_models(params, drive, g)
         rigid, _ = loop_models(params, drive, g, compliant=False)
-        for col, (loop, name) in enumerate(((inner, "inner (speed)"), (outer, "outer (position)"))):
+        color = f"C{drive - 1}"
+        for col, loop in enumerate((inner, outer)):
             r = _response(loop, omega)
+            db = 20 * np.log10(np.abs(r))
             ph = np.degrees(np.unwrap(np.angle(r)))
             ph -= 360.0 * np.round((ph[0] + 90.0) / 360.0)  # start near -90 deg (an integrator)
-            color = f"C{drive - 1}"
-            axes[0, col].semilogx(f, 20 * np.log10(np.abs(r)), color, lw=1.0, label=f"drive {drive}")
-            axes[1, col].semilogx(f, ph, color, lw=1.0)
-            axes[0, col].set_title(f"{name} open loop")
+            pm, f_pm, gm, f_gm = margin_points(loop)
+            mag_ax, ph_ax = axes[0, col], axes[1, col]
+            mag_ax.semilogx(f, db, color, lw=1.1,
+                            label=f"drive {drive}: phase margin {pm:.0f}° at {f_pm:.1f} Hz, "
+                                  f"gain margin {gm:.1f} dB at {f_gm:.0f} Hz")
+            ph_ax.semilogx(f, ph, color, lw=1.1)
+            if math.isfinite(f_pm):
+                mag_ax.plot(f_pm, 0.0, "o", color=color, ms=5)
+                ph_at = float(np.interp(f_pm, f, ph))
+                ph_ax.plot([f_pm, f_pm], [ph_at - pm, ph_at], color=color, lw=3, alpha=0.55,
+                           solid_capstyle="butt", gid=f"pm_drive{drive}_{col}")
+            if math.isfinite(f_gm):
+                db_at = float(np.interp(f_gm, f, db))
+                mag_ax.plot([f_gm, f_gm], [db_at, db_at + gm], color=color, lw=3, alpha=0.55,
+                            solid_capstyle="butt", gid=f"gm_drive{drive}_{col}")
             if col == 0:
-                rr = _response(rigid, omega)
-                axes[0, 0].semilogx(f, 20 * np.log10(np.abs(rr)), f"C{drive - 1}", lw=0.6, ls=":")
+                mag_ax.semilogx(f, 20 * np.log10(np.abs(_response(rigid, omega))), color, lw=0.7, ls=":")
     for col in (0, 1):
-        axes[0, col].axhline(0.0, color="k", lw=0.6)
-        axes[1, col].axhline(-180.0, color="k", lw=0.6)
+        axes[0, col].axhline(0.0, color="k", lw=0.7)
+        axes[1, col].axhline(-180.0, color="k", lw=0.7)
         axes[0, col].set_ylim(-40, 40)
         axes[1, col].set_ylim(-360, 0)
+        axes[0, col].set_title(names[col], fontsize=10)
         axes[1, col].set_xlabel("frequency (Hz)")
         for ax in axes[:, col]:
             ax.grid(alpha=0.3, which="both")
+        handles, _ = axes[0, col].get_legend_handles_labels()
+        extra = [Line2D([], [], color="k", lw=0.7, label="0 dB: |L| = 1; a dot marks the crossover"),
+                 Line2D([], [], color="0.5", lw=3, alpha=0.55,
+                        label="bars: the margins, where they are read (gain: up to 0 dB at -180°)")]
+        if col == 0:
+            extra.append(Line2D([], [], color="0.3", lw=0.7, ls=":", label="dotted: the same loop with a rigid gear"))
+        axes[1, col].legend(handles=handles + extra, fontsize=8, loc="upper left", bbox_to_anchor=(0.0, -0.14),
+                            frameon=False)
     axes[0, 0].set_ylabel("|L| (dB)")
-    axes[1, 0].set_ylabel("phase (deg)")
-    axes[0, 0].legend(fontsize=8, title="dotted: rigid gear", title_fontsize=7)
-    fig.tight_layout()
+    axes[1, 0].set_ylabel("phase of L (deg)")
+    axes[1, 1].text(0.02, 0.04, "-180°: a phase margin is the distance above this line at the crossover",
+                    transform=axes[1, 1].transAxes, fontsize=8, color="0.3")
+    return fig
+
+
+def plot_loops(params: ArmParams, gains: Gains, path: Path) -> Path:
+    """Write :func:`loops_figure` to a PNG file; returns the path."""
+    fig = loops_figure(params, gains)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path)
     return path
 
 
+#: The Bode plot :func:`tune_report` writes beside the step plots.
+LOOPS_PNG = "loops_bode.png"
+
+
 def tune_report(params: ArmParams, out_dir: Path | str) -> list[dict[str, Any]]:
-    """Design the gains, step every drive on the twin, write one PNG per drive.
+    """Design the gains, step every drive on the twin, write one PNG per drive and the Bode plot (``LOOPS_PNG``).
 
     Returns one dict per drive with exactly the keys ``drive``, ``step_rad``,
     ``rise_time_s``, ``settling_time_s``, ``overshoot_pct``,
@@ -489,6 +549,7 @@ def tune_report(params: ArmParams, out_dir: Path | str) -> list[dict[str, Any]]:
     """
     out = Path(out_dir)
     gains = design_gains(params)
+    plot_loops(params, gains, out / LOOPS_PNG)
     rows = []
     for drive in (1, 2, 3):
         m = step_response(params, gains, drive, STEP_RAD[drive])
@@ -529,12 +590,15 @@ def report_text(rows: list[dict[str, Any]]) -> str:
     width = max(len(name) for _, name, _, _, _ in REPORT_COLUMNS)
     legend = ["", "columns (error = setpoint - encoder angle):",
               *(f"  {name:<{width}}  {meaning}" for _, name, _, _, meaning in REPORT_COLUMNS)]
-    plots = [f"plot (every column but the margins drawn): {r['plot']}" for r in rows if r.get("plot")]
+    plots = [f"step plot (every column but the margins drawn): {r['plot']}" for r in rows if r.get("plot")]
+    if plots:
+        plots.append(f"open loops (Bode, the margins drawn): {Path(rows[0]['plot']).parent / LOOPS_PNG}")
     return "\n".join([header, *body, *legend, "", *plots])
 
 
 __all__ = [
     "TuningError", "drive_plant", "speed_estimator", "loop_models", "loop_margins", "design_gains",
-    "StepMetrics", "step_response", "settling_band_rad", "step_figure", "plot_step", "plot_loops", "tune_report",
-    "report_text", "REPORT_COLUMNS", "STEP_POSES", "STEP_RAD",
+    "StepMetrics", "step_response", "settling_band_rad", "step_figure", "plot_step", "margin_points",
+    "loops_figure", "plot_loops", "tune_report",
+    "report_text", "REPORT_COLUMNS", "LOOPS_PNG", "STEP_POSES", "STEP_RAD",
 ]

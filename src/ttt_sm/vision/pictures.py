@@ -19,12 +19,13 @@ OCCUPIED_BGR = (0, 150, 0)
 EMPTY_BGR = (120, 120, 120)
 
 
-def overlay(image: np.ndarray, detection: Detection) -> np.ndarray:
+def overlay(image: np.ndarray, detection: Detection, legend: bool = True) -> np.ndarray:
     """The photo with the located field drawn on it: lines, crossings, outer edge, each cell's reading.
 
     Orange: the 4 + 4 drawn lines as located; blue: the field's outer edge,
     extrapolated one cell beyond them; red dots: the 16 crossings; in each
-    cell its character and ink percentage.
+    cell its character and ink percentage.  With `legend`, a box in the
+    photo's corner farthest from the field says so (:data:`OVERLAY_LEGEND`).
     """
     out = image.copy() if image.ndim == 3 else cv2.cvtColor(image, cv2.COLOR_GRAY2BGR)
     g = detection.grid
@@ -40,12 +41,55 @@ def overlay(image: np.ndarray, detection: Detection) -> np.ndarray:
     for k, (u, v) in enumerate(centres):
         ch, pct = detection.cells[k], detection.percentages[k]
         colour = EMPTY_BGR if ch == "." else OCCUPIED_BGR
-        label = f"{ch} {pct:.0f}"
+        label = f"{ch} {pct:.0f}%"
         (w, h), _ = cv2.getTextSize(label, cv2.FONT_HERSHEY_SIMPLEX, 0.42, 1)
         org = (int(u - w / 2), int(v + h / 2))
         cv2.putText(out, label, org, cv2.FONT_HERSHEY_SIMPLEX, 0.42, (255, 255, 255), 3, cv2.LINE_AA)
         cv2.putText(out, label, org, cv2.FONT_HERSHEY_SIMPLEX, 0.42, colour, 1, cv2.LINE_AA)
+    if legend:
+        _legend(out, g.corners)
     return out
+
+
+#: What :func:`overlay`'s colours mean: (BGR, how it is drawn, what it is).
+OVERLAY_LEGEND = (
+    (GRID_BGR, "line", "the 4 + 4 drawn lines, as located"),
+    (BORDER_BGR, "line", "the field's outer edge, one cell beyond"),
+    (CROSSING_BGR, "dot", "the 16 crossings of the lines"),
+    (OCCUPIED_BGR, "text", "in each cell: what was read, ink %"),
+)
+
+
+def legend_box(shape: tuple[int, ...], field_corners: np.ndarray) -> tuple[int, int, int, int]:
+    """(x0, y0, x1, y1) of the overlay's legend: the image corner that hides the least of the field."""
+    font, scale = cv2.FONT_HERSHEY_SIMPLEX, 0.42
+    w = max(cv2.getTextSize(text, font, scale, 1)[0][0] for _, _, text in OVERLAY_LEGEND) + 40
+    h = 17 * len(OVERLAY_LEGEND) + 8
+    height, width = shape[:2]
+    fx0, fy0 = np.min(field_corners, axis=0)
+    fx1, fy1 = np.max(field_corners, axis=0)
+    boxes = [(4, 4), (width - 4 - w, 4), (4, height - 4 - h), (width - 4 - w, height - 4 - h)]
+
+    def hidden(x: int, y: int) -> float:
+        return max(0.0, min(x + w, fx1) - max(x, fx0)) * max(0.0, min(y + h, fy1) - max(y, fy0))
+
+    x, y = min(boxes, key=lambda b: hidden(*b))
+    return x, y, x + w, y + h
+
+
+def _legend(out: np.ndarray, field_corners: np.ndarray) -> None:
+    x0, y0, x1, y1 = legend_box(out.shape, field_corners)
+    cv2.rectangle(out, (x0, y0), (x1, y1), (255, 255, 255), -1)
+    cv2.rectangle(out, (x0, y0), (x1, y1), (150, 150, 150), 1)
+    for k, (colour, kind, text) in enumerate(OVERLAY_LEGEND):
+        y = y0 + 13 + 17 * k
+        if kind == "line":
+            cv2.line(out, (x0 + 6, y - 4), (x0 + 26, y - 4), colour, 2, cv2.LINE_AA)
+        elif kind == "dot":
+            cv2.circle(out, (x0 + 16, y - 4), 3, colour, -1, cv2.LINE_AA)
+        else:
+            cv2.putText(out, "X", (x0 + 10, y), cv2.FONT_HERSHEY_SIMPLEX, 0.42, colour, 1, cv2.LINE_AA)
+        cv2.putText(out, text, (x0 + 34, y), cv2.FONT_HERSHEY_SIMPLEX, 0.42, (40, 40, 40), 1, cv2.LINE_AA)
 
 
 def cells_picture(image: np.ndarray, detection: Detection, cell_px: int = CELL_PX) -> np.ndarray:
@@ -134,7 +178,8 @@ def doc_pictures(out_dir: str | Path, params: ArmParams | None = None) -> list[P
 
     pictures = {
         "vision_photo.png": small(photo),
-        "vision_overlay.png": overlay(photo, det)[max(0, y0):min(h, y1), max(0, x0):min(w, x1)],
+        # cropped to the field, without the legend (the page's caption says what the colours are)
+        "vision_overlay.png": overlay(photo, det, legend=False)[max(0, y0):min(h, y1), max(0, x0):min(w, x1)],
         "vision_cells.png": cells_picture(photo, det),
         "vision_dim_photo.png": small(dim_photo),
         "vision_fixed_level.png": fixed_level_picture(dim_photo, detect(dim_photo)),

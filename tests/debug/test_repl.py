@@ -151,3 +151,14 @@ def test_the_installed_command_with_a_pipe_quits_at_the_end_of_input():
     assert "breakpoint 1 (enter DriveInit1.turn_back): entered turn_back" in done.stdout
     assert re.search(r"DriveInit1 +run > initialise > turn_back", done.stdout)
     assert done.stdout.rstrip().endswith("(end of commands)")
+
+
+@pytest.mark.parametrize("argv", [["--start", "-120,0,0"], ["--start=-120,0,0"]])
+def test_a_negative_start_angle_is_read_after_a_space_or_an_equals_sign(argv, monkeypatch, capsys):
+    """docs/tutorial.md writes `--start -120,0,0`: argparse alone took -120,0,0 for an option."""
+    monkeypatch.setattr(sys, "stdin", io.StringIO("show signals\n"))
+    assert main(["debug", *argv]) == 0
+    out = capsys.readouterr().out
+    assert "start (-120.0, 0.0, 0.0, 0.0) deg" in out
+    assert re.search(r"q_true +\[-2\.0944 ", out)  # -120 deg in radians
+

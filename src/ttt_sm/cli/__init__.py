@@ -26,7 +26,7 @@ from collections.abc import Sequence
 
 from ..params import ParameterError
 from . import ai, camera, commands, debug, docs, scenario, vision
-from .common import CliError
+from .common import CliError, join_negative_values
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
 SUBCOMMANDS = (commands, scenario, debug, camera, vision, ai, docs)
@@ -47,7 +47,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ttt-sm` console script."""
     from ..twin.kinematics import IKError
 
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else argv))
     try:
         return int(args.func(args))
     except (ParameterError, IKError, CliError) as exc:

@@ -8,13 +8,15 @@
   infinity are ``null``, never the bare ``NaN`` that JSON readers refuse).
 - :func:`progress`: progress lines on standard error, so ``--json`` output
   stays one document.
+- :func:`join_negative_values`: ``--start -120,0,0`` read as ``--start=-120,0,0``.
 """
 
 from __future__ import annotations
 
 import argparse
+import re
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from ..runtime.jsonable import dumps
@@ -33,6 +35,49 @@ def add_command(sub: Any, name: str, func: Command, help_: str) -> argparse.Argu
     sp.add_argument("--json", action="store_true", help="print one JSON document")
     sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
     return sp
+
+
+#: A value that starts with a minus and a digit: a negative number, or a list of numbers.
+_NEGATIVE_VALUE = re.compile(r"^-\.?\d")
+
+
+def _value_options(parser: argparse.ArgumentParser) -> set[str]:
+    """The option strings of `parser` that take one value (``--start Q1,Q2,Q3``)."""
+    return {opt for action in parser._actions if action.option_strings and action.nargs is None
+            for opt in action.option_strings}
+
+
+def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
+def join_negative_values(parser: argparse.ArgumentParser, argv: Sequence[str]) -> list[str]:
+    """``--opt -1,2`` written as ``--opt=-1,2``, for every option that takes a value.
+
+    argparse reads a word that starts with ``-`` as an option unless it is a
+    plain number, so ``--start -120,0,0`` failed with "expected one argument"
+    while ``--start=-120,0,0`` worked; both mean the same to a person.
+    """
+    options = _value_options(parser)
+    subcommands = _subcommands(parser)
+    out: list[str] = []
+    args = list(argv)
+    i = 0
+    while i < len(args):
+        word = args[i]
+        if word in subcommands:
+            options = options | _value_options(subcommands[word])
+            subcommands = _subcommands(subcommands[word])
+        if word in options and i + 1 < len(args) and _NEGATIVE_VALUE.match(args[i + 1]):
+            out.append(f"{word}={args[i + 1]}")
+            i += 2
+            continue
+        out.append(word)
+        i += 1
+    return out
 
 
 def progress(enabled: bool) -> Callable[[str], None]:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import gc
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Generator, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
@@ -135,6 +135,84 @@ class GameRecord:
         self.events.append({"t": round(t, 4), "event": kind, **data})
 
 
+@dataclass(frozen=True)
+class Wait:
+    """What the game flow waits for between two of its moves.
+
+    Chart steps run until ``until()`` holds (checked after each step), at most
+    ``timeout_s`` of simulated time; ``what`` names it in the error a timeout
+    raises.  ``tell``: the Game chart's new messages are shown to the person
+    meanwhile.
+    """
+
+    until: Callable[[], bool]
+    timeout_s: float
+    what: str
+    tell: bool = True
+
+
+#: The game flow (:meth:`GameSession.flow`): yields what it waits for, returns at the end of the game.
+Flow = Generator[Wait, None, None]
+
+
+class GameDriver:
+    """Plays the game flow from inside the chart steps: whoever steps the robot plays the game.
+
+    :meth:`GameSession.play` runs the flow itself (``Robot.run_until`` for each
+    :class:`Wait`).  A debugger or a GUI steps the robot one control step at a
+    time instead; with a driver (:meth:`GameSession.drive`) the Game stage
+    checks the flow's wait at the start of each chart step, that is right after
+    the previous chart step, where ``run_until`` checks it: the same game,
+    move for move.  A wait that times out, or a camera view the game refuses,
+    ends the flow with :attr:`error` (the charts run on); nothing is raised
+    out of a chart step.
+    """
+
+    def __init__(self, session: GameSession, max_moves: int) -> None:
+        self.session = session
+        self._flow: Flow | None = session.flow(max_moves)
+        self.wait: Wait | None = None
+        #: Chart steps run since the flow began its current wait.
+        self.waited = 0
+        #: Why the flow stopped before the end of the game (a wait that timed out, a refused view).
+        self.error: GameError | None = None
+        #: The flow ran to its end: the game is over and the arm turned off.
+        self.done = False
+
+    @property
+    def running(self) -> bool:
+        """The flow has not ended (neither finished nor stopped by an error)."""
+        return self._flow is not None
+
+    def before_chart_step(self) -> None:
+        """Called at the start of every chart step: check the wait, go on with the flow when it holds."""
+        flow = self._flow
+        if flow is None:
+            return
+        wait = self.wait
+        if wait is not None:
+            self.waited += 1
+            if not self.session.watch(wait):
+                limit = self.session.robot.sched.ticks_for(wait.timeout_s)
+                if self.waited >= limit:
+                    self._stop(self.session.wait_failed(wait))
+                return
+        try:
+            self.wait = next(flow)
+        except StopIteration:
+            self._flow, self.wait, self.done = None, None, True
+            return
+        except GameError as exc:
+            self._stop(exc)
+            return
+        self.waited = 0
+
+    def _stop(self, error: GameError) -> None:
+        assert self._flow is not None
+        self._flow.close()
+        self._flow, self.error = None, error
+
+
 class GameStage:
     """Task stage before the Control chart: the Game and AlgorithmActivator charts and the engine.
 
@@ -165,6 +243,8 @@ class GameStage:
 
     def tick(self, signals: Signals) -> None:
         s = self.s
+        if s.driver is not None:
+            s.driver.before_chart_step()
         self._feed_game()
         s.game.tick()
         request, erasing, field_drawn = self._after_game()
@@ -181,11 +261,16 @@ class GameStage:
 
 
 class GameSession:
-    """One game on the simulated robot."""
+    """One game on the simulated robot.
+
+    ``q_start`` and ``settle_s`` are the :class:`Robot`'s: the pose before the
+    unpowered arm settles for ``settle_s`` seconds (default: the rest pose).
+    """
 
     def __init__(self, params: ArmParams, seed: int = 0, robot_symbol: str = "O", person: Person | None = None,
                  engine: str = "strong", camera: str = "serial", record_trace: bool = True,
-                 progress: Callable[[str], None] | None = None) -> None:
+                 progress: Callable[[str], None] | None = None, q_start: Sequence[float] | None = None,
+                 settle_s: float = 0.0) -> None:
         if robot_symbol not in ("X", "O"):
             raise ValueError(f"robot symbol must be X or O, got {robot_symbol!r}")
         setup0 = time.perf_counter()
@@ -193,12 +278,13 @@ class GameSession:
         self.say = progress or (lambda _m: None)
         self.trace = Trace() if record_trace else None
         listeners: list[object] = [self.trace] if self.trace else []
-        self.robot = Robot(params, seed=seed, listeners=listeners)
+        self.robot = Robot(params, seed=seed, listeners=listeners, q_start=q_start, settle_s=settle_s)
         self.activator = AlgorithmActivator(tick_period_s=params.control.chart_dt, listeners=listeners)
         self.game = Game(tick_period_s=params.control.chart_dt, listeners=listeners)
         self.robot_symbol = robot_symbol
         self.person_symbol = "X" if robot_symbol == "O" else "O"
         self.person = person or SimulatedPerson(seed, self.say)
+        self.engine_name = engine
         self.engine = engine_for(engine)
         self.camera = CameraLink(params, self.robot.board, seed=seed, mode=camera)
         self.board = "." * 25  # what the robot believes: its moves and the person's detected moves
@@ -215,10 +301,15 @@ class GameSession:
         self.detections_wrong = 0
         self.record = GameRecord()
         self.moves: list[dict[str, Any]] = []
+        #: 'X', 'O', 'draw' or 'abandoned' once the flow has seen the game end, else None.
+        self.outcome: str | None = None
+        #: Plays the flow from inside the chart steps (:meth:`drive`), else None.
+        self.driver: GameDriver | None = None
         self._last_message = ""
         #: The Session block's output `play_again`: one game per session.
         self.play_again = False
         self.robot.add_charts((self.activator, self.game), GAME_WIRES, GameStage(self))
+        self.robot.game = self
         #: Building the twin (controller design, compiled kernels loaded), the charts and the camera.
         self.setup_wall_s = time.perf_counter() - setup0
 
@@ -239,19 +330,25 @@ class GameSession:
 
     # -- running -----------------------------------------------------------------------
 
-    def _run_until(self, predicate: Callable[[], bool], timeout_s: float, what: str) -> None:
-        def watch() -> bool:
+    def watch(self, wait: Wait) -> bool:
+        """After a chart step: show the person the Game chart's new message; whether the wait is over."""
+        if wait.tell:
             msg = self.game.message
             if msg != self._last_message:
                 self._last_message = msg
                 self.person.tell(msg)
                 self.record.add(self.robot.t, "message", text=msg)
-            return predicate()
+        return wait.until()
 
-        if not self.robot.run_until(watch, timeout_s):
-            control, game = sorted(self.robot.active("Control")), sorted(self.robot.active("Game"))
-            raise GameError(f"{what} did not happen within {timeout_s:.0f} s of simulated time "
-                            f"(Control: {control}, Game: {game})")
+    def wait_failed(self, wait: Wait) -> GameError:
+        """The error of a wait that timed out, naming where the charts stand."""
+        control, game = sorted(self.robot.active("Control")), sorted(self.robot.active("Game"))
+        return GameError(f"{wait.what} did not happen within {wait.timeout_s:.0f} s of simulated time "
+                         f"(Control: {control}, Game: {game})")
+
+    def _run(self, wait: Wait) -> None:
+        if not self.robot.run_until(lambda: self.watch(wait), wait.timeout_s):
+            raise self.wait_failed(wait)
 
     def _waiting(self) -> bool:
         return bool(self.robot.control.ready)
@@ -271,36 +368,62 @@ class GameSession:
 
     def play(self, max_moves: int = 25) -> dict[str, Any]:
         """Play one game to its end (or until the person gives up); return the report."""
+        if self.driver is not None:
+            raise GameError("this game is played from inside the chart steps (drive()): step the robot")
         # What exists now (the twin, the charts, the engine, the modules) lives for the
         # whole game: keep it out of the collector's full passes (one of ~90 ms a game).
         gc.freeze()
         try:
-            return self._play(max_moves)
+            wall0 = time.perf_counter()
+            for wait in self.flow(max_moves):
+                self._run(wait)
+            return self.report(time.perf_counter() - wall0)
         finally:
             gc.unfreeze()
 
-    def _play(self, max_moves: int) -> dict[str, Any]:
-        wall0 = time.perf_counter()
+    def drive(self, max_moves: int = 25) -> GameDriver:
+        """Play the game from inside the chart steps from now on: whoever steps the robot plays it.
+
+        For a debugger or a GUI that steps the robot itself; see :class:`GameDriver`.
+        """
+        if self.driver is None:
+            self.driver = GameDriver(self, max_moves)
+        return self.driver
+
+    def flow(self, max_moves: int = 25) -> Flow:
+        """The game as the session plays it: the person's turns, the robot's, the end.
+
+        A generator: it yields a :class:`Wait` whenever the charts must run
+        before it can go on, and does its part (the person draws and clicks
+        Play, the camera looks, the board is updated) between chart steps.
+        :meth:`play` runs it with ``Robot.run_until``, a :class:`GameDriver`
+        from inside the chart steps.
+        """
         robot = self.robot
         self.say("initialising, then drawing the field")
-        self._run_until(self._waiting, 300.0, "initialising and drawing the field")
+        yield Wait(self._waiting, 300.0, "initialising and drawing the field")
         self.record.add(robot.t, "field_drawn")
         to_move = "X"
         while result_of(self.board) is None and len(self.moves) < max_moves:
             if to_move == self.person_symbol:
-                if not self._person_turn():
+                if not (yield from self._person_turn()):
                     break
             else:
-                self._robot_turn()
+                yield from self._robot_turn()
             to_move = "O" if to_move == "X" else "X"
         outcome = result_of(self.board) or "abandoned"
+        self.outcome = outcome
         if outcome == "abandoned":
             self.person.tell("You gave up: the manipulator erases the board.")
         self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3}.get(outcome, 3)
         self.record.add(robot.t, "result", outcome=outcome)
         self.say(f"result: {outcome}; erasing and turning off")
-        self._run_until(lambda: self.game.ended, 600.0, "erasing and turning off")
-        wall = time.perf_counter() - wall0
+        yield Wait(lambda: self.game.ended, 600.0, "erasing and turning off")
+
+    def report(self, wall_s: float) -> dict[str, Any]:
+        """What a game reports (docs/play.md, "What it reports"); `wall_s`: the wall time it took."""
+        robot = self.robot
+        outcome = self.outcome or "abandoned"
         ink_left = robot.board.ink_area_mm2()
         winner = {self.robot_symbol: "robot", self.person_symbol: "person"}.get(outcome, outcome)
         return {
@@ -311,8 +434,8 @@ class GameSession:
             "detections_correct": self.detections_correct,
             "detections_wrong": self.detections_wrong,
             "sim_time_s": round(robot.t, 3),
-            "wall_time_s": round(wall, 3),
-            "realtime_factor": round(robot.t / wall, 1),
+            "wall_time_s": round(wall_s, 3),
+            "realtime_factor": round(robot.t / wall_s, 1),
             "setup_wall_s": round(self.setup_wall_s, 3),
             "erased": ink_left == 0.0,
             "ink_left_mm2": round(ink_left, 3),
@@ -322,13 +445,22 @@ class GameSession:
             "ignored_play_clicks": self.activator.ignored_triggers,
         }
 
+    def state(self) -> dict[str, Any]:
+        """The session's own state (boards, moves, flags), plain data: what a replay must reproduce too."""
+        return {"board": self.board, "truth": self.truth, "moves": [dict(m) for m in self.moves],
+                "o_pos": self.o_pos, "result": self.result_code, "outcome": self.outcome,
+                "pending_move": self.pending_move, "erase_started": self.erase_started,
+                "erased_seen": self.erased_seen, "detections": [self.detections_correct, self.detections_wrong]}
+
     def _click_play(self) -> None:
         self.robot.post("AlgorithmActivator", "trigger")
 
-    def _person_turn(self) -> bool:
+    def _person_turn(self) -> Generator[Wait, None, bool]:
         robot = self.robot
-        robot.chart_step()  # the Game chart shows whose turn it is before the person is asked
-        self._run_until(lambda: True, self.params.control.chart_dt, "showing the message")
+        step = self.params.control.chart_dt
+        # The Game chart shows whose turn it is before the person is asked.
+        yield Wait(lambda: True, step, "the Game chart to show whose turn it is", tell=False)
+        yield Wait(lambda: True, step, "the person's move")
         cell = self.person.choose(self.truth, self.person_symbol)
         if cell is None:
             self.record.add(robot.t, "person_gave_up")
@@ -362,17 +494,18 @@ class GameSession:
             self._click_play()  # the person's Play click: the robot's turn
         return True
 
-    def _robot_turn(self) -> None:
+    def _robot_turn(self) -> Flow:
         robot = self.robot
         if not self.moves:
             self._click_play()  # the robot opens: Play without a drawing first
         self.pending_move = None
-        self._run_until(lambda: self.pending_move is not None, 10.0, "the algorithm's answer")
+        yield Wait(lambda: self.pending_move is not None, 10.0, "the algorithm's answer")
         cell = self.pending_move
         assert cell is not None
-        robot.chart_step()
-        robot.chart_step()
-        self._run_until(self._waiting, 120.0, f"drawing the robot's move {cell}")
+        step = self.params.control.chart_dt
+        yield Wait(lambda: True, step, "the Control chart to take the move", tell=False)
+        yield Wait(lambda: True, step, "the Control chart to take the move", tell=False)
+        yield Wait(self._waiting, 120.0, f"drawing the robot's move {cell}")
         self.robot_cells.append(cell)
         self._set_board(cell, self.robot_symbol)
         self._place(cell, self.robot_symbol, "truth")

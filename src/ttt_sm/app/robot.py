@@ -121,6 +121,9 @@ class Robot:
         self.wires: tuple[Wire, ...] = tuple(wires)
         self._wired: list[WiredStage] = [self.init_stage, self.control_stage]
         self.wiring = wire_stages(self.wires, self.charts, self._wired, BLOCKS)
+        #: The game around the charts when a :class:`~.game.GameSession` added its own, else None
+        #: (typed loosely: the game is built on the robot, not the robot on the game).
+        self.game: object | None = None
 
     def add_charts(self, charts: Sequence[TickChart], wires: Sequence[Wire], stage: WiredStage,
                    objects: dict[str, object] | None = None) -> None:

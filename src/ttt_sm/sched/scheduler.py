@@ -258,10 +258,14 @@ class Scheduler:
         """Run whole chart steps for `seconds` of simulated time."""
         self.run_until(lambda: False, seconds)
 
+    def ticks_for(self, seconds: float) -> int:
+        """The chart steps `run_until` runs for `seconds` of simulated time, at most."""
+        return int(round(seconds * self.params.control.rate_hz / self.divider))
+
     def run_until(self, predicate: Callable[[], bool], timeout_s: float) -> bool:
         """Run chart steps until `predicate()` holds (checked after each); False on timeout."""
         self._start_clock()
-        n_ticks = int(round(timeout_s * self.params.control.rate_hz / self.divider))
+        n_ticks = self.ticks_for(timeout_s)
         paced = self.clock.paced
         for _ in range(n_ticks):
             while self.steps % self.divider:

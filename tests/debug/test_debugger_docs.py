@@ -22,8 +22,9 @@ def test_the_api_example_runs(tmp_path, monkeypatch, capsys):
 
 def test_the_example_session_runs_without_errors(tmp_path, monkeypatch, params, capsys):
     monkeypatch.chdir(tmp_path)
-    commands = [line[len(PROMPT):] for line in DOC.read_text(encoding="utf-8").splitlines()
-                if line.startswith(PROMPT)]
+    session = re.search(r"```\n\$ ttt-sm debug\n(.*?)```", DOC.read_text(encoding="utf-8"), re.S)
+    assert session, "the example session is missing"
+    commands = [line[len(PROMPT):] for line in session.group(1).splitlines() if line.startswith(PROMPT)]
     assert len(commands) > 10 and "break enter DriveInit1.turn_back" in commands
     shell = DebugShell(Debugger.build(params, seed=0))
     shell.run_script(commands)

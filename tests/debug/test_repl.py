@@ -162,3 +162,10 @@ def test_a_negative_start_angle_is_read_after_a_space_or_an_equals_sign(argv, mo
     assert "start (-120.0, 0.0, 0.0, 0.0) deg" in out
     assert re.search(r"q_true +\[-2\.0944 ", out)  # -120 deg in radians
 
+
+def test_continue_runs_on_as_run_does(tmp_path, capsys):
+    rc, out = _run_cli(tmp_path, capsys, "break enter DriveInit1.turn_fwd\nbreak enter DriveInit1.turn_back\n"
+                                         "continue\ncontinue 20\nhelp continue\n")
+    assert rc == 0, out
+    assert "entered turn_fwd at chart tick 1" in out and "entered turn_back at chart tick" in out
+    assert "continue [SECONDS]: the same as run" in out

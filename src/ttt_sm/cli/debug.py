@@ -26,6 +26,10 @@ def register(sub: Any) -> argparse.ArgumentParser:
                     help="let the unpowered arm settle under gravity first (default 0)")
     sp.add_argument("--max-run", metavar="SECONDS", type=float, default=None,
                     help="the longest one command (run, next, step, tick) may run, simulated seconds (default 600)")
+    sp.add_argument("--game", action="store_true",
+                    help="a whole game: the Game and AlgorithmActivator charts, a simulated person"
+                         " (X) and the camera (read in-process) play on as you step;"
+                         " break enter Game.drawing stops at the robot's turn")
     sp.add_argument("--commands", metavar="FILE", default=None,
                     help="run the commands in FILE ('-': standard input) and quit;"
                          " standard input is read the same way when it is not a terminal")
@@ -63,7 +67,8 @@ def cmd_debug(args: argparse.Namespace) -> int:
         if args.settle > max_run:
             raise ValueError(f"--settle: {args.settle:g} s is beyond {max_run:g} s of simulated time, the longest"
                              " one command runs (raise it with --max-run)")
-        dbg = Debugger.build(params, seed=args.seed, q_start=q_start, settle_s=args.settle, max_run_s=max_run)
+        dbg = Debugger.build(params, seed=args.seed, q_start=q_start, settle_s=args.settle, max_run_s=max_run,
+                             game=args.game)
     except ValueError as exc:  # a bad pose (SimError), a bad option
         raise CliError(str(exc)) from exc
     shell = DebugShell(dbg)
@@ -71,6 +76,7 @@ def cmd_debug(args: argparse.Namespace) -> int:
         "(" + ", ".join(f"{math.degrees(v):.1f}" for v in q_start) + ") deg"
     shell.say(f"ttt-sm debugger: seed {args.seed}, start {start}"
               + (f", settled {args.settle:g} s" if args.settle else "")
+              + (", a game: robot O against a simulated person X, camera read in-process" if args.game else "")
               + f"; charts {', '.join(dbg.chart_names)}. Type help.")
     if args.commands and args.commands != "-":
         try:

@@ -10,8 +10,9 @@ See docs/debugger.md.
 from .breakpoints import Breakpoint, Hit
 from .debugger import Debugger
 from .errors import DebugError
-from .records import Action, StopReason
-from .replay import ReplayResult, RobotRecipe
+from .records import Action, DataChange, DataDiff, StopReason
+from .replay import GameRecipe, ReplayResult, RobotRecipe
+from .timeline import Interval, Timeline, TimelineWindow
 
-__all__ = ["Action", "Breakpoint", "DebugError", "Debugger", "Hit", "ReplayResult", "RobotRecipe",
-           "StopReason"]
+__all__ = ["Action", "Breakpoint", "DataChange", "DataDiff", "DebugError", "Debugger", "GameRecipe", "Hit",
+           "Interval", "ReplayResult", "RobotRecipe", "StopReason", "Timeline", "TimelineWindow"]

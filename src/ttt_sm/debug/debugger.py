@@ -16,11 +16,22 @@ with the control step it was applied at; :meth:`Debugger.replay` rebuilds the
 robot from its recipe (parameters, seed, power-on pose), re-applies them at the
 same steps and runs to a chart tick, and tells whether it arrived in exactly the
 state recorded when the session was there before.
+
+A robot built with the game (:class:`~.replay.GameRecipe`, ``ttt-sm debug
+--game``) carries the Game and AlgorithmActivator charts and plays its game
+from inside the chart steps (the simulated person, the camera, the engine):
+stepping the robot plays the game, and a breakpoint on ``Game.drawing``
+stops at the robot's turn.
+
+Besides the trace it keeps a :class:`~.timeline.Timeline` (when each state
+was entered and left) and the charts' data as they were just before the last
+chart tick, for :meth:`Debugger.data_diff`.
 """
 
 from __future__ import annotations
 
 import math
+import operator
 import signal
 import threading
 from collections import deque
@@ -29,6 +40,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from ..app.game import GameSession
 from ..app.robot import Robot, RobotError
 from ..params import ArmParams
 from ..runtime import Data, TickChart, UnknownEventError
@@ -38,8 +50,9 @@ from ..runtime.listeners import Trace
 from .breakpoints import BreakListener, Breakpoint, ChartIndex, Hit, parse_breakpoint
 from .errors import DebugError
 from .names import RobotNames, datum_decl, parse_input_value
-from .records import Action, StopKind, StopReason
-from .replay import Recipe, ReplayResult, RobotRecipe, differences, fingerprint
+from .records import Action, DataChange, DataDiff, StopKind, StopReason
+from .replay import GameRecipe, Recipe, ReplayResult, RobotRecipe, differences, fingerprint, game_of
+from .timeline import Timeline, TimelineWindow
 
 #: The longest one command (run, next, step, tick) may run unless raised, seconds of
 #: simulated time: a typo like ``run 1e12`` would never end.  ``ttt-sm debug --max-run``.
@@ -89,21 +102,42 @@ class Debugger:
 
     @classmethod
     def build(cls, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
-              settle_s: float = 0.0, *, max_run_s: float = DEFAULT_MAX_RUN_S) -> Debugger:
-        """A debugger on a new robot, with its recipe for :meth:`replay`."""
-        recipe = RobotRecipe(params, seed, None if q_start is None else tuple(float(v) for v in q_start),
-                             settle_s)
+              settle_s: float = 0.0, *, game: bool = False, max_run_s: float = DEFAULT_MAX_RUN_S) -> Debugger:
+        """A debugger on a new robot, with its recipe for :meth:`replay`.
+
+        ``game``: the robot plays a game (:class:`~.replay.GameRecipe`: the Game
+        and AlgorithmActivator charts, a simulated person, the camera read
+        in-process, the strong engine; the robot draws O).
+        """
+        pose = None if q_start is None else tuple(float(v) for v in q_start)
+        recipe: Recipe = GameRecipe(params, seed, pose, settle_s) if game else \
+            RobotRecipe(params, seed, pose, settle_s)
         return cls(recipe.build(), recipe, max_run_s=max_run_s)
 
     def _attach(self, robot: Robot) -> None:
         self.robot = robot
         self.trace = Trace()
+        self.state_history = Timeline()
         for chart in robot.charts.values():
             chart.add_listener(self.trace, self.listener)
+        self.state_history.observe(robot.charts.values())
         self._index = ChartIndex(dict(robot.charts))
         self._divider = robot.params.control.chart_divider
         self._dt = robot.params.control.dt
         self._names.forget()
+        # The charts' data just before the last chart tick (for data_diff): one
+        # itemgetter per chart over its instance dict, where the declared data live.
+        self._data_getters = [(name, [d.name for d in c.declarations()], c.__dict__)
+                              for name, c in robot.charts.items()]
+        self._getters = [(_values_of(names), d) for _, names, d in self._data_getters]
+        self._before: list[Any] | None = None
+        self._before_tick = 0
+        self._game_stopped = _game_error(robot) is not None
+
+    @property
+    def game(self) -> GameSession | None:
+        """The game around the charts (``build(..., game=True)``), else None."""
+        return game_of(self.robot)
 
     # -- where we are ------------------------------------------------------------
 
@@ -131,6 +165,39 @@ class Debugger:
     def datum_decl(self, chart: str, name: str) -> Data:
         """The declaration of a chart datum (name, unit, default, doc, kind)."""
         return datum_decl(self.robot, chart, name)
+
+    def timeline(self, chart: str, seconds: float | None = None) -> TimelineWindow:
+        """When the chart's states were entered and left, over the last ``seconds`` of chart
+        time (None: all the bounded history holds); see :class:`~.timeline.Timeline`."""
+        c = self.chart(chart)
+        if seconds is not None and not (isinstance(seconds, (int, float)) and math.isfinite(seconds)
+                                        and seconds > 0):
+            raise DebugError(f"timeline: the time must be a positive number of seconds, got {seconds!r}")
+        period = c.tick_period_s or self.robot.params.control.chart_dt
+        return self.state_history.window(chart, c.tick_count, period, seconds)
+
+    def data_diff(self, chart: str | None = None) -> DataDiff | None:
+        """The chart data that changed since just before the last chart tick (None: no tick run yet).
+
+        ``chart``: one chart, or every chart.  The values before the tick are
+        kept as the debugger runs each chart tick, at the cost of one copy of
+        the declared data per tick.
+        """
+        if chart is not None:
+            self.chart(chart)
+        if self._before is None:
+            return None
+        changes: list[DataChange] = []
+        for (name, names, d), before in zip(self._data_getters, self._before, strict=True):
+            if chart is not None and name != chart:
+                continue
+            decls = {x.name: x for x in self.robot.charts[name].declarations()}
+            for datum, old in zip(names, before, strict=True):
+                new = d[datum]
+                if not _same(old, new):
+                    decl = decls[datum]
+                    changes.append(DataChange(name, datum, decl.kind, decl.unit, old, new))
+        return DataDiff(self._before_tick, tuple(changes))
 
     # -- breakpoints -------------------------------------------------------------
 
@@ -224,12 +291,15 @@ class Debugger:
         watch_events = any(bp.enabled and bp.kind == "event" for bp in self.breakpoints)
         report_every = max(1, int(round(PROGRESS_EVERY_S / self._dt)))
         t_end = robot.t + max_steps * self._dt
+        game_error = self._game_error_now
         with self._sigint_pauses():
             for done in range(1, max_steps + 1):
                 ticking = robot.steps % divider == 0
                 pending = [[e for e, _ in c.pending_events] for c in charts] \
                     if ticking and watch_events else None
                 mark = len(self.trace.records)
+                if ticking:
+                    self._keep_before_tick()
                 robot.control_step()
                 if ticking:
                     ticks_done += 1
@@ -241,6 +311,9 @@ class Debugger:
                         self._check_conditions(when)
                 if listener.hits:
                     kind = "breakpoint"
+                    break
+                if ticking and game_error():
+                    kind = "game"
                     break
                 if until_transition and len(self.trace.records) > mark:
                     kind = "transition"
@@ -254,8 +327,20 @@ class Debugger:
                 if self.progress is not None and done % report_every == 0:
                     self.progress(robot.t, t_end)
         self._remember()
+        detail = str(_game_error(robot)) if kind == "game" else ""
         return StopReason(kind, robot.t, robot.steps, robot.chart_ticks, tuple(listener.hits),
-                          tuple(self.trace.records[first:]))
+                          tuple(self.trace.records[first:]), detail)
+
+    def _game_error_now(self) -> bool:
+        """The game's flow stopped with an error in the chart step just run (reported once)."""
+        if self._game_stopped or _game_error(self.robot) is None:
+            return False
+        self._game_stopped = True
+        return True
+
+    def _keep_before_tick(self) -> None:
+        self._before = [get(d) for get, d in self._getters]
+        self._before_tick = self.robot.chart_ticks + 1
 
     def _check_conditions(self, when: list[Breakpoint]) -> None:
         tick = self.robot.chart_ticks
@@ -439,9 +524,12 @@ class Debugger:
                     self._apply(queue.popleft(), robot)
                 if robot.steps >= target:
                     break
+                if robot.steps % self._divider == 0:
+                    self._keep_before_tick()
                 robot.control_step()
         finally:
             self.listener.muted = False
+        self._game_stopped = _game_error(robot) is not None
         self.actions = kept
         now = self.fingerprint()
         before = self._fingerprints.get(target)
@@ -454,6 +542,28 @@ class Debugger:
                 bp.last_value = bp.condition.evaluate(self._names)
         return ReplayResult(robot.chart_ticks, robot.steps, robot.t, len(kept), dropped,
                             None if before is None else not diffs, diffs)
+
+
+def _game_error(robot: Robot) -> Exception | None:
+    """Why the robot's game flow stopped before the end, if it did."""
+    game = game_of(robot)
+    return None if game is None or game.driver is None else game.driver.error
+
+
+def _values_of(names: Sequence[str]) -> Callable[[dict[str, Any]], tuple[Any, ...]]:
+    """A fast reader of the named values of a dict, as a tuple (one C call per chart tick)."""
+    if len(names) > 1:
+        return operator.itemgetter(*names)
+    return lambda d: tuple(d[n] for n in names)
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    try:
+        return bool(a == b)
+    except (TypeError, ValueError):  # arrays compare element-wise
+        return a is b
 
 
 def _check_count(n: int, what: str) -> None:

@@ -8,7 +8,7 @@ from typing import Any, Literal
 from ..runtime.listeners import TraceRecord
 from .breakpoints import Hit
 
-StopKind = Literal["breakpoint", "timeout", "paused", "transition", "done"]
+StopKind = Literal["breakpoint", "timeout", "paused", "transition", "done", "game"]
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,9 @@ class StopReason:
     ``kind``: ``breakpoint`` (``hits`` says which), ``timeout`` (the simulated
     time given ran out), ``paused`` (:meth:`Debugger.pause` or Ctrl-C),
     ``transition`` (``next`` saw one), ``done`` (``step``/``tick`` did what
-    was asked).  ``transitions`` are the transitions taken during the command.
+    was asked), ``game`` (the game around the charts could not go on:
+    ``detail`` says why).  ``transitions`` are the transitions taken during
+    the command.
     """
 
     kind: StopKind
@@ -48,6 +50,7 @@ class StopReason:
     chart_ticks: int
     hits: tuple[Hit, ...] = ()
     transitions: tuple[TraceRecord, ...] = ()
+    detail: str = ""
 
     @property
     def breakpoint(self) -> Hit | None:
@@ -58,6 +61,34 @@ class StopReason:
         where = f"t = {self.t:.4f} s, step {self.steps}, chart tick {self.chart_ticks}"
         if self.kind == "breakpoint":
             return f"stopped at {where}: " + "; ".join(h.describe() for h in self.hits)
+        if self.kind == "game":
+            return f"the game stopped at {where}: {self.detail}"
         text = {"timeout": "time is up", "paused": "paused", "transition": "transition",
                 "done": "done"}[self.kind]
         return f"{text} at {where}"
+
+
+@dataclass(frozen=True)
+class DataChange:
+    """A chart datum that changed: its value ``before`` the last chart tick and ``after`` (now)."""
+
+    chart: str
+    name: str
+    kind: str
+    unit: str
+    before: Any
+    after: Any
+
+
+@dataclass(frozen=True)
+class DataDiff:
+    """What changed in the charts' data since just before chart tick ``tick`` (the last one run).
+
+    ``changes`` lists the data whose value differs, chart by chart in the
+    robot's order, each chart's data in declaration order.  Inputs the user
+    set after the tick count as changed too: the diff is between the data
+    before the tick and the data now.
+    """
+
+    tick: int
+    changes: tuple[DataChange, ...]

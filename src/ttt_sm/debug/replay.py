@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass
 from types import MappingProxyType
 from typing import Any, Protocol
 
+from ..app.game import GameSession
 from ..app.robot import Robot
 from ..params import ArmParams
 from ..twin.plant import ArmSim
@@ -59,6 +60,32 @@ class RobotRecipe:
 
 
 @dataclass(frozen=True)
+class GameRecipe:
+    """A robot with the game around it, built again bit for bit: a :class:`GameSession`
+    (Game and AlgorithmActivator charts, the simulated person, the camera) whose
+    flow is played from inside the chart steps (:meth:`GameSession.drive`).
+
+    The camera is read in-process (``direct``): the debugger steps the robot
+    one control step at a time, and the serial link's emulated camera, a
+    thread behind a pseudo-terminal, would only add wall time to each reading.
+    The simulated person is seeded with the seed, as in ``ttt-sm play``.
+    """
+
+    params: ArmParams
+    seed: int = 0
+    q_start: tuple[float, ...] | None = None
+    settle_s: float = 0.0
+    robot_symbol: str = "O"
+    engine: str = "strong"
+
+    def build(self) -> Robot:
+        session = GameSession(self.params, seed=self.seed, robot_symbol=self.robot_symbol, engine=self.engine,
+                              camera="direct", record_trace=False, q_start=self.q_start, settle_s=self.settle_s)
+        session.drive()
+        return session.robot
+
+
+@dataclass(frozen=True)
 class ReplayResult:
     """What :meth:`Debugger.replay` did and whether it reached the state seen before.
 
@@ -89,7 +116,8 @@ class ReplayResult:
 
 def fingerprint(robot: Robot, forced: Mapping[tuple[str, str], Any] = MappingProxyType({})) -> dict[str, Any]:
     """The whole state a replay must reproduce: configurations, chart data (and their
-    previous outputs, clocks, queued events), forced inputs and the twin's state, exact."""
+    previous outputs, clocks, queued events), forced inputs and the twin's state, exact;
+    in a game, the session's boards, moves and flags and where its flow stands."""
     sim = _sim(robot)
     charts = {}
     for name, c in robot.charts.items():
@@ -99,8 +127,21 @@ def fingerprint(robot: Robot, forced: Mapping[tuple[str, str], Any] = MappingPro
     twin = {name: getattr(sim, name).tolist() for name in TWIN_FIELDS}
     twin.update({f"truth.{name}": getattr(sim.truth, name).tolist() for name in TRUTH_FIELDS})
     twin["sensors"] = asdict(sim.sensors())
-    return {"steps": robot.steps, "chart_ticks": robot.chart_ticks, "t": sim.t, "charts": charts,
-            "forced": sorted(forced.items()), "twin": twin}
+    out = {"steps": robot.steps, "chart_ticks": robot.chart_ticks, "t": sim.t, "charts": charts,
+           "forced": sorted(forced.items()), "twin": twin}
+    game = game_of(robot)
+    if game is not None:
+        driver = game.driver
+        out["game"] = {**game.state(), "flow": None if driver is None else
+                       {"waited": driver.waited, "done": driver.done,
+                        "error": None if driver.error is None else str(driver.error)}}
+    return out
+
+
+def game_of(robot: Robot) -> GameSession | None:
+    """The game session a robot plays, if a :class:`GameSession` added its charts."""
+    game = robot.game
+    return game if isinstance(game, GameSession) else None
 
 
 def _sim(robot: Robot) -> ArmSim:

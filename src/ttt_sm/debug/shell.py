@@ -27,7 +27,7 @@ PROMPT = "(ttt-sm) "
 #: What a command may raise for a request it cannot take: printed as one ``error:`` line.
 USER_ERRORS = (DebugError, RobotError, UnknownEventError, UnknownDataError)
 _REPEATABLE = ("step", "tick", "next")
-_SHOW = ("charts", "data", "signals", "trace", "breakpoints", "inputs", "snapshot")
+_SHOW = ("charts", "data", "signals", "trace", "breakpoints", "inputs", "snapshot", "timeline", "game")
 
 
 def _count(arg: str, what: str, default: int = 1) -> int:
@@ -166,6 +166,10 @@ class DebugShell(cmd.Cmd):
         SECONDS are simulated seconds; the run stops between two control steps."""
         self.say(*views.stop_lines(self.dbg.run(_seconds(arg, "run", 60.0))))
 
+    def do_continue(self, arg: str) -> None:
+        """continue [SECONDS]: the same as run: on from here until a breakpoint (default 60 s)."""
+        self.do_run(arg)
+
     def do_step(self, arg: str) -> None:
         """step [N]: run N control steps (default 1; a chart tick starts every second one)."""
         self.say(*views.stop_lines(self.dbg.step(_count(arg, "step"))))
@@ -232,9 +236,13 @@ class DebugShell(cmd.Cmd):
         self.say(*views.where_lines(self.dbg))
 
     def do_show(self, arg: str) -> None:
-        """show charts | data [CHART] | signals | trace [N] | breakpoints | inputs | snapshot
-        charts: active configurations; data: declared data with units; signals: time,
-        setpoints, encoders, true angles, index switches, currents, tool pose;
+        """show charts | data [CHART] [--diff] | timeline CHART [SECONDS] | signals | trace [N]
+        | game | breakpoints | inputs | snapshot
+        charts: active configurations; data: declared data with units (--diff: only what
+        changed since just before the last chart tick, before -> now); timeline: when each
+        state was entered and left, as bars and a table (the last SECONDS of chart time,
+        default all kept); signals: time, setpoints, encoders, true angles, index switches,
+        currents, tool pose; game: the board, the moves and where the game stands (--game);
         inputs: what you set, forced and posted (replay re-applies them);
         snapshot: everything as one JSON document."""
         what, _, rest = arg.strip().partition(" ")
@@ -242,8 +250,25 @@ class DebugShell(cmd.Cmd):
         if what == "charts":
             self.do_where("")
         elif what == "data":
-            for chart in ([rest] if rest else self.dbg.chart_names):
+            words = rest.split()
+            diff = "--diff" in words
+            words = [w for w in words if w != "--diff"]
+            if len(words) > 1:
+                raise DebugError(f"show data: expected [CHART] [--diff], got {rest!r}")
+            if diff:
+                chart = words[0] if words else None
+                self.say(*views.diff_lines(self.dbg.data_diff(chart), chart))
+                return
+            for chart in (words or self.dbg.chart_names):
                 self.say(*views.data_lines(self.dbg, chart))
+        elif what == "timeline":
+            words = rest.split()
+            if not 1 <= len(words) <= 2:
+                raise DebugError(f"show timeline: expected CHART [SECONDS]; charts: {', '.join(self.dbg.chart_names)}")
+            seconds = _seconds(words[1], "show timeline", 0.0) if len(words) == 2 else None
+            self.say(*views.timeline_lines(self.dbg, self.dbg.timeline(words[0], seconds)))
+        elif what == "game":
+            self.say(*views.game_lines(self.dbg))
         elif what == "signals":
             self.say(*views.signal_lines(self.dbg))
         elif what == "trace":

@@ -29,8 +29,10 @@ ends at once: the arm still stands at its start pose.
 
 Every move is a straight line at a set speed, one increment per tick, towards
 a target held in the local data `tx`, `ty`, `tz`; a state's exit guard is
-"target reached".  Geometry (cell corners, heights, the waiting pose) is local
-data the application sets from the parameter file.
+"target reached".  The field's, the cells' and the symbols' geometry are pure
+functions in :mod:`ttt_sm.charts.geometry`; their inputs (the field's corner,
+the cell side, heights, the waiting pose) are local data the application sets
+from the parameter file.
 """
 
 from __future__ import annotations
@@ -40,6 +42,23 @@ import math
 from statemachine import State
 
 from ..runtime import Data, TickChart
+from .geometry import (
+    O_START,
+    arc_end,
+    circle_point,
+    circle_x,
+    circle_y,
+    field_line,
+    o_centre,
+    o_radius,
+    on_x_line_1,
+    on_x_line_2,
+    pass_ends,
+    pass_x,
+    x_line_1,
+    x_line_2,
+    x_start,
+)
 
 
 class Control(TickChart):
@@ -378,20 +397,8 @@ class Control(TickChart):
     # ------------------------------------------- Drawing_playing_field
 
     def _field_line(self, k: int) -> tuple[float, float, float, float]:
-        """Start and end (x, y) of field line k: 0-3 parallel to X, 4-7 parallel to Y.
-
-        Lines run alternately one way and back, so the pen travels little.
-        """
-        n = self.cells - 1
-        size = self.cells * self.L
-        x_lo, y_lo = self.x11 - size, self.y11 - size
-        if k < n:
-            y = self.y11 - (k + 1) * self.L
-            xs = (self.x11, x_lo) if k % 2 == 0 else (x_lo, self.x11)
-            return xs[0], y, xs[1], y
-        x = self.x11 - (k - n + 1) * self.L
-        ys = (self.y11, y_lo) if k % 2 == 0 else (y_lo, self.y11)
-        return x, ys[0], x, ys[1]
+        """Start and end (x, y) of field line k: 0-3 parallel to X, 4-7 parallel to Y."""
+        return field_line(self.x11, self.y11, self.L, self.cells, k)
 
     def on_enter_Drawing_playing_field(self) -> None:
         self.k = 0
@@ -422,10 +429,8 @@ class Control(TickChart):
 
     def on_enter_Drawing_X(self) -> None:
         # eqs. 3.37-3.38, with the symbol size as a parameter: L/5 margins for size 3L/5
-        margin = (self.L - self.size) / 2
-        self.x_ini = self.x11 - (self.column - 1) * self.L - margin
-        self.y_ini = self.y11 - (self.row - 1) * self.L - margin
-        self.h1 = self.y_ini - self.x_ini  # eq. 3.39
+        self.x_ini, self.y_ini = x_start(self.x11, self.y11, self.L, self.row, self.column, self.size)
+        self.h1 = x_line_1(self.x_ini, self.y_ini)  # eq. 3.39
         self._aim(self.x_ini, self.y_ini, self.z_up)
 
     def _travel(self) -> None:
@@ -436,7 +441,7 @@ class Control(TickChart):
     def during_line_1(self) -> None:
         # eqs. 3.40-3.41: X decreases, Y follows the 45-degree line Y = X + h1
         self.X_out = max(self.X_out_p - self.speed * self.tick_period_s / math.sqrt(2), self.x_ini - self.size)
-        self.Y_out = self.X_out + self.h1
+        self.Y_out = on_x_line_1(self.X_out, self.h1)
 
     def end_line_1(self) -> None:
         self.Y_end = self.Y_out
@@ -444,7 +449,7 @@ class Control(TickChart):
 
     def aim_line_2(self) -> None:
         # eq. 3.42: the second line starts at (x_ini, Y_end)
-        self.h2 = self.Y_end + self.x_ini
+        self.h2 = x_line_2(self.Y_end, self.x_ini)
         self._aim(self.x_ini, self.Y_end, self.z_up)
 
     def during_to_line_2(self) -> None:
@@ -453,17 +458,16 @@ class Control(TickChart):
     def during_line_2(self) -> None:
         # eqs. 3.43-3.44: Y = -X + h2; X decreases (the printed '+' would leave the cell)
         self.X_out = max(self.X_out_p - self.speed * self.tick_period_s / math.sqrt(2), self.x_ini - self.size)
-        self.Y_out = -self.X_out + self.h2
+        self.Y_out = on_x_line_2(self.X_out, self.h2)
 
     # ------------------------------------------------------- Drawing_O
 
     def on_enter_Drawing_O(self) -> None:
         # eqs. 3.45-3.47; R = size/2 (the printed R = L/4 is the size L/2)
-        self.x0 = self.x11 - (self.column - 1) * self.L - self.L / 2
-        self.y0 = self.y11 - (self.row - 1) * self.L - self.L / 2
-        self.R = self.size / 2
-        a = -0.75 * math.pi  # part 1 starts at the lower left, as in fig. 3.27
-        self._aim(self.x0 + self.R * math.cos(a), self.y0 + self.R * math.sin(a), self.z_up)
+        self.x0, self.y0 = o_centre(self.x11, self.y11, self.L, self.row, self.column)
+        self.R = o_radius(self.size)
+        # part 1 starts at the lower left, as in fig. 3.27
+        self._aim(*circle_point(self.x0, self.y0, self.R, O_START), self.z_up)
 
     def start_arc_1(self) -> None:
         self.k = 0
@@ -475,9 +479,8 @@ class Control(TickChart):
 
     def _aim_arc(self) -> None:
         """End point of arc k: a quarter plus the overlap, counter-clockwise from -135 deg."""
-        self.arc_end = -0.75 * math.pi + (self.k + 1) * (math.pi / 2 + self.arc_overlap)
-        self._aim(self.x0 + self.R * math.cos(self.arc_end), self.y0 + self.R * math.sin(self.arc_end),
-                  self.z_draw)
+        self.arc_end = arc_end(self.k, self.arc_overlap)
+        self._aim(*circle_point(self.x0, self.y0, self.R, self.arc_end), self.z_draw)
 
     def _arc_step(self) -> float:
         return self.speed * self.tick_period_s * math.sqrt(0.5)
@@ -485,28 +488,28 @@ class Control(TickChart):
     def during_arc_1(self) -> None:
         # eqs. 3.48-3.49: X increases along the lower half, Y from the circle
         self.X_out = min(self.X_out_p + self._arc_step(), self.tx)
-        self.Y_out = self.y0 - math.sqrt(max(self.R ** 2 - (self.X_out - self.x0) ** 2, 0.0))
+        self.Y_out = circle_y(self.X_out, self.x0, self.y0, self.R, -1.0)
         if self.X_out == self.tx:
             self.Y_out = self.ty
 
     def during_arc_2(self) -> None:
         # eqs. 3.50-3.51: Y increases along the right half, X from the circle
         self.Y_out = min(self.Y_out_p + self._arc_step(), self.ty)
-        self.X_out = self.x0 + math.sqrt(max(self.R ** 2 - (self.Y_out - self.y0) ** 2, 0.0))
+        self.X_out = circle_x(self.Y_out, self.x0, self.y0, self.R, 1.0)
         if self.Y_out == self.ty:
             self.X_out = self.tx
 
     def during_arc_3(self) -> None:
         # like part 1 mirrored: X decreases along the upper half
         self.X_out = max(self.X_out_p - self._arc_step(), self.tx)
-        self.Y_out = self.y0 + math.sqrt(max(self.R ** 2 - (self.X_out - self.x0) ** 2, 0.0))
+        self.Y_out = circle_y(self.X_out, self.x0, self.y0, self.R, 1.0)
         if self.X_out == self.tx:
             self.Y_out = self.ty
 
     def during_arc_4(self) -> None:
         # like part 2 mirrored: Y decreases along the left half
         self.Y_out = max(self.Y_out_p - self._arc_step(), self.ty)
-        self.X_out = self.x0 - math.sqrt(max(self.R ** 2 - (self.Y_out - self.y0) ** 2, 0.0))
+        self.X_out = circle_x(self.Y_out, self.x0, self.y0, self.R, -1.0)
         if self.Y_out == self.ty:
             self.X_out = self.tx
 
@@ -543,12 +546,11 @@ class Control(TickChart):
         self.phi = min(self.phi + self.phi_rate * self.tick_period_s, self.pi_2)
 
     def _pass_x(self, k: int) -> float:
-        return self.x11 - self.L / 2 - k * (self.cells * self.L - self.L) / (self.cells - 1)
+        return pass_x(self.x11, self.L, self.cells, k)
 
     def _pass_ends(self, k: int) -> tuple[float, float]:
         """Passes along Y over the whole field (and 5 mm beyond), alternately one way and back."""
-        far, near = self.y11 + 0.005, self.y11 - self.cells * self.L - 0.005
-        return (far, near) if k % 2 == 0 else (near, far)
+        return pass_ends(self.y11, self.L, self.cells, k)
 
     def aim_pass_start(self) -> None:
         self.k = 0

@@ -438,7 +438,7 @@ def load_params(path: str | Path | None = None) -> ArmParams:
         text = resources.files("ttt_sm.data").joinpath(DEFAULT_PARAMS_NAME).read_text(encoding="utf-8")
         where = f"ttt_sm/data/{DEFAULT_PARAMS_NAME}"
     else:
-        where = str(path)
+        where = _shown(path)
         text = _read_text(Path(path), where)
     try:
         data = tomllib.loads(text)
@@ -447,6 +447,12 @@ def load_params(path: str | Path | None = None) -> ArmParams:
     except RecursionError:
         raise ParameterError(f"{where}: not valid TOML (arrays or tables nested too deeply)") from None
     return parse_params(data, where, text)
+
+
+def _shown(path: str | Path) -> str:
+    """A file name for a message: as it is, or quoted when it holds line breaks or other control characters."""
+    name = str(path)
+    return name if name.isprintable() else repr(name)
 
 
 def _read_text(path: Path, where: str) -> str:

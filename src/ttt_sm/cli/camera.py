@@ -26,7 +26,7 @@ from ..seriallink.emulator import CameraEmulator, Fault
 from ..seriallink.errors import SerialLinkError
 from ..seriallink.reader import ReconnectPolicy, SerialCameraReader
 from ..seriallink.sources import board_source
-from .common import print_json
+from .common import print_json, seed
 
 DEFAULT_LINK = str(Path(tempfile.gettempdir()) / "ttt-sm-camera")
 """Where ``serve`` puts its stable link and ``read`` looks by default."""
@@ -49,7 +49,7 @@ def register(sub: Any) -> argparse.ArgumentParser:
     serve.add_argument("--board", default=DEMO_BOARD,
                        help=f"25 cells of . X O, rows split by / (default {DEMO_BOARD})")
     serve.add_argument("--rate", type=float, default=10.0, help="frames per second (default 10)")
-    serve.add_argument("--seed", type=int, default=0, help="seed of the pixel noise (default 0)")
+    serve.add_argument("--seed", type=seed, default=0, help="seed of the pixel noise (default 0)")
     serve.add_argument("--duration", type=float, default=None, help="stop after this many seconds (default: Ctrl-C)")
     serve.add_argument("--fault-every", type=int, default=0, metavar="N",
                        help="spoil every Nth frame with the next fault of a fixed cycle, to watch a reader cope"

@@ -10,13 +10,12 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import sys
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..params import ArmParams
-from .common import CliError, add_command, emit, progress
+from .common import CliError, add_command, emit, out_dir, progress
 
 if TYPE_CHECKING:
     from ..runtime.export import ExtraDiagram
@@ -33,8 +32,9 @@ def load_arm(path: str | None) -> ArmParams:
 def cmd_demo(args: argparse.Namespace) -> int:
     from ..app.play import run_play
 
+    out = out_dir(args.out)
     params = load_arm(args.params)
-    result = run_play(params, seed=args.seed, out_dir=Path(args.out), progress=progress(True))
+    result = run_play(params, seed=args.seed, out_dir=out, progress=progress(True))
     lines = [f"  {k}: {v}" for k, v in result.items() if k != "drawings"]
     emit(result, args.json, "demo:\n" + "\n".join(lines))
     return 0
@@ -43,6 +43,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
 def cmd_play(args: argparse.Namespace) -> int:
     from ..app.game import GameError, GameSession, SimulatedPerson, TerminalPerson
 
+    out = out_dir(args.out)
     params = load_arm(args.params)
     say = progress(True)
     opponent = args.opponent
@@ -56,10 +57,10 @@ def cmd_play(args: argparse.Namespace) -> int:
                           engine=args.engine, camera=args.camera, progress=say)
     try:
         report = session.play()
-        files = session.save(Path(args.out))
+        files = session.save(out)
     except GameError as exc:
         # what happened up to the failure is kept: the record and the board as it is
-        saved = session.save(Path(args.out))
+        saved = session.save(out)
         raise CliError(f"{exc} (the game so far: {saved['record']}, {saved['board_png']})") from exc
     finally:
         session.close()
@@ -73,6 +74,7 @@ def cmd_play(args: argparse.Namespace) -> int:
 def cmd_draw(args: argparse.Namespace) -> int:
     from ..app.drawing import DrawError, DrawSession, check_request
 
+    out = out_dir(args.out)
     params = load_arm(args.params)
     speed = None if args.speed is None else args.speed / 1000
     size = None if args.size is None else args.size / 1000
@@ -80,7 +82,7 @@ def cmd_draw(args: argparse.Namespace) -> int:
         check_request(params, args.kind, args.row, args.column, speed, size)
         session = DrawSession(params, seed=args.seed, progress=progress(True))
         session.start()
-        result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=Path(args.out))
+        result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=out)
     except DrawError as exc:
         raise CliError(str(exc)) from exc
     data = dataclasses.asdict(result)
@@ -91,8 +93,9 @@ def cmd_draw(args: argparse.Namespace) -> int:
 def cmd_tune(args: argparse.Namespace) -> int:
     from ..twin.tuning import report_text, tune_report
 
+    out = out_dir(args.out)
     params = load_arm(args.params)
-    rows = tune_report(params, Path(args.out))
+    rows = tune_report(params, out)
     emit(rows, args.json, report_text(rows))
     return 0
 
@@ -100,10 +103,11 @@ def cmd_tune(args: argparse.Namespace) -> int:
 def cmd_bench(args: argparse.Namespace) -> int:
     from ..bench import run_bench
 
+    out = out_dir(args.out)
     params = load_arm(args.params)
     only = [s.strip() for s in args.only.split(",")] if args.only else None
     try:
-        result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=Path(args.out),
+        result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
                            progress=progress(True))
     except ValueError as exc:
         raise CliError(str(exc)) from exc
@@ -127,11 +131,15 @@ def cmd_ik(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Most power-on poses one ``init`` runs (each takes a few seconds of computing).
+MAX_STARTS = 1000
+
+
 def cmd_init(args: argparse.Namespace) -> int:
     from ..app.init_wiring import init_report
 
-    if args.starts < 1:
-        raise CliError(f"--starts must be at least 1, got {args.starts}")
+    if not 1 <= args.starts <= MAX_STARTS:
+        raise CliError(f"--starts must lie in 1..{MAX_STARTS}, got {args.starts}")
     params = load_arm(args.params)
     report = init_report(params, args.starts, seed=args.seed)
     text = "\n".join(f"  {k}: {v}" for k, v in report.items())
@@ -160,6 +168,8 @@ def cmd_charts(args: argparse.Namespace) -> int:
     unknown = [f for f in formats if f not in FORMATS]
     if unknown:
         raise CliError(f"unknown format(s) {', '.join(unknown)}; choose from {', '.join(FORMATS)}")
+    if args.action == "export":
+        out_dir(args.out)
     result = export_command(ALL_CHARTS, args.out, check=args.action == "check", formats=formats,
                             extras=repo_chart_extras())
     if args.action == "check":
@@ -211,7 +221,8 @@ def register(sub: Any) -> None:
     sp.add_argument("z", type=float, help="mm")
     sp.add_argument("--phi", type=float, default=0.0, help="pen angle phi, degrees (default 0)")
     sp = add_command(sub, "init", cmd_init, "initialise the drives with the init charts from random power-on poses")
-    sp.add_argument("--starts", type=int, default=20, help="number of random power-on poses (default 20)")
+    sp.add_argument("--starts", type=int, default=20,
+                    help=f"number of random power-on poses, 1..{MAX_STARTS} (default 20)")
     sp = add_command(sub, "charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
     sp.add_argument("action", choices=["export", "check"])
     sp.add_argument("--format", default=None,

@@ -14,9 +14,11 @@
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 from ..runtime.jsonable import dumps
@@ -33,7 +35,7 @@ def add_command(sub: Any, name: str, func: Command, help_: str) -> argparse.Argu
     sp: argparse.ArgumentParser = sub.add_parser(name, help=help_, description=help_)
     sp.set_defaults(func=func)
     sp.add_argument("--json", action="store_true", help="print one JSON document")
-    sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
+    sp.add_argument("--seed", type=seed, default=0, help="seed of the simulated arm (default 0)")
     return sp
 
 
@@ -78,6 +80,32 @@ def join_negative_values(parser: argparse.ArgumentParser, argv: Sequence[str]) -
         out.append(word)
         i += 1
     return out
+
+
+def seed(text: str) -> int:
+    """The ``type`` of every ``--seed``: a whole number 0 .. 2**63 - 1 (numpy's generators take no negative
+    seed, and a run is reproducible from it)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {text[:40]!r}") from None
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"expected a whole number 0 .. 2**63 - 1, got {text[:40]}")
+    return value
+
+
+def out_dir(path: str, what: str = "--out") -> Path:
+    """The folder a command writes to, made now and known writable: refused before the run, not after it."""
+    folder = Path(path)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / f".ttt-sm-can-write-{os.getpid()}"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        reason = getattr(exc, "strerror", None) or str(exc)
+        raise CliError(f"{what} {path[:200]}: cannot write there ({reason})") from None
+    return folder
 
 
 def progress(enabled: bool) -> Callable[[str], None]:

@@ -9,9 +9,10 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+from collections.abc import Iterator
 from typing import Any
 
-from .common import CliError
+from .common import CliError, seed
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
@@ -19,7 +20,7 @@ def register(sub: Any) -> argparse.ArgumentParser:
     help_ = "step through the robot's charts: breakpoints, data, signals, trace, replay"
     sp: argparse.ArgumentParser = sub.add_parser("debug", help=help_, description=help_)
     sp.set_defaults(func=cmd_debug)
-    sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
+    sp.add_argument("--seed", type=seed, default=0, help="seed of the simulated arm (default 0)")
     sp.add_argument("--start", metavar="Q1,Q2,Q3[,Q4]", default=None,
                     help="joint angles before power-on, degrees (default: the twin's rest pose)")
     sp.add_argument("--settle", metavar="SECONDS", type=float, default=0.0,
@@ -48,6 +49,27 @@ def parse_start(text: str) -> tuple[float, ...]:
     if len(values) == 3:
         values.append(0.0)
     return tuple(math.radians(v) for v in values)
+
+
+#: Longest line read from a commands file: a command is a line; /dev/zero is one endless line.
+MAX_COMMAND_CHARS = 10_000
+
+
+def command_lines(stream: Any, what: str) -> Iterator[str]:
+    """The lines of a commands file, each read no further than :data:`MAX_COMMAND_CHARS`."""
+    number = 0
+    while True:
+        try:
+            line = stream.readline(MAX_COMMAND_CHARS + 1)
+        except UnicodeDecodeError as exc:
+            raise CliError(f"--commands {what}: not UTF-8 text ({exc.reason})") from None
+        if not line:
+            return
+        number += 1
+        if len(line) > MAX_COMMAND_CHARS:
+            raise CliError(f"--commands {what}:{number}: a line longer than {MAX_COMMAND_CHARS} characters:"
+                           " not a commands file")
+        yield line
 
 
 def cmd_debug(args: argparse.Namespace) -> int:
@@ -81,11 +103,11 @@ def cmd_debug(args: argparse.Namespace) -> int:
     if args.commands and args.commands != "-":
         try:
             with open(args.commands, encoding="utf-8") as f:
-                shell.run_script(f)
+                shell.run_script(command_lines(f, args.commands))
         except OSError as exc:
             raise CliError(f"--commands: cannot read {args.commands}: {exc.strerror}") from exc
     elif args.commands == "-" or not sys.stdin.isatty():
-        shell.run_script(sys.stdin)
+        shell.run_script(command_lines(sys.stdin, "standard input"))
     else:
         shell.interact()
         return 0

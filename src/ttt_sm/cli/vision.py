@@ -28,7 +28,7 @@ import cv2
 
 from ..vision.errors import VisionError
 from ..vision.orientation import VIEW_NAMES, board_text, board_values, check_orientation, check_robot_marks
-from .common import print_json
+from .common import print_json, seed
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
@@ -52,7 +52,7 @@ def register(sub: Any) -> argparse.ArgumentParser:
     r = actions.add_parser("render", help="save a simulated camera photo of a board",
                            description="Save a simulated camera photo: perspective, uneven light, blur, noise.")
     r.add_argument("out", metavar="OUT.png", help="where to save the photo")
-    r.add_argument("--seed", type=int, default=0, help="seed of the board, the camera and the light (default 0)")
+    r.add_argument("--seed", type=seed, default=0, help="seed of the board, the camera and the light (default 0)")
     r.add_argument("--board", metavar="TEXT", default=None,
                    help="25 characters . X O in board order (row 1 first; default: a random board)")
     r.add_argument("--robot", choices=["X", "O"], default="X", help="the robot's symbol for --board (default X)")
@@ -65,7 +65,7 @@ def register(sub: Any) -> argparse.ArgumentParser:
     b = actions.add_parser("bench", help="accuracy and time per frame on simulated photos",
                            description="Detect the cells of simulated photos: accuracy and time per frame.")
     b.add_argument("--photos", type=int, default=200, help=f"number of photos, 1..{MAX_PHOTOS} (default 200)")
-    b.add_argument("--seed", type=int, default=0, help="seed of the photo series (default 0)")
+    b.add_argument("--seed", type=seed, default=0, help="seed of the photo series (default 0)")
     b.add_argument("--json", action="store_true", help="print one JSON document")
     b.set_defaults(func=cmd_vision_bench)
     return sp

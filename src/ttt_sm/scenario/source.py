@@ -160,18 +160,19 @@ def _reader_error(exc: yaml.reader.ReaderError, text: str, file: str) -> Scenari
 def load_yaml_file(path: str | Path) -> Any:
     """Read and parse a YAML file (see :func:`load_yaml`): at most :data:`MAX_FILE_BYTES`, UTF-8."""
     path = Path(path)
+    name = str(path) if str(path).isprintable() else repr(str(path))  # a line break in a name breaks the line
     try:
         with path.open("rb") as f:
             raw = f.read(MAX_FILE_BYTES + 1)  # a device or a pipe may never end
     except OSError as exc:
-        raise ScenarioError(str(path), 0, f"cannot read the file: {exc.strerror or exc}") from None
+        raise ScenarioError(name, 0, f"cannot read the file: {exc.strerror or exc}") from None
     if len(raw) > MAX_FILE_BYTES:
-        raise ScenarioError(str(path), 0, f"more than {MAX_FILE_BYTES} bytes: not a scenario file")
+        raise ScenarioError(name, 0, f"more than {MAX_FILE_BYTES} bytes: not a scenario file")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
         column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1
-        raise ScenarioError(str(path), line, f"not UTF-8 text (byte 0x{raw[exc.start]:02x} at column {column});"
+        raise ScenarioError(name, line, f"not UTF-8 text (byte 0x{raw[exc.start]:02x} at column {column});"
                                              " save the file as UTF-8") from None
-    return load_yaml(text, str(path))
+    return load_yaml(text, name)

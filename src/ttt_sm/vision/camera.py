@@ -84,26 +84,27 @@ def read_image(path: str | Path) -> np.ndarray:
     take 1.2 GB as pixels.  Files over :data:`MAX_FILE_BYTES` are not read.
     """
     p = Path(path)
+    name = str(p) if str(p).isprintable() else repr(str(p))  # a line break in a name breaks the message
     if not p.is_file():
-        raise ImageError(f"{p}: no such file" if not p.exists() else f"{p}: not a file")
+        raise ImageError(f"{name}: no such file" if not p.exists() else f"{name}: not a file")
     try:
         with p.open("rb") as f:
             data = f.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
-        raise ImageError(f"{p}: cannot read the file ({exc.strerror or exc})") from None
+        raise ImageError(f"{name}: cannot read the file ({exc.strerror or exc})") from None
     if len(data) > MAX_FILE_BYTES:
-        raise ImageError(f"{p}: more than {MAX_FILE_BYTES // 2**20} MB: not a camera photo")
+        raise ImageError(f"{name}: more than {MAX_FILE_BYTES // 2**20} MB: not a camera photo")
     if not data:
-        raise ImageError(f"{p}: not an image: the file is empty")
-    width, height = image_size(data, str(p))
-    _check_size(width, height, str(p))
+        raise ImageError(f"{name}: not an image: the file is empty")
+    width, height = image_size(data, name)
+    _check_size(width, height, name)
     try:
         image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
     except cv2.error as exc:
-        raise ImageError(f"{p}: OpenCV cannot decode it ({str(exc).strip().splitlines()[-1][:80]})") from None
+        raise ImageError(f"{name}: OpenCV cannot decode it ({str(exc).strip().splitlines()[-1][:80]})") from None
     if image is None:
-        raise ImageError(f"{p}: not an image OpenCV can decode (damaged or cut short?)")
-    return check_image(image, str(p))
+        raise ImageError(f"{name}: not an image OpenCV can decode (damaged or cut short?)")
+    return check_image(image, name)
 
 
 def _check_size(width: int, height: int, what: str) -> None:

@@ -12,12 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from ttt_sm.architecture.layers import CONTRACT, SOURCE_ROOT, allowed, check, component_of, cycles, scan
-
-#: Issue 9, item 4: twin/plant <-> twin/tuning, removed by the plant/controller split.  Until it
-#: lands, this one circle is not reported by test_the_layers_hold and test_the_plant_tuning_circle_is_gone
-#: is an expected failure; when it is gone, that test passes, strict xfail fails it: remove both.
-PLANT_TUNING = frozenset({"ttt_sm.twin.plant", "ttt_sm.twin.tuning"})
+from ttt_sm.architecture.layers import CONTRACT, SOURCE_ROOT, allowed, check, component_of, scan
 
 
 @pytest.fixture(scope="module")
@@ -26,14 +21,8 @@ def graph():
 
 
 def test_the_layers_hold(graph):
-    problems = check(graph, ignore_cycles=[PLANT_TUNING])
+    problems = check(graph)
     assert problems == [], "the layering contract is broken:\n" + "\n".join(problems)
-
-
-@pytest.mark.xfail(strict=True, reason="issue 9 item 4: the twin/plant <-> twin/tuning circle is being removed; "
-                   "once it is gone this passes: delete PLANT_TUNING, its uses and this test (tests/test_layers.py)")
-def test_the_plant_tuning_circle_is_gone(graph):
-    assert PLANT_TUNING not in {frozenset(c) for c in cycles(graph)}
 
 
 def test_the_issue_rules_are_in_the_contract():
@@ -72,12 +61,12 @@ def add_line(package: Path, module: str, line: str) -> int:
 
 
 def test_the_copy_holds_before_anything_is_added(package):
-    assert check(scan(package), ignore_cycles=[PLANT_TUNING]) == []
+    assert check(scan(package)) == []
 
 
 def test_an_import_upwards_fails_naming_the_file_line_and_rule(package):
     n = add_line(package, "twin/kinematics.py", "from ..app.robot import Robot")
-    problems = check(scan(package), ignore_cycles=[PLANT_TUNING])
+    problems = check(scan(package))
     assert problems[0] == (f"src/ttt_sm/twin/kinematics.py:{n}: ttt_sm.twin.kinematics imports ttt_sm.app.robot, "
                            "but app (application) stands above twin (parts); twin may import: params, arm")
     # the app imports the twin, so the wrong import closes a circle too, named by the same line
@@ -87,20 +76,20 @@ def test_an_import_upwards_fails_naming_the_file_line_and_rule(package):
 
 def test_an_import_sideways_fails(package):
     n = add_line(package, "vision/simulated.py", "from ttt_sm.twin.whiteboard import Whiteboard")
-    [problem] = check(scan(package), ignore_cycles=[PLANT_TUNING])
+    [problem] = check(scan(package))
     assert problem.startswith(f"src/ttt_sm/vision/simulated.py:{n}: ttt_sm.vision.simulated imports "
                               "ttt_sm.twin.whiteboard, but twin stands beside vision (both parts)")
 
 
 def test_an_import_outside_an_only_list_fails(package):
     add_line(package, "charts/game.py", "from ..params import ArmParams")
-    [problem] = check(scan(package), ignore_cycles=[PLANT_TUNING])
+    [problem] = check(scan(package))
     assert "params is not among what charts may import; charts may import: runtime" in problem
 
 
 def test_a_circle_of_type_checking_imports_fails(package):
     n = add_line(package, "runtime/temporal.py", "if TYPE_CHECKING:\n    from .chart import TickChart")
-    [problem] = check(scan(package), ignore_cycles=[PLANT_TUNING])
+    [problem] = check(scan(package))
     assert problem.startswith("import circle among ttt_sm.runtime.chart, ttt_sm.runtime.guards, "
                               "ttt_sm.runtime.temporal:")
     assert f"ttt_sm.runtime.temporal -> ttt_sm.runtime.chart (src/ttt_sm/runtime/temporal.py:{n + 1})" in problem
@@ -108,19 +97,19 @@ def test_a_circle_of_type_checking_imports_fails(package):
 
 def test_a_subcommand_importing_back_from_the_cli_fails(package):
     n = add_line(package, "cli/ai.py", "def _late():\n    from . import main")
-    [problem] = check(scan(package), ignore_cycles=[PLANT_TUNING])
+    [problem] = check(scan(package))
     assert problem.startswith("import circle among ttt_sm.cli, ttt_sm.cli.ai")
     assert f"ttt_sm.cli.ai -> ttt_sm.cli (src/ttt_sm/cli/ai.py:{n + 1})" in problem
 
 
 def test_a_tool_importing_the_cli_fails(package):
     add_line(package, "debug/shell.py", "from ..cli.common import CliError")
-    [problem] = check(scan(package), ignore_cycles=[PLANT_TUNING])
+    [problem] = check(scan(package))
     assert "imports ttt_sm.cli.common, but cli common stands beside debug (both tools)" in problem
 
 
 def test_a_module_outside_the_contract_fails(package):
     (package / "extras").mkdir()
     (package / "extras" / "__init__.py").write_text('"""Something new."""\n', encoding="utf-8")
-    assert check(scan(package), ignore_cycles=[PLANT_TUNING]) == [
+    assert check(scan(package)) == [
         "ttt_sm.extras: in no component of the layering contract; add it to CONTRACT"]

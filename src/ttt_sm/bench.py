@@ -21,7 +21,7 @@ from .sched.clock import WallClock
 from .sched.scheduler import PathStage, Scheduler
 from .sched.trajectory import Waypoint, sample_polyline, square_path
 from .twin.kinematics import HOME_Q, IKSolver
-from .twin.plant import ArmSim
+from .twin.sim import ArmSim
 
 
 def _drawing_samples(params: ArmParams, seconds: float, speed: float = 0.03) -> np.ndarray:
@@ -92,7 +92,7 @@ def bench_ik_section(params: ArmParams, seed: int = 0) -> dict[str, Any]:
 
 def bench_steps(params: ArmParams, out_dir: Path) -> dict[str, Any]:
     """Step responses of the three drives on the nonlinear plant (as `ttt-sm tune`)."""
-    from .twin.tuning import tune_report
+    from .twin.step_response import tune_report
 
     rows = tune_report(params, out_dir)
     return {"step_responses": rows}

@@ -17,7 +17,7 @@ import pytest
 from ttt_sm.app.robot import Robot
 from ttt_sm.arm import Arm, Sensors
 from ttt_sm.params import load_params
-from ttt_sm.twin.plant import ArmSim
+from ttt_sm.twin.sim import ArmSim
 
 P = load_params()
 

@@ -15,8 +15,8 @@ from ttt_sm.runtime.listeners import Trace
 
 
 def _twin_arrays(d: Debugger) -> list[np.ndarray]:
-    sim = d.robot.sim  # the kernel's whole state, to check "bit for bit" past the public API
-    return [sim._ds.copy(), sim._di.copy(), sim._gs.copy()]
+    sim = d.robot.sim  # the whole memory of both compiled steps, to check "bit for bit" past the public API
+    return [a.copy() for a in sim.state_arrays()]
 
 
 def test_trace_round_trips_through_json_lines(dbg: Debugger, tmp_path):

@@ -9,7 +9,7 @@ from ttt_sm.sched.scheduler import PathStage, Scheduler, Signals, tool_path
 from ttt_sm.sched.stages import JointMoveStage
 from ttt_sm.sched.trajectory import Waypoint, distance_to_path, sample_polyline
 from ttt_sm.twin.kinematics import HOME_Q, IKSolver, fk
-from ttt_sm.twin.plant import ArmSim
+from ttt_sm.twin.sim import ArmSim
 
 P = load_params()
 

@@ -15,7 +15,7 @@ from ttt_sm.twin.control import (
     max_joint_speed,
     setpoint_filter_matrices,
 )
-from ttt_sm.twin.plant import ArmSim
+from ttt_sm.twin.sim import ArmSim
 from ttt_sm.twin.tuning import design_gains
 
 WORK_POSE = (0.0, 0.6, -1.0, 0.0)

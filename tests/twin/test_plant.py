@@ -14,7 +14,7 @@ import pytest
 
 from ttt_sm.params import load_params
 from ttt_sm.twin.control import DriveNumberError
-from ttt_sm.twin.plant import REST_POSE, ArmSim, SimError, gravity_torques
+from ttt_sm.twin.sim import REST_POSE, ArmSim, SimError, gravity_torques
 from ttt_sm.twin.tuning import design_gains
 
 
@@ -243,7 +243,7 @@ def test_numba_disabled_runs_the_same_kernel(params, gains, tmp_path):
         import json, dataclasses
         from ttt_sm.params import load_params
         from ttt_sm.twin.control import Gains, DriveGains
-        from ttt_sm.twin.plant import ArmSim
+        from ttt_sm.twin.sim import ArmSim
         g = json.load(open(%r))
         gains = Gains(tuple(DriveGains(**d) for d in g))
         sim = ArmSim(load_params(), gains, q0=(0.0, 0.5, -0.5, 0.2))

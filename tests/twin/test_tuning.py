@@ -10,24 +10,20 @@ import pytest
 
 from ttt_sm.params import load_params
 from ttt_sm.twin.control import setpoint_filter_matrices
-from ttt_sm.twin.plant import ArmSim
-from ttt_sm.twin.tuning import (
+from ttt_sm.twin.sim import ArmSim
+from ttt_sm.twin.step_response import (
     LOOPS_PNG,
     REPORT_COLUMNS,
     SETTLING_BAND,
     STATIC_WINDOW_S,
     STEP_POSES,
     STEP_RAD,
-    design_gains,
-    drive_plant,
-    loop_margins,
-    loop_models,
-    loops_figure,
     report_text,
     step_figure,
     step_response,
     tune_report,
 )
+from ttt_sm.twin.tuning import design_gains, drive_plant, loop_margins, loop_models, loops_figure
 
 REPORT_KEYS = {"drive", "step_rad", "rise_time_s", "settling_time_s", "overshoot_pct", "error_at_0_5s_rad",
                "static_error_rad", "inner_phase_margin_deg", "outer_phase_margin_deg",

@@ -29,7 +29,7 @@ from ..charts.drive_init import DriveInit1, DriveInit2, DriveInit3
 from ..params import ArmParams
 from ..sched.scheduler import Scheduler, Signals
 from ..twin.kinematics import link_points
-from ..twin.plant import ArmSim
+from ..twin.sim import ArmSim
 from .wires import BLOCKS, INIT_WIRES
 from .wiring import Wiring, not_wired, wire_stages
 

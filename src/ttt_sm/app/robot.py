@@ -26,7 +26,7 @@ from ..arm import Arm
 from ..params import ArmParams
 from ..runtime import TickChart
 from ..sched.scheduler import Scheduler, Signals, Stage
-from ..twin.plant import ArmSim
+from ..twin.sim import ArmSim
 from ..twin.truth import ArmTruth
 from ..twin.whiteboard import Whiteboard
 from ..twin.workspace import check_reach

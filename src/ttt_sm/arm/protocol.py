@@ -14,7 +14,7 @@ wiring, the debugger's signals) runs unchanged on any backend:
   disabling a drive's controller.
 
 Where the cascade controller runs is the backend's business: in-process,
-fused with the plant, for the simulation (:class:`ttt_sm.twin.plant.ArmSim`);
+fused with the plant, for the simulation (:class:`ttt_sm.twin.sim.ArmSim`);
 in the microcontroller for a hardware backend.  Ground truth is not part of
 this protocol: the simulated arm keeps it behind its ``truth`` attribute.
 

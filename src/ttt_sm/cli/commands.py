@@ -91,7 +91,7 @@ def cmd_draw(args: argparse.Namespace) -> int:
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
-    from ..twin.tuning import report_text, tune_report
+    from ..twin.step_response import report_text, tune_report
 
     out = out_dir(args.out)
     params = load_arm(args.params)

@@ -17,7 +17,7 @@ from typing import Any, Protocol
 from ..app.game import GameSession
 from ..app.robot import Robot
 from ..params import ArmParams
-from ..twin.plant import ArmSim
+from ..twin.sim import ArmSim
 from .errors import DebugError
 
 #: Quantities of the simulated arm a fingerprint compares (arrays, exact floats): its

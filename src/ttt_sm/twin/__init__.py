@@ -1,4 +1,8 @@
-"""The arm's digital twin: kinematics, the simulated plant and its control.
+"""The arm's digital twin: kinematics, the simulated arm (cascade controller and plant) and its tuning.
 
-Nothing here imports charts or the runtime; the application wires them.
+``sim.ArmSim`` fuses the controller's step (``cascade.py``, ``_cascade.py``) and
+the plant's (``plant.py``, ``_plant.py``) in one compiled loop (``_kernel.py``);
+its ground truth sits behind ``truth.py``.  Nothing here imports charts, the
+runtime, the scheduler or the application; the application wires them.  The
+twin imports :mod:`ttt_sm.arm` (the interface it implements), never the reverse.
 """

@@ -4,10 +4,11 @@ Per DC drive: a second-order setpoint filter (cut-off switched by ``fr_sw``),
 an outer position PID whose output, the speed setpoint, is clamped to what
 the drive can do, an inner speed PID whose output is the PWM duty, and a
 speed estimate from the filtered derivative of the encoder angle.  The loops
-themselves run inside the numba kernel (``_kernel.run_steps``); this module
-holds their gains (:class:`Gains`, computed by :func:`ttt_sm.twin.tuning.design_gains`)
+themselves run in the controller's compiled step (``_cascade.cascade_step``,
+held by :class:`ttt_sm.twin.cascade.CascadeController`); this module holds
+their gains (:class:`Gains`, computed by :func:`ttt_sm.twin.tuning.design_gains`)
 and the pure functions that turn parameters into filter coefficients, so that
-the kernel and the tuning model use the very same numbers.
+the controller step and the tuning model use the very same numbers.
 """
 
 from __future__ import annotations
@@ -109,7 +110,7 @@ def setpoint_filter_matrices(cutoff_hz: float, dt: float,
 
 
 def setpoint_filter_row(cutoff_hz: float, dt: float) -> np.ndarray:
-    """The six coefficients ``a11 a12 b1 a21 a22 b2`` the kernel reads (G_SF_*)."""
+    """The six coefficients ``a11 a12 b1 a21 a22 b2`` the controller step reads (``CG_SF_*``)."""
     ad, bd = setpoint_filter_matrices(cutoff_hz, dt)
     return np.array([ad[0, 0], ad[0, 1], bd[0], ad[1, 0], ad[1, 1], bd[1]])
 

@@ -11,43 +11,49 @@ the debugger's ``q_true`` signal.  Code typed on ``Arm`` never reads it.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
 from ..params import ArmParams
-from . import _kernel as K
+from . import _cascade as C
+from . import _plant as P
 from .kinematics import fk
-
-
-def flat_view(a: np.ndarray) -> Any:
-    """A flat memoryview of `a`'s memory: its items read and written as plain Python numbers."""
-    return memoryview(a.reshape(-1))  # type: ignore[arg-type]  # numpy's stubs lack __buffer__
+from .plant import Plant
 
 
 class ArmTruth:
-    """The true state of the simulated arm (reads the twin's state arrays; a view, not a copy).
+    """The true state of the simulated arm: a view of the plant's memory, not a copy.
 
     Angles are load side, radians; drives 1..3 first, q4 the servo's output.
+
+    Parameters
+    ----------
+    params : ArmParams
+        The arm (geometry for the tool pose, encoder resolution for the offsets).
+    plant : Plant
+        The simulated plant.
+    act : ndarray
+        The actuator commands the plant receives (``_cascade.ACT_*``), for :attr:`stalled`.
     """
 
-    def __init__(self, params: ArmParams, dp: np.ndarray, gp: np.ndarray, ds: np.ndarray,
-                 di: np.ndarray, gs: np.ndarray) -> None:
+    def __init__(self, params: ArmParams, plant: Plant, act: np.ndarray) -> None:
         self.params = params
-        self._dp, self._gp, self._ds, self._di, self._gs = dp, gp, ds, di, gs
-        self._dsv = flat_view(ds)
-        self._gsv = flat_view(gs)
+        self._plant = plant
+        self._act = act
+        self._rpc = np.array([d.rad_per_count for d in params.drives])
+        self._psv, self._pgsv = plant.psv, plant.pgsv
 
     @property
     def q(self) -> np.ndarray:
         """True joint angles q1..q4 (rad), a copy."""
         # built from a list: np.append costs several microseconds, and this runs every chart step
-        return np.array([*self._ds[:, K.S_Q].tolist(), float(self._gs[K.GS_SV_Q])])
+        p = self._plant
+        return np.array([*p.ps[:, P.PS_Q].tolist(), float(p.pgs[P.PGS_SV_Q])])
 
     def angles(self) -> tuple[float, float, float, float]:
         """:attr:`q` as plain floats, for code that runs every chart step (the whiteboard)."""
-        ds, n = self._dsv, K.N_DS
-        return ds[K.S_Q], ds[n + K.S_Q], ds[2 * n + K.S_Q], self._gsv[K.GS_SV_Q]
+        ps, n = self._psv, P.WIDTH
+        return ps[P.PS_Q], ps[n + P.PS_Q], ps[2 * n + P.PS_Q], self._pgsv[P.PGS_SV_Q]
 
     def tool_pose(self) -> np.ndarray:
         """The true tool pose x, y, z (m), phi (rad): forward kinematics of :attr:`q` (eqs. 3.17-3.25)."""
@@ -56,37 +62,39 @@ class ArmTruth:
     @property
     def offsets(self) -> np.ndarray:
         """The encoder offsets that make an encoder angle the motor-side joint angle within half a count (rad)."""
-        return (self._di[:, K.I_C0] + 0.5) * self._dp[:, K.P_RPC]
+        return (self._plant.ints[:, P.PI_C0] + 0.5) * self._rpc
 
     @property
     def q_motor(self) -> np.ndarray:
         """True motor angles divided by the gear ratios (rad): what an ideal encoder would see."""
-        return self._ds[:, K.S_TH] / self._dp[:, K.P_N]
+        p = self._plant
+        return p.ps[:, P.PS_TH] / p.pp[:, P.PP_N]
 
     @property
     def current_a(self) -> np.ndarray:
         """True armature currents (A), without the measurement noise."""
-        return self._ds[:, K.S_I].copy()
+        return self._plant.ps[:, P.PS_I].copy()
 
     @property
     def speed_motor(self) -> np.ndarray:
         """True motor shaft speeds (rad/s)."""
-        return self._ds[:, K.S_WM].copy()
+        return self._plant.ps[:, P.PS_WM].copy()
 
     @property
     def speed_load(self) -> np.ndarray:
         """True load (joint) speeds of drives 1..3 (rad/s)."""
-        return self._ds[:, K.S_WQ].copy()
+        return self._plant.ps[:, P.PS_WQ].copy()
 
     @property
     def at_limit(self) -> np.ndarray:
         """True per drive while its load rests on a hard stop."""
-        return self._di[:, K.I_AT_LIMIT] != 0
+        return self._plant.ints[:, P.PI_AT_LIMIT] != 0
 
     @property
     def stalled(self) -> np.ndarray:
         """True per drive while the bridge drives it (|duty| > 0.1) but the motor stands still."""
-        return (np.abs(self._ds[:, K.S_DUTY]) > 0.1) & (self._ds[:, K.S_WM] == 0.0)
+        duty = self._act[C.ACT_DUTY:C.ACT_DUTY + 3]
+        return (np.abs(duty) > 0.1) & (self._plant.ps[:, P.PS_WM] == 0.0)
 
     def mechanical_energy(self) -> float:
         """Kinetic energy of rotors and loads + gravity and gear-spring potential of drives 1..3, J.
@@ -94,15 +102,15 @@ class ArmTruth:
         Gravity's zero is the arm hanging straight down.  With the drives
         off, friction can only take energy out: a check of the integrator.
         """
-        ds, dp = self._ds, self._dp
-        kinetic = 0.5 * float(np.sum(dp[:, K.P_JM] * ds[:, K.S_WM] ** 2 + dp[:, K.P_JL] * ds[:, K.S_WQ] ** 2))
-        g2, g23 = float(self._gp[K.G_GRAV2]), float(self._gp[K.G_GRAV23])
-        q2, q3 = float(ds[1, K.S_Q]), float(ds[2, K.S_Q])
+        ps, pp, pg = self._plant.ps, self._plant.pp, self._plant.pg
+        kinetic = 0.5 * float(np.sum(pp[:, P.PP_JM] * ps[:, P.PS_WM] ** 2 + pp[:, P.PP_JL] * ps[:, P.PS_WQ] ** 2))
+        g2, g23 = float(pg[P.PG_GRAV2]), float(pg[P.PG_GRAV23])
+        q2, q3 = float(ps[1, P.PS_Q]), float(ps[2, P.PS_Q])
         gravity = g2 * (1.0 - math.cos(q2)) + g23 * (1.0 - math.cos(q2 + q3))
-        delta = ds[:, K.S_TH] / dp[:, K.P_N] - ds[:, K.S_Q]
-        squeeze = np.maximum(np.abs(delta) - 0.5 * dp[:, K.P_CLEAR], 0.0)
-        spring = 0.5 * float(np.sum(dp[:, K.P_K] * squeeze**2))
+        delta = ps[:, P.PS_TH] / pp[:, P.PP_N] - ps[:, P.PS_Q]
+        squeeze = np.maximum(np.abs(delta) - 0.5 * pp[:, P.PP_CLEAR], 0.0)
+        spring = 0.5 * float(np.sum(pp[:, P.PP_K] * squeeze**2))
         return kinetic + gravity + spring
 
 
-__all__ = ["ArmTruth", "flat_view"]
+__all__ = ["ArmTruth"]

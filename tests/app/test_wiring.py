@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from ttt_sm.app.game import GameSession
@@ -87,18 +89,35 @@ def game_robot() -> Robot:
     session.close()
 
 
-def _plant(robot: Robot) -> dict[str, float]:
-    """A distinct value at every source of the robot's table; returns them by source."""
+#: Blocks whose outputs their stage computes every chart step and passes to the feeds as arguments.
+ARGUMENT_BLOCKS = ("FK", "IK")
+
+
+def _plant(robot: Robot) -> tuple[dict[str, float], list[object]]:
+    """A distinct value at every source of the robot's table.
+
+    Returns the values by source, and the arguments a feed of every chart takes
+    (the outputs of ARGUMENT_BLOCKS, in declaration order).
+    """
     wiring = robot.wiring
     values: dict[str, float] = {}
+    blocks = {b.name: b for b in BLOCKS}
+    arguments = {f"{name}.{p.name}": [math.nan] * p.size if p.size > 1 else math.nan
+                 for name in ARGUMENT_BLOCKS for p in blocks[name].outputs}
     for k, row in enumerate(wiring.rows):
         source = row.source
         key = str(source)
         if key in values:
             continue
         values[key] = value = 1000.0 + k
+        port = f"{source.block}.{source.port}"
         if source.block in robot.charts:
             vars(robot.charts[source.block])[source.port] = value
+        elif port in arguments:
+            if source.index is None:
+                arguments[port] = value
+            else:
+                arguments[port][source.index] = value  # type: ignore[index]
         else:
             obj = wiring.objects[source.block]
             attr = row.source_port.attribute
@@ -108,13 +127,13 @@ def _plant(robot: Robot) -> dict[str, float]:
                 vector = list(getattr(obj, attr))
                 vector[source.index] = value
                 setattr(obj, attr, vector)
-    return values
+    return values, list(arguments.values())
 
 
 def test_every_row_that_feeds_a_chart_copies_its_source_into_the_input(game_robot):
     robot = game_robot
-    values = _plant(robot)
-    robot.wiring.feed(list(robot.charts))()
+    values, arguments = _plant(robot)
+    robot.wiring.feed(list(robot.charts), args=ARGUMENT_BLOCKS)(*arguments)
     rows = [r for r in robot.wiring.rows if r.target.block in robot.charts]
     assert len(rows) == 30
     for row in rows:
@@ -123,7 +142,7 @@ def test_every_row_that_feeds_a_chart_copies_its_source_into_the_input(game_robo
 
 def test_every_row_into_another_block_is_collected_from_its_source(game_robot):
     robot = game_robot
-    values = _plant(robot)
+    values, _ = _plant(robot)
     rows = [r for r in robot.wiring.rows if r.target.block not in robot.charts]
     ports = sorted({f"{r.target.block}.{r.target.port}" for r in rows})
     collected = dict(zip(ports, robot.wiring.collect(*ports)(), strict=True))

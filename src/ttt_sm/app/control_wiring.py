@@ -44,15 +44,6 @@ def make_control_chart(params: ArmParams, listeners: Sequence[object] = ()) -> C
     )
 
 
-class ToolPose:
-    """Forward kinematics of the encoder angles this chart step (the table's ``FK.X``, ``Y``, ``Z``)."""
-
-    __slots__ = ("X", "Y", "Z")
-
-    def __init__(self) -> None:
-        self.X = self.Y = self.Z = math.nan
-
-
 class ControlStage:
     """Task stage: the Control chart between the game and inverse kinematics.
 
@@ -73,21 +64,23 @@ class ControlStage:
         #: Inputs forced by a test or scenario (``Robot.set_input(..., force=True)``),
         #: applied after the wiring's own: name -> value.
         self.overrides: dict[str, object] = {}
-        self.fk = ToolPose()
         self._no_task = np.full(4, np.nan)
         self._inputs = vars(chart)  # plain attribute writes: this runs every chart step
         g = params.geometry
         self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
-        self._feed: Callable[[], None] = not_wired
+        self._feed: Callable[[float, float, float], None] = not_wired
         self._outputs: Callable[[], tuple[float, float, float, float, bool, bool]] = not_wired  # type: ignore
 
     def blocks(self) -> dict[str, object]:
-        """The objects holding the outputs of this stage's blocks (FK, EraseFlag), by block name."""
-        return {"FK": self.fk, "EraseFlag": self}
+        """The objects holding the outputs of this stage's blocks (EraseFlag), by block name.
+
+        The FK block's outputs, computed here every chart step, are the feed's arguments.
+        """
+        return {"EraseFlag": self}
 
     def wire(self, wiring: Wiring) -> None:
         """Compile this stage's part of the wiring table."""
-        self._feed = wiring.feed([self.chart.chart_name])
+        self._feed = wiring.feed([self.chart.chart_name], args=("FK",))
         self._outputs = wiring.collect("IK.X", "IK.Y", "IK.Z", "IK.phi", "Drives.fr_sw", "EraseFlag.erasing")
 
     def tick(self, signals: Signals) -> None:
@@ -99,9 +92,8 @@ class ControlStage:
             # no setpoint yet (the first chart step): the servo has no sensor, so
             # its pose is the angle it was last commanded
             servo = arm.servo_setpoint
-        fk = self.fk
-        fk.X, fk.Y, fk.Z, _ = _fk_python(q1, q2, q3, servo, *self._geometry)
-        self._feed()
+        x, y, z, _ = _fk_python(q1, q2, q3, servo, *self._geometry)
+        self._feed(x, y, z)
         if self.overrides:
             self._inputs.update(self.overrides)
         self.chart.tick()

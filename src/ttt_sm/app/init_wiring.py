@@ -78,15 +78,6 @@ class EncoderBlock:
                             counts[2] * rpc[2] + offsets[2]]
 
 
-class JointCommand:
-    """The joint coordinates inverse kinematics gave this chart step (the table's ``IK.q_des``)."""
-
-    __slots__ = ("q_des",)
-
-    def __init__(self) -> None:
-        self.q_des: Sequence[float] = (math.nan,) * 4
-
-
 class DriveInitStage:
     """Joint stage: the Encoder blocks and the three init charts between IK and the drives.
 
@@ -104,27 +95,30 @@ class DriveInitStage:
         self.sched = sched
         self.charts = charts
         self.encoder = EncoderBlock(params)
-        self.ik = JointCommand()
         self.servo_init = servo_init_angle(params)
         #: Inputs forced by a test or scenario, applied after the Encoder blocks: (chart index, name) -> value.
         self.overrides: dict[tuple[int, str], object] = {}
         self.done = False  # every drive passes its commanded position through (the table's Homing.done)
         self.failed = False  # a chart gave up (a switch not found)
-        self._feed: Callable[[], None] = not_wired
-        self._feed_held: Callable[[], None] = not_wired
+        self._data = tuple(vars(c) for c in charts)  # the charts' data, as plain dictionaries
+        self._feed: Callable[[Sequence[float]], None] = not_wired
+        self._feed_held: Callable[[Sequence[float]], None] = not_wired
         self._setpoints: Callable[[], list[float]] = not_wired  # type: ignore[assignment]
         self._offsets: Callable[[], list[float]] = not_wired  # type: ignore[assignment]
         self._status: Callable[[], tuple[list[bool], list[bool]]] = not_wired  # type: ignore[assignment]
 
     def blocks(self) -> dict[str, object]:
-        """The objects holding the outputs of this stage's blocks (Encoder, IK, Homing), by block name."""
-        return {"Encoder": self.encoder, "IK": self.ik, "Homing": self}
+        """The objects holding the outputs of this stage's blocks (Encoder, Homing), by block name.
+
+        The IK block's output, this chart step's joint coordinates, is the feeds' argument.
+        """
+        return {"Encoder": self.encoder, "Homing": self}
 
     def wire(self, wiring: Wiring) -> None:
         """Compile this stage's part of the wiring table."""
         names = [c.chart_name for c in self.charts]
-        self._feed = wiring.feed(names)
-        self._feed_held = wiring.feed(names, skip=("Encoder",))
+        self._feed = wiring.feed(names, args=("IK",))
+        self._feed_held = wiring.feed(names, skip=("Encoder",), args=("IK",))
         self._setpoints = wiring.collect("Drives.q_set")
         self._offsets = wiring.collect("Encoder.offset")
         self._status = wiring.collect("Homing.passing", "Homing.gave_up")
@@ -139,10 +133,10 @@ class DriveInitStage:
         c1, c2, c3 = self.charts
         q_set = signals.q_set
         pos_in: Sequence[float] = q_set.tolist() if type(q_set) is np.ndarray else q_set  # type: ignore[assignment]
-        self.ik.q_des = pos_in
         if self.done:
-            self._feed_held()
-            if not self.overrides and not (c1._queue or c2._queue or c3._queue):
+            self._feed_held(pos_in)
+            d1, d2, d3 = self._data
+            if not self.overrides and not (d1["_queue"] or d2["_queue"] or d3["_queue"]):
                 # the offsets are set for good: tick and pass on (every chart step of a game)
                 t1, t2, t3 = c1.tick(), c2.tick(), c3.tick()
                 if t1 or t2 or t3:
@@ -155,7 +149,7 @@ class DriveInitStage:
             sensors = signals.sensors
             assert sensors is not None
             self.encoder.read(sensors, self.arm.encoder_angles(), self.arm.offset_estimates())
-            self._feed()
+            self._feed(pos_in)
         for (d, name), value in self.overrides.items():
             setattr(self.charts[d], name, value)
         # Posted events may move a chart without a tick transition.

@@ -213,17 +213,20 @@ class Wiring:
         self.objects = dict(objects)
         self._used: set[int] = set()
 
-    def feed(self, charts: Sequence[str], skip: Iterable[str] = ()) -> Callable[[], None]:
+    def feed(self, charts: Sequence[str], skip: Iterable[str] = (), args: Sequence[str] = ()) -> Callable[..., None]:
         """A function that writes every wired input of `charts` from its source, now.
 
         Wires from the blocks named in `skip` are left out: their targets keep
         the value last written (a Simulink enabled subsystem that holds its outputs).
+        The outputs of the blocks named in `args` are the function's arguments,
+        every output port of each in declaration order (a vector as one
+        sequence): the stage that computes them passes them straight in.
         """
         unknown = [c for c in charts if c not in self.charts]
         if unknown:
             raise WiringError(f"no chart named {', '.join(unknown)} to feed; charts: {', '.join(self.charts)}")
         skipped = set(skip)
-        code = _Code(self)
+        code = _Code(self, args)
         for i, row in enumerate(self.rows):
             if row.target.block in charts and row.source.block not in skipped:
                 target = code.chart(row.target.block)
@@ -266,10 +269,17 @@ class Wiring:
 
 
 class _Code:
-    """Source text of one generated function, and the objects it binds (as default arguments)."""
+    """Source text of one generated function, its arguments, and the objects it binds (as default arguments)."""
 
-    def __init__(self, wiring: Wiring) -> None:
+    def __init__(self, wiring: Wiring, args: Sequence[str] = ()) -> None:
         self.wiring = wiring
+        self.args: dict[str, str] = {}  # "Block.port" -> argument name
+        for block in args:
+            spec = wiring.blocks.get(block)
+            if spec is None:
+                raise WiringError(f"no block named {block!r} to pass as arguments")
+            for port in spec.outputs:
+                self.args[f"{block}.{port.name}"] = f"{block}_{port.name}"
         self.bound: dict[str, object] = {}
         self.prelude: list[str] = []
         self.body: list[str] = []
@@ -284,6 +294,9 @@ class _Code:
         s = row.source
         if s.block in self.wiring.charts:
             return f"{self.chart(s.block)}[{s.port!r}]"
+        arg = self.args.get(f"{s.block}.{s.port}")
+        if arg is not None:
+            return arg if s.index is None else f"{arg}[{s.index}]"
         obj = self.wiring.objects.get(s.block)
         attr = row.source_port.attribute
         if obj is None or not hasattr(obj, attr):
@@ -300,7 +313,7 @@ class _Code:
         return f"{self.hoisted[key]}[{s.index}]"
 
     def function(self, name: str, result: str) -> Callable[..., Any]:
-        args = ", ".join(f"{v}={v}" for v in self.bound)
+        args = ", ".join([*self.args.values(), *(f"{v}={v}" for v in self.bound)])
         lines = [f"def {name}({args}):", *(f"    {line}" for line in (*self.prelude, *self.body))]
         lines.append(f"    return {result}" if result else "    return None")
         source = "\n".join(lines) + "\n"
@@ -311,7 +324,7 @@ class _Code:
         return fn  # type: ignore[no-any-return]
 
 
-def not_wired() -> Any:
+def not_wired(*args: Any) -> Any:
     """What a stage runs before it is wired: an error saying so."""
     raise RuntimeError("the stage is not wired yet: the Robot wires it when it is built")
 

@@ -159,6 +159,12 @@ test_an_unusable_path_is_refused_in_one_line, test_an_unusable_path_is_refused_i
     (["debug", "--max-run", "0.001", "--commands", "/dev/zero"],
      "--commands /dev/zero:1: a line longer than 10000 characters: not a commands file"),
     (["--params", "a\rb", "params"], "'a\\rb': cannot read parameter file"),
+    (["--params", "a\x00b", "params"], "'a\\x00b': cannot read parameter file (embedded null byte)"),
+    (["scenario", "check", "a\x00b"], "'a\\x00b': cannot read the file: embedded null byte"),
+    (["scenario", "check", "a" * 5000], "cannot read the file: File name too long"),
+    (["vision", "detect", "a" * 5000], "cannot read the file (File name too long)"),
+    (["debug", "--commands", "a\rb"], "--commands: cannot read 'a\\rb': No such file or directory"),
+    (["debug", "--commands", "a\x00b"], "--commands: cannot read 'a\\x00b': embedded null byte"),
 ])
 def test_what_the_cli_fuzzer_found_is_one_line_before_any_work(argv, message):
     rc, err = _run(argv)

@@ -438,7 +438,7 @@ def load_params(path: str | Path | None = None) -> ArmParams:
         text = resources.files("ttt_sm.data").joinpath(DEFAULT_PARAMS_NAME).read_text(encoding="utf-8")
         where = f"ttt_sm/data/{DEFAULT_PARAMS_NAME}"
     else:
-        where = _shown(path)
+        where = shown_path(path)
         text = _read_text(Path(path), where)
     try:
         data = tomllib.loads(text)
@@ -449,7 +449,7 @@ def load_params(path: str | Path | None = None) -> ArmParams:
     return parse_params(data, where, text)
 
 
-def _shown(path: str | Path) -> str:
+def shown_path(path: str | Path) -> str:
     """A file name for a message: as it is, or quoted when it holds line breaks or other control characters."""
     name = str(path)
     return name if name.isprintable() else repr(name)
@@ -460,8 +460,8 @@ def _read_text(path: Path, where: str) -> str:
     try:
         with path.open("rb") as f:
             raw = f.read(MAX_FILE_BYTES + 1)
-    except OSError as exc:
-        raise ParameterError(f"{where}: cannot read parameter file ({exc.strerror or exc})") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL character in the name
+        raise ParameterError(f"{where}: cannot read parameter file ({getattr(exc, 'strerror', None) or exc})") from None
     if len(raw) > MAX_FILE_BYTES:
         raise ParameterError(f"{where}: more than {MAX_FILE_BYTES} bytes: not a parameter file"
                              f" (the packaged one has about 6 kB)")

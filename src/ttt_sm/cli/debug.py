@@ -12,6 +12,7 @@ import sys
 from collections.abc import Iterator
 from typing import Any
 
+from ..params import shown_path
 from .common import CliError, seed
 
 
@@ -104,8 +105,9 @@ def cmd_debug(args: argparse.Namespace) -> int:
         try:
             with open(args.commands, encoding="utf-8") as f:
                 shell.run_script(command_lines(f, args.commands))
-        except OSError as exc:
-            raise CliError(f"--commands: cannot read {args.commands}: {exc.strerror}") from exc
+        except (OSError, ValueError) as exc:  # ValueError: a NUL character in the name
+            reason = getattr(exc, "strerror", None) or exc
+            raise CliError(f"--commands: cannot read {shown_path(args.commands)}: {reason}") from exc
     elif args.commands == "-" or not sys.stdin.isatty():
         shell.run_script(command_lines(sys.stdin, "standard input"))
     else:

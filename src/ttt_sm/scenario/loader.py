@@ -505,7 +505,11 @@ def scenario_files(paths: Iterable[str | Path]) -> list[Path]:
     """The scenario files named: files as given, folders as their ``*.yaml``/``*.yml`` files, sorted."""
     out: list[Path] = []
     for p in map(Path, paths):
-        if p.is_dir():
+        try:
+            folder = p.is_dir()
+        except OSError:  # a name too long: reading it as a file says so
+            folder = False
+        if folder:
             out += sorted(f for f in p.iterdir() if f.suffix in (".yaml", ".yml") and f.is_file())
         else:
             out.append(p)

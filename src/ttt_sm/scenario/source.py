@@ -24,6 +24,7 @@ from typing import Any
 
 import yaml
 
+from ..params import shown_path
 from .errors import ScenarioError
 
 #: Largest scenario file read, bytes (the longest packaged one has about 3 kB).
@@ -160,12 +161,12 @@ def _reader_error(exc: yaml.reader.ReaderError, text: str, file: str) -> Scenari
 def load_yaml_file(path: str | Path) -> Any:
     """Read and parse a YAML file (see :func:`load_yaml`): at most :data:`MAX_FILE_BYTES`, UTF-8."""
     path = Path(path)
-    name = str(path) if str(path).isprintable() else repr(str(path))  # a line break in a name breaks the line
+    name = shown_path(path)
     try:
         with path.open("rb") as f:
             raw = f.read(MAX_FILE_BYTES + 1)  # a device or a pipe may never end
-    except OSError as exc:
-        raise ScenarioError(name, 0, f"cannot read the file: {exc.strerror or exc}") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL character in the name
+        raise ScenarioError(name, 0, f"cannot read the file: {getattr(exc, 'strerror', None) or exc}") from None
     if len(raw) > MAX_FILE_BYTES:
         raise ScenarioError(name, 0, f"more than {MAX_FILE_BYTES} bytes: not a scenario file")
     try:

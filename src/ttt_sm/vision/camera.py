@@ -16,6 +16,7 @@ from typing import Any, Protocol, runtime_checkable
 import cv2
 import numpy as np
 
+from ..params import shown_path
 from .errors import CameraError, ImageError
 
 #: Default frame size (width, height), pixels.
@@ -84,9 +85,12 @@ def read_image(path: str | Path) -> np.ndarray:
     take 1.2 GB as pixels.  Files over :data:`MAX_FILE_BYTES` are not read.
     """
     p = Path(path)
-    name = str(p) if str(p).isprintable() else repr(str(p))  # a line break in a name breaks the message
-    if not p.is_file():
-        raise ImageError(f"{name}: no such file" if not p.exists() else f"{name}: not a file")
+    name = shown_path(p)
+    try:
+        if not p.is_file():
+            raise ImageError(f"{name}: no such file" if not p.exists() else f"{name}: not a file")
+    except OSError as exc:  # a name too long, a folder without search permission, ...
+        raise ImageError(f"{name}: cannot read the file ({exc.strerror or exc})") from None
     try:
         with p.open("rb") as f:
             data = f.read(MAX_FILE_BYTES + 1)

@@ -65,13 +65,14 @@ def test_the_copy_holds_before_anything_is_added(package):
 
 
 def test_an_import_upwards_fails_naming_the_file_line_and_rule(package):
-    n = add_line(package, "twin/kinematics.py", "from ..app.robot import Robot")
+    n = add_line(package, "twin/kinematics/__init__.py", "from ...app.robot import Robot")
     problems = check(scan(package))
-    assert problems[0] == (f"src/ttt_sm/twin/kinematics.py:{n}: ttt_sm.twin.kinematics imports ttt_sm.app.robot, "
+    assert problems[0] == (f"src/ttt_sm/twin/kinematics/__init__.py:{n}: ttt_sm.twin.kinematics imports "
+                           "ttt_sm.app.robot, "
                            "but app (application) stands above twin (parts); twin may import: params, arm")
     # the app imports the twin, so the wrong import closes a circle too, named by the same line
     assert len(problems) == 2 and problems[1].startswith("import circle among ttt_sm.app.")
-    assert f"ttt_sm.twin.kinematics -> ttt_sm.app.robot (src/ttt_sm/twin/kinematics.py:{n})" in problems[1]
+    assert f"ttt_sm.twin.kinematics -> ttt_sm.app.robot (src/ttt_sm/twin/kinematics/__init__.py:{n})" in problems[1]
 
 
 def test_an_import_sideways_fails(package):

@@ -84,8 +84,8 @@ def bench_pacing(params: ArmParams, seconds: float = 10.0, seed: int = 0) -> dic
 
 
 def bench_ik_section(params: ArmParams, seed: int = 0) -> dict[str, Any]:
-    """IK speed and robustness (see twin/kinematics_bench.py)."""
-    from .twin.kinematics_bench import bench_ik
+    """IK speed and robustness (see twin/kinematics/bench.py)."""
+    from .twin.kinematics.bench import bench_ik
 
     return bench_ik(params, seed=seed)
 

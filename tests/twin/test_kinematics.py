@@ -30,7 +30,7 @@ from ttt_sm.twin.kinematics import (
     ik_closed_form,
     jacobian,
 )
-from ttt_sm.twin.kinematics_bench import bench_ik, cold_targets
+from ttt_sm.twin.kinematics.bench import bench_ik, cold_targets
 
 PARAMS = load_params()
 GEOM = PARAMS.geometry
@@ -306,7 +306,7 @@ def test_a_start_in_the_other_elbow_configuration_falls_back_to_the_home_pose() 
 
 def test_python_kernel_matches_the_compiled_one() -> None:
     """NUMBA_DISABLE_JIT=1 runs the same code as plain Python; both must agree."""
-    kernel = kin._dls_kernel
+    kernel = kin.dls._dls_kernel
     python_kernel = getattr(kernel, "py_func", kernel)
     target = np.array([0.05, 0.3, 0.01, 0.0])
     geom = np.array([GEOM.L1, GEOM.L2, GEOM.L3, GEOM.L4, GEOM.l_f])

@@ -23,7 +23,10 @@ import time
 import numpy as np
 
 from ttt_sm.params import ArmParams
-from ttt_sm.twin.kinematics import IKError, IKSolver, UnreachableTargetError, ik_closed_form
+
+from .closed_form import ik_closed_form
+from .errors import IKError, UnreachableTargetError
+from .solver import IKSolver
 
 PHI_SPONGE = math.pi / 2
 

@@ -25,10 +25,14 @@ from ttt_sm.twin.kinematics import (
     JointLimitError,
     NonFiniteTargetError,
     UnreachableTargetError,
+    arm_chain,
+    arm_chain_py,
+    arm_points,
     damped_least_squares,
     fk,
     ik_closed_form,
     jacobian,
+    link_points,
 )
 from ttt_sm.twin.kinematics.bench import bench_ik, cold_targets
 
@@ -162,6 +166,41 @@ def test_printed_eqs_3_23_and_3_24_carry_typos_that_eq_3_21_does_not() -> None:
     corrected_y = g.l_f * s1 + r * c1
     corrected_z = g.L1 - g.L2 * math.cos(q2) - g.L3 * math.cos(q2 + q3) - g.L4 * math.cos(q2 + q3 + q4)
     assert (corrected_y, corrected_z) == pytest.approx((y, z), abs=1e-12)
+
+
+@PROPERTY
+@given(joint_angles)
+def test_the_one_arm_chain_gives_the_tool_pose_and_orientation_of_the_matrices(q: np.ndarray) -> None:
+    g = GEOM
+    lengths = (g.L1, g.L2, g.L3, g.L4, g.l_f)
+    x, y, z, phi, s1, c1, s_phi, c_phi = arm_chain(*q.tolist(), *lengths)
+    T = t40(q)
+    np.testing.assert_allclose((x, y, z), T[:3, 3], atol=1e-12)
+    assert phi == pytest.approx(q[1:].sum(), abs=1e-15)
+    R = T[:3, :3]
+    np.testing.assert_allclose((c1, s1, 0.0), R[:, 0], atol=1e-12)  # the tool's sideways offset
+    np.testing.assert_allclose((-s1 * s_phi, c1 * s_phi, -c_phi), -R[:, 2], atol=1e-12)  # axis, to the tip
+    np.testing.assert_allclose((s1 * c_phi, -c1 * c_phi, -s_phi), -R[:, 1], atol=1e-12)  # sponge normal
+    # the Python original that chart-step code calls is the same chain
+    np.testing.assert_allclose(arm_chain_py(*q.tolist(), *lengths), (x, y, z, phi, s1, c1, s_phi, c_phi),
+                               rtol=0.0, atol=1e-15)
+
+
+@PROPERTY
+@given(joint_angles)
+def test_arm_points_are_the_origins_of_the_matrices_along_the_chain(q: np.ndarray) -> None:
+    q1, q2, q3, _ = q
+    g = GEOM
+    t10 = transform(True, q1, (-g.l_f, 0, g.L1))
+    t20 = t10 @ transform(False, q2, (0, g.L2 * math.sin(q2), -g.L2 * math.cos(q2)))
+    t30 = t20 @ transform(False, q3, (0, g.L3 * math.sin(q3), -g.L3 * math.cos(q3)))
+    pts = arm_points(q, g)
+    np.testing.assert_allclose(pts[0], (-g.l_f, 0.0, 0.0), atol=1e-15)  # the column's foot
+    np.testing.assert_allclose(pts[1], t10[:3, 3], atol=1e-12)  # shoulder, joint 2
+    np.testing.assert_allclose(pts[2], t20[:3, 3], atol=1e-12)  # elbow, joint 3
+    np.testing.assert_allclose(pts[3], t30[:3, 3], atol=1e-12)  # wrist, the servo axis
+    np.testing.assert_allclose(pts[4], t40(q)[:3, 3], atol=1e-12)  # pen tip
+    np.testing.assert_array_equal(link_points(q, g), pts[2:])
 
 
 def test_the_base_axis_is_the_vertical_line_x_minus_l_f() -> None:

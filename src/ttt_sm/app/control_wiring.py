@@ -18,13 +18,9 @@ from ..arm import Arm
 from ..charts.control import Control
 from ..params import ArmParams
 from ..sched.scheduler import Signals
-from ..twin.kinematics import fk_floats
+from ..twin.kinematics import arm_chain_py
 from .init_wiring import DriveInitStage
 from .wiring import Wiring, not_wired
-
-# The compiled forward kinematics' Python original: a numba call with nine
-# float arguments costs ~10 us in dispatch, the plain function ~2 us.
-_fk_python = fk_floats.py_func
 
 
 def make_control_chart(params: ArmParams, listeners: Sequence[object] = ()) -> Control:
@@ -92,7 +88,7 @@ class ControlStage:
             # no setpoint yet (the first chart step): the servo has no sensor, so
             # its pose is the angle it was last commanded
             servo = arm.servo_setpoint
-        x, y, z, _ = _fk_python(q1, q2, q3, servo, *self._geometry)
+        x, y, z, _, _, _, _, _ = arm_chain_py(q1, q2, q3, servo, *self._geometry)
         self._feed(x, y, z)
         if self.overrides:
             self._inputs.update(self.overrides)

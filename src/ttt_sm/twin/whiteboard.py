@@ -36,6 +36,7 @@ import numpy as np
 
 from ttt_sm.params import ArmParams
 from ttt_sm.twin._ink import ink_capsule, ink_polyline, wipe_sweep
+from ttt_sm.twin.kinematics import arm_chain_py
 
 #: Line width of the robot's whiteboard marker (m).
 INK_WIDTH_M = 0.8e-3
@@ -352,25 +353,21 @@ class Whiteboard:
         its stand, a collision (:attr:`Contact.pen_collision_count`), and
         does not write.
         """
-        if type(q) is np.ndarray:
-            q1, q2, q3, q4 = q.tolist()
-        elif type(q) is tuple:
+        if type(q) is tuple:  # the robot's board stage passes a tuple
             q1, q2, q3, q4 = q
+        elif type(q) is np.ndarray:
+            q1, q2, q3, q4 = q.tolist()
         else:
             q1, q2, q3, q4 = (float(v) for v in q)
-        a23 = q2 + q3
-        a = a23 + q4
-        sa = math.sin(a)
-        ca = math.cos(a)
-        r = self._L2 * math.sin(q2) + self._L3 * math.sin(a23) + self._L4 * sa
-        z = self._L1 - (self._L2 * math.cos(q2) + self._L3 * math.cos(a23) + self._L4 * ca)
+        x, y, z, _, s1, c1, sa, ca = arm_chain_py(q1, q2, q3, q4, self._L1, self._L2, self._L3, self._L4,
+                                                  self._lf)
         if not (z == z and q1 == q1):
             raise WhiteboardError(f"joint angles must be finite, got {[q1, q2, q3, q4]}")
         self._t = t
         self._seq += 1
         depth = self._surface - z
         if depth >= 0.0:
-            self._pen_contact(t, q1, sa, ca, r, depth)
+            self._pen_contact(t, x, y, s1, c1, sa, ca, depth)
         else:
             if self._pen_on:
                 self._pen_lift()
@@ -379,7 +376,7 @@ class Whiteboard:
         press = self._surface - (z - self._sp_off * sa)
         if press >= 0.0:
             if sa >= _SPONGE_MIN_SIN and (self._sp_on or self._sp_above):
-                self._sponge_contact(q1, ca, r, press)
+                self._sponge_contact(x, y, s1, c1, ca, press)
                 return
             self._sp_above = False
         else:
@@ -389,11 +386,8 @@ class Whiteboard:
             self._sp_press = 0.0
             self._sp_over = False
 
-    def _pen_contact(self, t: float, q1: float, sa: float, ca: float, r: float, depth: float) -> None:
-        s1 = math.sin(q1)
-        c1 = math.cos(q1)
-        x = self._lf * c1 - r * s1 - self._lf
-        y = self._lf * s1 + r * c1
+    def _pen_contact(self, t: float, x: float, y: float, s1: float, c1: float, sa: float, ca: float,
+                     depth: float) -> None:
         if ca >= _PEN_MIN_COS:
             comp = depth / ca
             cx = x + comp * s1 * sa  # p - comp * u, u = (-s1 sa, c1 sa, -ca)
@@ -480,11 +474,7 @@ class Whiteboard:
         self._pen_over = False
         self._cache = None
 
-    def _sponge_contact(self, q1: float, ca: float, r: float, press: float) -> None:
-        s1 = math.sin(q1)
-        c1 = math.cos(q1)
-        x = self._lf * c1 - r * s1 - self._lf
-        y = self._lf * s1 + r * c1
+    def _sponge_contact(self, x: float, y: float, s1: float, c1: float, ca: float, press: float) -> None:
         fx = x + self._sp_off * s1 * ca  # p + offset n, n = (s1 ca, -c1 ca, -sa)
         fy = y - self._sp_off * c1 * ca
         h = self._sp_half

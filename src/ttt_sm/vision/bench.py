@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ttt_sm.params import ArmParams, Geometry, load_params
-from ttt_sm.twin.kinematics import ik_closed_form, link_points
+from ttt_sm.twin.kinematics import arm_points, ik_closed_form
 
 from .detection import detect
 from .errors import VisionError
@@ -37,10 +37,8 @@ BENCH_JITTER = CameraJitter(position_m=0.04, target_m=0.02, roll_deg=8.0, focal_
 def shadow_of(q: Sequence[float], geometry: Geometry, lamp_m: tuple[float, float, float] = LAMP_M,
               depth: float = SHADOW_DEPTH) -> Shadow:
     """The :class:`Shadow` of the arm at joint angles ``q`` (rad): its links from the twin's kinematics."""
-    g = geometry
     # the column's foot and the shoulder, then the elbow, the wrist and the pen tip
-    points = [(-g.l_f, 0.0, 0.0), (-g.l_f, 0.0, g.L1)]
-    points += [(float(x), float(y), float(z)) for x, y, z in link_points(q, g)]
+    points = [(float(x), float(y), float(z)) for x, y, z in arm_points(q, geometry)]
     return Shadow(tuple(points), lamp_m, depth)
 
 

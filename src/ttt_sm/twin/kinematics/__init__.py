@@ -10,8 +10,10 @@ down.  docs/kinematics.md derives the equations and lists the thesis' typos.
 
 One module per idea, everything importable from here:
 
-* :mod:`.chain`: :func:`fk` and :func:`jacobian`, eqs. 3.22-3.25 and 3.30
-  (corrected), and :func:`link_points`.
+* :mod:`.chain`: the arm's chain of transforms written once, compiled on
+  plain numbers (:func:`arm_chain`, and :data:`arm_chain_py` for plain
+  Python); :func:`fk` and :func:`jacobian`, eqs. 3.22-3.25 and 3.30
+  (corrected); :func:`arm_points` and :func:`link_points`.
 * :mod:`.closed_form`: :func:`ik_closed_form` solves the inverse problem
   geometrically; it is the test oracle, not what the arm runs.
 * :mod:`.dls`: :func:`damped_least_squares`, the thesis' iterative solver
@@ -24,12 +26,12 @@ One module per idea, everything importable from here:
 * :mod:`.bench`: how fast and how reliably the solver solves (``ttt-sm bench``).
 """
 
-from .chain import fk, fk_floats, jacobian, link_points
+from .chain import arm_chain, arm_chain_py, arm_points, fk, jacobian, link_points
 from .closed_form import ik_closed_form
 from .dls import IKResult, damped_least_squares
 from .errors import IKError, JointLimitError, NonFiniteTargetError, UnreachableTargetError
 from .solver import HOME_Q, IKSolver
 
 __all__ = ["HOME_Q", "IKError", "IKResult", "IKSolver", "JointLimitError", "NonFiniteTargetError",
-           "UnreachableTargetError", "damped_least_squares", "fk", "fk_floats", "ik_closed_form", "jacobian",
-           "link_points"]
+           "UnreachableTargetError", "arm_chain", "arm_chain_py", "arm_points", "damped_least_squares", "fk",
+           "ik_closed_form", "jacobian", "link_points"]

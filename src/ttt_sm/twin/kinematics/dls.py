@@ -17,7 +17,7 @@ import numpy as np
 
 from ttt_sm.params import Geometry, IKParams
 
-from .chain import _fk_floats, _jacobian_into
+from .chain import _jacobian_into, arm_chain
 from .errors import _as_vector
 
 # Bounds of the adaptive damping mu = lambda^2.  Below _MU_MIN the 4x4 system
@@ -121,7 +121,7 @@ def _dls_kernel(target: np.ndarray, q0: np.ndarray, geom: np.ndarray, damping: f
         if not (math.isfinite(target[i]) and math.isfinite(q0[i])):
             return q, 0, math.nan  # the caller names what was not finite
     e = np.empty(4)
-    pose = _fk_floats(q[0], q[1], q[2], q[3], L1, L2, L3, L4, l_f)
+    pose = arm_chain(q[0], q[1], q[2], q[3], L1, L2, L3, L4, l_f)  # x, y, z, phi first
     for i in range(4):
         e[i] = target[i] - pose[i]
     err_sq = e[0] ** 2 + e[1] ** 2 + e[2] ** 2 + e[3] ** 2
@@ -161,7 +161,7 @@ def _dls_kernel(target: np.ndarray, q0: np.ndarray, geom: np.ndarray, damping: f
                 dq[k] *= _MAX_STEP_RAD / largest
         for k in range(4):
             q_new[k] = q[k] + dq[k]
-        pose = _fk_floats(q_new[0], q_new[1], q_new[2], q_new[3], L1, L2, L3, L4, l_f)
+        pose = arm_chain(q_new[0], q_new[1], q_new[2], q_new[3], L1, L2, L3, L4, l_f)
         for i in range(4):
             e_new[i] = target[i] - pose[i]
         err_new_sq = e_new[0] ** 2 + e_new[1] ** 2 + e_new[2] ** 2 + e_new[3] ** 2

@@ -9,7 +9,7 @@ import numpy as np
 
 from ttt_sm.params import ArmParams
 
-from .chain import _fk_floats
+from .chain import fk
 from .dls import IKResult, _dls_kernel, _geometry_vector, _solve_pose_kernel, _unwind
 from .errors import JointLimitError, UnreachableTargetError, _as_shape4, _as_vector
 
@@ -51,7 +51,8 @@ class IKSolver:
         self._settings = (ik.damping, ik.tolerance, ik.max_iterations, adaptive)
         # Load the control loop's compiled solve now, not in the first chart step; the answer
         # is not kept (the first solve still starts from HOME_Q).
-        _solve_pose_kernel(*_fk_floats(*HOME_Q, *self._geom.tolist()), *HOME_Q, self._consts, *self._settings)
+        x, y, z, phi = fk(HOME_Q, params.geometry)
+        _solve_pose_kernel(float(x), float(y), float(z), float(phi), *HOME_Q, self._consts, *self._settings)
 
     @property
     def last_q(self) -> np.ndarray | None:

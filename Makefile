@@ -3,7 +3,7 @@
 PY := .venv/bin/python
 TTT := .venv/bin/ttt-sm
 
-.PHONY: setup play test soak lint bench tune clean
+.PHONY: setup play test soak fuzz lint bench tune clean
 
 setup:
 	@sh scripts/setup.sh
@@ -16,6 +16,9 @@ test: setup
 
 soak: setup
 	$(PY) -m pytest -q -m soak; rc=$$?; [ $$rc -eq 5 ] && echo "no soak tests" || exit $$rc
+
+fuzz: setup
+	TTT_SM_FUZZ_RANDOM=1 $(PY) -m pytest -q -m soak -k fuzz
 
 lint: setup
 	.venv/bin/ruff check src tests

@@ -1,8 +1,12 @@
 """Settings shared by the fuzz tests of every input surface (docs/reliability.md).
 
 Each surface has a quick property test in the default run (a few hundred
-cases, derandomized so the suite is reproducible) and a long one under the
-``soak`` marker (thousands of fresh random cases).  The property is always
+cases) and a long one under the ``soak`` marker (thousands of cases).  Both
+are derandomized, so the default run, ``make soak`` and CI see the same cases
+every time and a red run means a change, not luck.  ``make fuzz`` runs the
+soak tests on fresh random cases (``TTT_SM_FUZZ_RANDOM=1``) to look for what
+the fixed cases miss; what it finds becomes a named case in the surface's
+tests before it is fixed.  The property is always
 the same: the surface raises nothing but the project's own error type, and
 its message is one line that names the file, line or argument.
 """
@@ -12,10 +16,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import os
+
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis.strategies import SearchStrategy
 
+#: Fresh random cases in the soak run (``make fuzz``) instead of the fixed ones (``make soak``).
+RANDOM = os.environ.get("TTT_SM_FUZZ_RANDOM", "") not in ("", "0")
 #: Cases per surface in the default run, and in the soak run.
 QUICK_EXAMPLES = 200
 SOAK_EXAMPLES = 5000
@@ -30,7 +38,8 @@ def fuzz(*strategies: SearchStrategy[Any], quick: int = QUICK_EXAMPLES, soak: in
     """Turn a property into ``(quick_test, soak_test)``: bind both to ``test_...`` names."""
     def wrap(check: Callable[..., None]) -> tuple[Callable[..., None], Callable[..., None]]:
         quick_test = settings(derandomize=True, max_examples=quick, **_COMMON)(given(*strategies)(check))
-        soak_test = pytest.mark.soak(settings(max_examples=soak, **_COMMON)(given(*strategies)(check)))
+        soak_test = pytest.mark.soak(settings(max_examples=soak, derandomize=not RANDOM, **_COMMON)(
+            given(*strategies)(check)))
         return quick_test, soak_test
     return wrap
 

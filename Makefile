@@ -3,7 +3,7 @@
 PY := .venv/bin/python
 TTT := .venv/bin/ttt-sm
 
-.PHONY: setup play test soak fuzz lint bench tune clean
+.PHONY: setup play test gui soak fuzz lint bench tune clean
 
 setup:
 	@sh scripts/setup.sh
@@ -13,6 +13,9 @@ play: setup
 
 test: setup
 	$(PY) -m pytest -q
+
+gui: setup
+	$(TTT) gui --open
 
 soak: setup
 	$(PY) -m pytest -q -m soak; rc=$$?; [ $$rc -eq 5 ] && echo "no soak tests" || exit $$rc

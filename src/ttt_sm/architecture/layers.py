@@ -51,7 +51,7 @@ class Component:
 
 
 #: Tier names, bottom up.
-TIERS = ("foundations", "parts", "assemblies", "application", "tools", "command line")
+TIERS = ("foundations", "parts", "assemblies", "application", "tools", "views", "benchmarks", "command line")
 
 CONTRACT: tuple[Component, ...] = (
     Component("package", 0, ("ttt_sm",), "the package's docstring and version", exact=True),
@@ -75,11 +75,13 @@ CONTRACT: tuple[Component, ...] = (
     Component("app", 3, ("ttt_sm.app",), "the application: wires charts, scheduler, twin, camera and game"),
     Component("debug", 4, ("ttt_sm.debug",), "the step-through debugger"),
     Component("scenario", 4, ("ttt_sm.scenario",), "scenario tests of event sequences (YAML)"),
-    Component("bench", 4, ("ttt_sm.bench",), "the speed and quality targets"),
+    Component("web", 5, ("ttt_sm.web",),
+              "the browser cockpit (ttt-sm gui): a session over the debugger, its protocol, server and pages"),
+    Component("bench", 6, ("ttt_sm.bench",), "the speed and quality targets"),
     Component("architecture", 4, ("ttt_sm.architecture",), "this contract, its checker, docs/architecture.md"),
     Component("cli common", 4, ("ttt_sm.cli.common",), "the CLI's one-line error, options and strict JSON output",
               only=("runtime",)),
-    Component("cli", 5, ("ttt_sm.cli",), "ttt-sm: parse, call, print; one module per command group"),
+    Component("cli", 7, ("ttt_sm.cli",), "ttt-sm: parse, call, print; one module per command group"),
 )
 
 

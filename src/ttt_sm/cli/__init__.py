@@ -11,7 +11,7 @@ strict JSON output); each other module adds its subcommands with a
 ``ttt-sm --help`` shows them:
 
 - :mod:`.commands`: play, demo, draw, tune, bench, ik, init, charts, params;
-- :mod:`.scenario`, :mod:`.debug`, :mod:`.camera`, :mod:`.vision`, :mod:`.ai`,
+- :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.vision`, :mod:`.ai`,
   :mod:`.docs`: the command of that name.
 
 The subcommand modules import only :mod:`.common` from this package, never
@@ -25,11 +25,11 @@ import sys
 from collections.abc import Sequence
 
 from ..params import ParameterError
-from . import ai, camera, commands, debug, docs, scenario, vision
+from . import ai, camera, commands, debug, docs, gui, scenario, vision
 from .common import CliError, join_negative_values
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
-SUBCOMMANDS = (commands, scenario, debug, camera, vision, ai, docs)
+SUBCOMMANDS = (commands, scenario, debug, gui, camera, vision, ai, docs)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -59,6 +59,10 @@ from .timeline import Timeline, TimelineWindow
 DEFAULT_MAX_RUN_S = 600.0
 #: A long run tells :attr:`Debugger.progress` where it is every this many simulated seconds.
 PROGRESS_EVERY_S = 5.0
+#: At most this many fingerprints are kept to check replays against (each a few kB): past
+#: it every other old one is dropped, so a session that runs for hours (a GUI calls the
+#: debugger 30 times a second) holds them spread over its whole run in bounded memory.
+MAX_FINGERPRINTS = 512
 
 
 class Debugger:
@@ -97,6 +101,7 @@ class Debugger:
         self._pause = threading.Event()
         self._fingerprints: dict[int, dict[str, Any]] = {}
         self._names = RobotNames(lambda: self.robot)
+        self._listeners: list[object] = []
         self._attach(robot)
         self._remember()
 
@@ -119,7 +124,7 @@ class Debugger:
         self.trace = Trace()
         self.state_history = Timeline()
         for chart in robot.charts.values():
-            chart.add_listener(self.trace, self.listener)
+            chart.add_listener(self.trace, self.listener, *self._listeners)
         self.state_history.observe(robot.charts.values())
         self._index = ChartIndex(dict(robot.charts))
         self._divider = robot.params.control.chart_divider
@@ -138,6 +143,16 @@ class Debugger:
     def game(self) -> GameSession | None:
         """The game around the charts (``build(..., game=True)``), else None."""
         return game_of(self.robot)
+
+    def add_listener(self, listener: object) -> None:
+        """Attach a python-statemachine listener to every chart, now and after each replay's rebuild.
+
+        A view over the session (a GUI counting the transitions taken) sees
+        the charts the debugger runs, whichever robot that is.
+        """
+        self._listeners.append(listener)
+        for chart in self.robot.charts.values():
+            chart.add_listener(listener)
 
     # -- where we are ------------------------------------------------------------
 
@@ -476,8 +491,20 @@ class Debugger:
         return fingerprint(self.robot, self.forced)
 
     def _remember(self) -> None:
-        self._fingerprints[self.robot.steps] = self.fingerprint()
+        kept = self._fingerprints
+        kept[self.robot.steps] = self.fingerprint()
+        if len(kept) > MAX_FINGERPRINTS:
+            # Thin the older half (every other one), keep the recent half whole.
+            steps = sorted(kept)
+            old = steps[:len(steps) // 2]
+            for s in old[1::2]:
+                del kept[s]
         self._furthest_steps = max(self._furthest_steps, self.robot.steps)
+
+    @property
+    def furthest_tick(self) -> int:
+        """The furthest chart tick the session has run to: :meth:`replay` takes any tick up to it."""
+        return (self._furthest_steps + self._divider - 1) // self._divider
 
     def steps_of_tick(self, tick: int) -> int:
         """The control step count right after chart tick ``tick`` (0: power-on)."""
@@ -495,9 +522,8 @@ class Debugger:
         if not isinstance(tick, int) or tick < 0:
             raise DebugError(f"replay: the chart tick must be a whole number >= 0, got {tick!r}")
         if self.steps_of_tick(tick) > self._furthest_steps:
-            furthest = (self._furthest_steps + self._divider - 1) // self._divider
             raise DebugError(f"replay: chart tick {tick} lies beyond where this session has been (chart tick"
-                             f" {furthest}); replay goes back, run goes forward")
+                             f" {self.furthest_tick}); replay goes back, run goes forward")
         return self.replay_to_step(self.steps_of_tick(tick))
 
     def replay_to_step(self, steps: int) -> ReplayResult:

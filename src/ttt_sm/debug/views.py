@@ -234,14 +234,17 @@ def signal_lines(dbg: Debugger) -> list[str]:
     width = max(len(n) for n in values)
     lines = []
     for name, value in values.items():
-        unit = SIGNAL_UNITS.get(name, "")
-        if isinstance(value, (list, tuple)):
-            text = _vector(value, unit)
-        else:
-            text = fmt_value(value, unit if isinstance(unit, str) else "")
         doc = SIGNAL_DOCS.get(name)
-        lines.append(f"  {name:<{width}}  {text}" + (f"  -- {doc}" if doc else ""))
+        lines.append(f"  {name:<{width}}  {signal_text(name, value)}" + (f"  -- {doc}" if doc else ""))
     return lines
+
+
+def signal_text(name: str, value: Any) -> str:
+    """One signal's value with its unit, as `show signals` prints it (angles also in degrees)."""
+    unit = SIGNAL_UNITS.get(name, "")
+    if isinstance(value, (list, tuple)):
+        return _vector(value, unit)
+    return fmt_value(value, unit if isinstance(unit, str) else "")
 
 
 def record_line(r: TraceRecord) -> str:

@@ -28,6 +28,7 @@ edge of transition ``n`` (its index in :class:`~.structure.ChartStructure`).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from statemachine import StateChart
@@ -61,6 +62,8 @@ class View:
     key: str = ""
     root: str | None = None
     closed: frozenset[str] = frozenset()
+    #: sub-charts drawn open in an overview (:func:`overview_with`), for the title
+    opened: tuple[str, ...] = ()
 
     def file_stem(self, chart_name: str) -> str:
         """``Control``, ``Control.overview``, ``Control.Drawing_X``."""
@@ -69,6 +72,8 @@ class View:
     def title(self, chart_name: str) -> str:
         if self.root is not None:
             return f"{chart_name} — sub-chart {self.root}"
+        if self.opened:
+            return f"{chart_name} — overview, {', '.join(self.opened)} open"
         if self.closed:
             return f"{chart_name} — overview, sub-charts closed"
         return chart_name
@@ -95,6 +100,23 @@ def views(chart: StateChart | type[StateChart]) -> tuple[View, ...]:
         raise ValueError(f"{structure_of(chart).name}: a sub-chart named {OVERVIEW!r} would share"
                          " its picture's name with the overview; rename the state")
     return (View(OVERVIEW, closed=frozenset(subs)), *(View(s, root=s) for s in subs), WHOLE)
+
+
+def overview_with(chart: StateChart | type[StateChart], opened: Iterable[str] = ()) -> View:
+    """The overview with the sub-charts ``opened`` drawn open in place, the others closed.
+
+    Stateflow opens a subchart where it stands; a live view (the browser
+    cockpit) offers the same, one picture per set of open sub-charts.
+    """
+    subs = subcharts(chart)
+    wanted = tuple(s for s in subs if s in set(opened))
+    unknown = sorted(set(opened) - set(subs))
+    if unknown:
+        raise ValueError(f"{structure_of(chart).name} has no sub-chart {unknown[0]!r};"
+                         f" sub-charts: {', '.join(subs) or 'none'}")
+    if not wanted:
+        return View(OVERVIEW, closed=frozenset(subs))
+    return View("+".join((OVERVIEW, *wanted)), closed=frozenset(subs) - set(wanted), opened=wanted)
 
 
 # -- text --------------------------------------------------------------------

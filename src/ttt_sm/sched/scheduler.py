@@ -27,7 +27,7 @@ import numpy as np
 from ..arm import Arm, Sensors
 from ..params import ArmParams
 from ..twin.kinematics import IKError, IKSolver, fk
-from .clock import VirtualClock, WallClock
+from .clock import Clock, VirtualClock
 
 
 class Signals:
@@ -130,14 +130,14 @@ class Scheduler:
         The arm with its controllers: the simulated arm, or a hardware backend.
     task_stages, joint_stages : sequence of Stage
         Ticked at the chart rate before and after inverse kinematics.
-    clock : VirtualClock or WallClock, optional
+    clock : Clock, optional
         Virtual time by default.
     record : bool
         Keep a per-chart-tick :class:`Record` (costs time; off for benchmarks).
     """
 
     def __init__(self, params: ArmParams, arm: Arm, task_stages: Sequence[Stage] = (),
-                 joint_stages: Sequence[Stage] = (), clock: VirtualClock | WallClock | None = None,
+                 joint_stages: Sequence[Stage] = (), clock: Clock | None = None,
                  ik: IKSolver | None = None, record: bool = False) -> None:
         self.params = params
         self.arm = arm
@@ -189,7 +189,7 @@ class Scheduler:
             self.mark_homed(drive)
         self._hold = [*self.arm.encoder_angles(), self.arm.servo_setpoint]
 
-    def set_clock(self, clock: VirtualClock | WallClock) -> None:
+    def set_clock(self, clock: Clock) -> None:
         """Switch clocks; the new clock's period 0 is the next control step."""
         self.clock = clock
         self._clock_started = False

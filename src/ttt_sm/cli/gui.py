@@ -1,0 +1,113 @@
+"""``ttt-sm gui``: the browser cockpit over one running robot (docs/gui.md).
+
+:func:`register` adds the command; the web app, the robot and uvicorn are
+imported only when it runs, so the CLI starts fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ipaddress
+import math
+import secrets
+import sys
+import threading
+import webbrowser
+from pathlib import Path
+from typing import Any
+
+from .common import CliError
+
+DEFAULT_PORT = 8765
+LOOPBACK = ("127.0.0.1", "localhost", "::1")
+
+
+def register(sub: Any) -> argparse.ArgumentParser:
+    """Add the ``gui`` subcommand to the subparsers of ``ttt-sm``."""
+    help_ = "the live chart cockpit in a browser: diagrams, data, breakpoints, replay, coverage"
+    sp: argparse.ArgumentParser = sub.add_parser("gui", help=help_, description=help_)
+    sp.set_defaults(func=cmd_gui)
+    sp.add_argument("--host", default="127.0.0.1",
+                    help="address to listen on (default 127.0.0.1; any other needs the printed token)")
+    sp.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default {DEFAULT_PORT}; 0: any free one)")
+    sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
+    sp.add_argument("--speed", default="1",
+                    help="times real time, 0.1 to 10, or 'max' for as fast as it goes (default 1)")
+    sp.add_argument("--paused", action="store_true", help="start paused at power-on")
+    sp.add_argument("--open", action="store_true", help="open the cockpit in a web browser")
+    sp.add_argument("--scenarios", metavar="DIR", default=None,
+                    help="scenario files the page may run for coverage (default: tests/scenarios when it exists)")
+    sp.add_argument("--trace", metavar="FILE", default="out/gui/trace.jsonl",
+                    help="where the trace is saved when the cockpit stops (default out/gui/trace.jsonl)")
+    return sp
+
+
+def parse_speed(text: str) -> float | None:
+    """``"max"`` -> None, else a factor from 0.1 to 10."""
+    if text.strip().lower() == "max":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise CliError(f"--speed: expected a number from 0.1 to 10 or 'max', got {text!r}") from None
+    if not (math.isfinite(value) and 0.1 <= value <= 10):
+        raise CliError(f"--speed: expected a number from 0.1 to 10 or 'max', got {text!r}")
+    return value
+
+
+def needs_token(host: str) -> bool:
+    """Whether a listening address is reachable from other machines (everything but loopback)."""
+    if host in LOOPBACK:
+        return False
+    try:
+        return not ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return True
+
+
+def cmd_gui(args: argparse.Namespace) -> int:
+    """Build the robot and its debugger, start the session and serve the pages until Ctrl-C."""
+    import socket
+
+    import uvicorn
+
+    from ..debug.debugger import Debugger
+    from ..twin.workspace import load_arm
+    from ..web.coverage import scenario_dir_files
+    from ..web.server import create_app
+    from ..web.session import Session
+
+    speed = parse_speed(args.speed)
+    if not 0 <= args.port <= 65535:
+        raise CliError(f"--port: expected 0 to 65535, got {args.port}")
+    folder = Path(args.scenarios) if args.scenarios else Path("tests/scenarios")
+    if args.scenarios and not folder.is_dir():
+        raise CliError(f"--scenarios: {args.scenarios} is not a folder")
+    params = load_arm(getattr(args, "params", None))
+    token = secrets.token_urlsafe(24) if needs_token(args.host) else None
+    try:
+        sock = socket.socket(socket.AF_INET6 if ":" in args.host else socket.AF_INET, socket.SOCK_STREAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind((args.host, args.port))
+    except OSError as exc:
+        raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
+    port = sock.getsockname()[1]
+    print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
+    dbg = Debugger.build(params, seed=args.seed)
+    session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
+                      trace_path=Path(args.trace))
+    shown = f"[{args.host}]" if ":" in args.host else args.host
+    hosts = [f"{h}:{port}" for h in ("127.0.0.1", "localhost", "[::1]", shown)]
+    app = create_app(session, token=token, hosts=hosts)
+    url = f"http://{shown}:{port}/charts" + (f"?token={token}" if token else "")
+    print(f"ttt-sm gui: the chart cockpit is at {url}", flush=True)
+    if token:
+        print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
+              flush=True)
+    print("ttt-sm gui: Ctrl-C stops it (the trace is saved to " + args.trace + ")", flush=True)
+    if args.open:
+        threading.Timer(1.0, webbrowser.open, args=(url,)).start()
+    config = uvicorn.Config(app, log_level="warning", ws_max_size=1 << 20, lifespan="on")
+    server = uvicorn.Server(config)
+    server.run(sockets=[sock])
+    return 0

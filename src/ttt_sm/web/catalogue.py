@@ -1,0 +1,90 @@
+"""What a session runs, described once for the pages: charts, states, transitions, data, signals.
+
+The pages name everything by what the charts declare (``Chart.structure()``,
+``Chart.declarations()``) and the robot's signals: a state by its qualified
+name (``Control.start_stop.wait_1``, chart then the state's ancestors), a
+transition as ``Chart.source->target`` (as ``break transition`` writes it),
+with its index in the chart's structure, the number its diagram edge carries
+(``tr-<index>``).  Nothing is read from chart code.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..debug.debugger import Debugger
+from ..debug.views import SIGNAL_DOCS, SIGNAL_UNITS
+from ..runtime import TickChart
+from ..runtime.dot import subcharts, views
+from ..runtime.structure import ChartStructure
+
+#: Signals that only a simulation has (the twin's ground truth): labelled so in the pages.
+SIMULATION_ONLY = ("q_true", "tool_true")
+
+
+def qualified_names(chart_name: str, structure: ChartStructure) -> dict[str, str]:
+    """State id -> qualified name: the chart, then the state's ancestors, then the state."""
+    by_id = {s.id: s for s in structure.states}
+    out = {}
+    for s in structure.states:
+        chain = [s.id]
+        parent = s.parent
+        while parent is not None:
+            chain.insert(0, parent)
+            parent = by_id[parent].parent
+        out[s.id] = ".".join([chart_name, *chain])
+    return out
+
+
+def transition_name(chart_name: str, source: str, target: str | None) -> str | None:
+    """``Chart.source->target``, as a transition breakpoint names it (None: a targetless handler)."""
+    return None if target is None else f"{chart_name}.{source}->{target}"
+
+
+def view_list(chart: TickChart | type[TickChart]) -> list[dict[str, str]]:
+    """The pictures of a chart (:func:`~ttt_sm.runtime.dot.views`) as the pages offer them."""
+    out = []
+    cls = chart if isinstance(chart, type) else type(chart)
+    for v in views(cls):
+        key = v.key or "whole"
+        title = {"overview": "overview", "whole": "whole chart"}.get(key, f"{key} on its own")
+        out.append({"key": key, "title": title})
+    return out
+
+
+def describe_chart(name: str, chart: TickChart) -> dict[str, Any]:
+    """One chart: its states, transitions, data and events, and its pictures."""
+    structure = type(chart).structure()
+    qnames = qualified_names(name, structure)
+    return {
+        "name": name,
+        "class": type(chart).__name__,
+        "doc": (type(chart).__doc__ or "").strip().splitlines()[0] if type(chart).__doc__ else "",
+        "states": [{"id": s.id, "qname": qnames[s.id], "parent": s.parent, "compound": s.is_compound,
+                    "history": bool(s.history)} for s in structure.states],
+        "transitions": [{"index": t.index, "source": t.source, "target": t.target,
+                         "name": transition_name(name, t.source, t.target), "label": t.label,
+                         "trigger": t.trigger} for t in structure.transitions],
+        "data": [{"name": d.name, "kind": d.kind, "unit": d.unit, "doc": d.doc} for d in chart.declarations()],
+        "events": list(structure.user_events),
+        "subcharts": list(subcharts(type(chart))),
+        "views": view_list(chart),
+    }
+
+
+def describe_session(debugger: Debugger) -> dict[str, Any]:
+    """Everything static a page needs: the charts (in the robot's order) and the signals."""
+    robot = debugger.robot
+    signals = []
+    for key in robot.signal_values():
+        unit = SIGNAL_UNITS.get(key, "")
+        signals.append({"name": key, "unit": unit if isinstance(unit, str) else " ".join(unit),
+                        "doc": SIGNAL_DOCS.get(key, ""), "simulation_only": key in SIMULATION_ONLY})
+    return {
+        "charts": [describe_chart(name, chart) for name, chart in robot.charts.items()],
+        "signals": signals,
+        "dt": robot.params.control.dt,
+        "chart_dt": robot.params.control.chart_dt,
+        "seed": getattr(debugger.recipe, "seed", None),
+        "max_run_s": debugger.max_run_s,
+    }

@@ -1,0 +1,130 @@
+"""Coverage colouring: which states were entered and which transitions taken, per chart of the session.
+
+Two sources, one result: scenario files run from the page (the scenario
+runner's :class:`~ttt_sm.runtime.listeners.Coverage`, as ``ttt-sm scenario
+run --coverage``), or a report that command wrote with ``--json``.  A report
+names charts by class, states by id and transitions by their stable label
+(``"off -> on: tick [sw]"``); :func:`colouring` turns it into the session's
+chart names, state ids and transition indices, the numbers its diagram edges
+carry, and refuses a report that names a state or transition the charts do not
+have (a report of other charts, or of an older version of them).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from ..params import ArmParams
+from ..runtime import TickChart
+from ..scenario.errors import ScenarioError
+from ..scenario.loader import load_scenario, load_scenario_text
+from ..scenario.model import Scenario
+from ..scenario.runner import ScenarioResult
+from ..scenario.suite import coverage_dict, run_scenarios
+
+
+class CoverageError(ValueError):
+    """A coverage report that does not fit the session's charts, or scenarios that cannot run."""
+
+
+def colouring(report: Mapping[str, Any], charts: Mapping[str, type[TickChart]]) -> dict[str, Any]:
+    """Per chart of the session: the states entered and the transitions taken, and what was never.
+
+    ``report`` is the ``coverage`` object of ``ttt-sm scenario run --coverage
+    --json`` (or that whole document).  Returns ``{"charts": {name: {"entered":
+    [ids], "missing_states": [ids], "taken": [indices], "missing_transitions":
+    [indices], "states": "n/m", "transitions": "n/m"}}, "ignored": [class names]}``.
+    """
+    if "coverage" in report and isinstance(report["coverage"], dict):
+        report = report["coverage"]
+    by_class = {cls.__name__: name for name, cls in charts.items()}
+    out: dict[str, Any] = {}
+    ignored = []
+    for cls_name, entry in report.items():
+        if cls_name not in by_class:
+            ignored.append(str(cls_name))
+            continue
+        if not isinstance(entry, dict):
+            raise CoverageError(f"coverage report: {cls_name} must be an object with 'entered' and 'taken'"
+                                " (or 'missing_states' and 'missing_transitions')")
+        name = by_class[cls_name]
+        structure = charts[name].structure()
+        states = [s.id for s in structure.states if not s.history]
+        labels: dict[str, list[int]] = {}
+        for t in structure.transitions:
+            labels.setdefault(t.label, []).append(t.index)
+        entered = _names(entry, cls_name, "entered", "missing_states", states)
+        taken_labels = _names(entry, cls_name, "taken", "missing_transitions", list(labels))
+        taken = sorted(i for label in taken_labels for i in labels[label])
+        out[name] = {
+            "entered": [s for s in states if s in entered],
+            "missing_states": [s for s in states if s not in entered],
+            "taken": taken,
+            "missing_transitions": [t.index for t in structure.transitions if t.index not in set(taken)],
+            "states": f"{len(entered)}/{len(states)}",
+            "transitions": f"{len(set(taken_labels))}/{len(labels)}",
+        }
+    if not out:
+        raise CoverageError("coverage report: it covers none of this session's charts"
+                            f" ({', '.join(charts)}); it names {', '.join(map(str, report)) or 'nothing'}")
+    return {"charts": out, "ignored": ignored}
+
+
+def _names(entry: dict[str, Any], chart: str, key: str, missing_key: str, known: Sequence[str]) -> set[str]:
+    """The names a report lists under ``key``, or all ``known`` but those under ``missing_key``."""
+    if key in entry:
+        listed, invert = entry[key], False
+    elif missing_key in entry:
+        listed, invert = entry[missing_key], True
+    else:
+        raise CoverageError(f"coverage report: {chart} has neither {key!r} nor {missing_key!r}")
+    if not isinstance(listed, list) or not all(isinstance(x, str) for x in listed):
+        raise CoverageError(f"coverage report: {chart}.{key if not invert else missing_key} must be a list of names")
+    unknown = [x for x in listed if x not in known]
+    if unknown:
+        raise CoverageError(f"coverage report: {chart} has no {'state' if 'state' in missing_key else 'transition'}"
+                            f" {unknown[0]!r} (a report of other charts, or of an older version of them?)")
+    return set(known) - set(listed) if invert else set(listed)
+
+
+def load_scenarios(files: Sequence[str], available: Mapping[str, Path]) -> list[Scenario]:
+    """The scenario files a page picked, by name among the session's ``available`` ones."""
+    scenarios = []
+    for name in files:
+        path = available.get(name)
+        if path is None:
+            raise CoverageError(f"no scenario file {name!r} in this session; files: {', '.join(available) or 'none'}"
+                                " (start ttt-sm gui with --scenarios DIR)")
+        try:
+            scenarios.append(load_scenario(path))
+        except ScenarioError as exc:
+            raise CoverageError(str(exc)) from None
+    return scenarios
+
+
+def scenario_from_text(name: str, text: str) -> Scenario:
+    """A scenario sent as text from the page (a file the person picked)."""
+    try:
+        return load_scenario_text(text, file=name)
+    except ScenarioError as exc:
+        raise CoverageError(str(exc)) from None
+
+
+def run_for_coverage(scenarios: Sequence[Scenario], params: ArmParams, charts: Mapping[str, type[TickChart]],
+                     progress: Callable[[ScenarioResult], None] | None = None) -> dict[str, Any]:
+    """Run scenarios with coverage, as ``ttt-sm scenario run --coverage``; the colouring and the verdicts."""
+    report = run_scenarios(scenarios, params, coverage=True, progress=progress)
+    assert report.coverage is not None
+    result = colouring(coverage_dict(report.coverage), charts)
+    result["scenarios"] = [{"name": r.name, "file": r.file, "passed": r.passed,
+                            "failures": [str(f) for f in r.failures]} for r in report.results]
+    return result
+
+
+def scenario_dir_files(folder: Path | None) -> dict[str, Path]:
+    """The ``*.yaml`` scenario files of a folder, by file name."""
+    if folder is None or not folder.is_dir():
+        return {}
+    return {p.name: p for p in sorted(folder.glob("*.yaml"))}

@@ -1,0 +1,237 @@
+"""The cockpit's web server: pages, diagrams and one WebSocket over one :class:`~.session.Session`.
+
+An ASGI app on Starlette, served by uvicorn (``ttt-sm gui``).  Starlette
+because the cockpit needs exactly its pieces and little else: routes, a
+WebSocket endpoint, static files served from the package, a lifespan to start
+and stop the session, and a test client that speaks the same ASGI (the
+protocol tests run without a browser or a socket).
+
+Routes: ``/`` (links every page), ``/charts`` (the chart cockpit),
+``/static/...`` (the pages' scripts and styles, from the package: nothing from
+a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
+SVG, :mod:`.diagrams`), ``/api/trace.jsonl`` (the trace so far), ``/ws``.
+
+Safe by default:
+
+* the server binds 127.0.0.1; any other host needs the session's token,
+  printed in the URL at start (``?token=...``, as Jupyter does); a request
+  with it gets a cookie, one without it gets 403;
+* the ``Host`` header must name this server (no DNS rebinding), and a
+  WebSocket's ``Origin``, when a browser sends one, must be this server's;
+* every WebSocket message is checked by :mod:`.protocol` before the session
+  sees it; a bad one gets an ``error`` reply naming what was wrong and the
+  connection goes on.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import hmac
+from collections.abc import AsyncIterator, Iterable
+from importlib import resources
+from typing import Any
+from urllib.parse import urlsplit
+
+from starlette.applications import Starlette
+from starlette.requests import HTTPConnection, Request
+from starlette.responses import HTMLResponse, PlainTextResponse, Response
+from starlette.routing import Mount, Route, WebSocketRoute
+from starlette.staticfiles import StaticFiles
+from starlette.types import ASGIApp, Receive, Scope, Send
+from starlette.websockets import WebSocket, WebSocketDisconnect
+
+from ..runtime.errors import GraphvizMissingError
+from .diagrams import DiagramError, Diagrams
+from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
+from .session import Session
+
+TOKEN_COOKIE = "ttt_sm_token"
+#: Messages queued for one page at most; a page that falls further behind gets a full frame again.
+CLIENT_QUEUE = 64
+LOOPBACK = ("127.0.0.1", "localhost", "::1")
+
+
+def static_dir() -> str:
+    """The pages' files, inside the package."""
+    return str(resources.files("ttt_sm.web") / "static")
+
+
+class Guard:
+    """ASGI middleware: the token (when there is one) and the Host header, for HTTP and WebSocket."""
+
+    def __init__(self, app: ASGIApp, token: str | None, hosts: Iterable[str]) -> None:
+        self.app = app
+        self.token = token
+        self.hosts = {h.lower() for h in hosts}
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] not in ("http", "websocket"):
+            await self.app(scope, receive, send)
+            return
+        conn = HTTPConnection(scope)
+        host = conn.headers.get("host", "").lower()
+        if self.hosts and host not in self.hosts:
+            await self._refuse(scope, receive, send, f"host {host!r} is not this server")
+            return
+        given = conn.query_params.get("token") or conn.cookies.get(TOKEN_COOKIE)
+        if self.token is not None and not (given and hmac.compare_digest(given, self.token)):
+            await self._refuse(scope, receive, send, "this cockpit needs its token: open the URL that"
+                                                     " `ttt-sm gui` printed (it ends in ?token=...)")
+            return
+        if self.token is not None and conn.query_params.get("token") and scope["type"] == "http":
+            token = self.token
+
+            async def send_with_cookie(message: Any) -> None:
+                if message["type"] == "http.response.start":
+                    headers = list(message.get("headers", []))
+                    headers.append((b"set-cookie", f"{TOKEN_COOKIE}={token}; Path=/; HttpOnly;"
+                                                   f" SameSite=Strict".encode()))
+                    message = {**message, "headers": headers}
+                await send(message)
+
+            await self.app(scope, receive, send_with_cookie)
+            return
+        await self.app(scope, receive, send)
+
+    @staticmethod
+    async def _refuse(scope: Scope, receive: Receive, send: Send, why: str) -> None:
+        if scope["type"] == "websocket":
+            await send({"type": "websocket.close", "code": 1008, "reason": why[:120]})
+            return
+        await PlainTextResponse(f"403 Forbidden: {why}\n", status_code=403)(scope, receive, send)
+
+
+def origin_ok(origin: str | None, host: str) -> bool:
+    """A WebSocket's Origin must be this server (a page of another site may not drive the robot)."""
+    if origin is None:
+        return True  # not a browser: the token and the Host check apply
+    parts = urlsplit(origin)
+    return parts.scheme in ("http", "https") and parts.netloc.lower() == host.lower()
+
+
+def create_app(session: Session, *, token: str | None = None, hosts: Iterable[str] = (),
+               manage_session: bool = True) -> Starlette:
+    """The cockpit's ASGI app over ``session``.
+
+    ``token``: required on every request when given (``ttt-sm gui`` sets one
+    for any host but 127.0.0.1).  ``hosts``: the ``host[:port]`` values the Host
+    header may take (empty: any).  ``manage_session``: start the session with
+    the app and stop it (saving the trace) when the app shuts down.
+    """
+    diagrams = Diagrams(session.chart_classes)
+    files = resources.files("ttt_sm.web") / "static"
+
+    def page(name: str) -> Response:
+        return HTMLResponse((files / name).read_text(encoding="utf-8"),
+                            headers={"Cache-Control": "no-store", "X-Content-Type-Options": "nosniff",
+                                     "Referrer-Policy": "no-referrer"})
+
+    async def index(request: Request) -> Response:
+        return page("index.html")
+
+    async def charts(request: Request) -> Response:
+        return page("charts.html")
+
+    async def diagram(request: Request) -> Response:
+        chart = request.path_params["chart"]
+        key = request.query_params.get("view", "overview")
+        opened = tuple(x for x in request.query_params.get("open", "").split(",") if x)
+        try:
+            svg = await asyncio.to_thread(diagrams.svg, chart, key, opened)
+        except DiagramError as exc:
+            return PlainTextResponse(f"{exc}\n", status_code=404)
+        except GraphvizMissingError as exc:
+            return PlainTextResponse(f"{exc}\n", status_code=503)
+        return Response(svg, media_type="image/svg+xml", headers={"Cache-Control": "no-store"})
+
+    async def trace(request: Request) -> Response:
+        records = list(session.debugger.trace.records)
+        body = "".join(r.to_json() + "\n" for r in records)
+        return Response(body, media_type="application/x-ndjson",
+                        headers={"Content-Disposition": 'attachment; filename="trace.jsonl"'})
+
+    async def ws(websocket: WebSocket) -> None:
+        host = websocket.headers.get("host", "")
+        if not origin_ok(websocket.headers.get("origin"), host):
+            await websocket.close(code=1008, reason="the Origin is not this server")
+            return
+        await websocket.accept()
+        loop = asyncio.get_running_loop()
+        outbox: asyncio.Queue[str | None] = asyncio.Queue(maxsize=CLIENT_QUEUE)
+        lagging = False
+
+        def put(text: str) -> None:
+            nonlocal lagging
+            try:
+                outbox.put_nowait(text)
+            except asyncio.QueueFull:
+                lagging = True
+
+        def send_threadsafe(text: str) -> None:
+            loop.call_soon_threadsafe(put, text)
+
+        cid = session.connect(send_threadsafe)
+
+        async def pump() -> None:
+            nonlocal lagging
+            while True:
+                text = await outbox.get()
+                if text is None:
+                    return
+                await websocket.send_text(text)
+                if lagging and outbox.empty():
+                    lagging = False  # dropped frames: join again for a full frame
+                    session.submit(cid, parse_command('{"type": "hello"}'))
+
+        sender = asyncio.create_task(pump())
+        try:
+            while True:
+                message = await websocket.receive()
+                if message["type"] == "websocket.disconnect":
+                    break
+                raw = message.get("text")
+                if raw is None:
+                    raw = message.get("bytes") or b""
+                try:
+                    command = parse_command(raw)
+                except ProtocolError as exc:
+                    session.reply_error(cid, str(exc))
+                    continue
+                session.submit(cid, command)
+        except WebSocketDisconnect:
+            pass
+        finally:
+            session.disconnect(cid)
+            with contextlib.suppress(asyncio.QueueFull):
+                outbox.put_nowait(None)
+            sender.cancel()
+            with contextlib.suppress(asyncio.CancelledError, Exception):
+                await sender
+
+    @contextlib.asynccontextmanager
+    async def lifespan(app: Starlette) -> AsyncIterator[None]:
+        if manage_session:
+            session.start()
+        try:
+            yield
+        finally:
+            if manage_session:
+                saved = await asyncio.to_thread(session.stop)
+                if saved is not None:
+                    print(f"ttt-sm gui: trace saved to {saved} ({len(session.debugger.trace.records)}"
+                          " transitions)", flush=True)
+
+    routes = [
+        Route("/", index),
+        Route("/charts", charts),
+        Route("/api/diagram/{chart}", diagram),
+        Route("/api/trace.jsonl", trace),
+        WebSocketRoute("/ws", ws),
+        Mount("/static", app=StaticFiles(directory=static_dir()), name="static"),
+    ]
+    app = Starlette(routes=routes, lifespan=lifespan)
+    app.add_middleware(Guard, token=token, hosts=list(hosts))
+    app.state.session = session
+    app.state.max_message_bytes = MAX_MESSAGE_BYTES
+    return app

@@ -1,0 +1,67 @@
+"""A live cockpit for the browser tests: a Session served by uvicorn on a free loopback port.
+
+``cockpit`` is module-scoped: building the robot costs a second or more, and each
+test module's tests share one session (they say what state they need: a
+replay to power-on, a paused run, ...).
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+import uvicorn
+
+from ttt_sm.debug.debugger import Debugger
+from ttt_sm.params import load_params
+from ttt_sm.web.coverage import scenario_dir_files
+from ttt_sm.web.server import create_app
+from ttt_sm.web.session import Session
+
+SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
+
+
+@dataclass
+class Cockpit:
+    url: str
+    session: Session
+    server: uvicorn.Server
+
+    def page_url(self, path: str = "/charts") -> str:
+        return self.url + path
+
+
+def serve(session: Session, token: str | None = None) -> tuple[uvicorn.Server, threading.Thread, str]:
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    sock.bind(("127.0.0.1", 0))
+    port = sock.getsockname()[1]
+    hosts = [f"127.0.0.1:{port}", f"localhost:{port}"]
+    app = create_app(session, token=token, hosts=hosts)
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 30
+    while not server.started:
+        if time.monotonic() > deadline or not thread.is_alive():
+            raise RuntimeError("the cockpit's server did not start")
+        time.sleep(0.02)
+    return server, thread, f"http://127.0.0.1:{port}"
+
+
+@pytest.fixture(scope="module")
+def cockpit(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cockpit]:
+    """A paused session at power-on, as fast as it goes when run, served on 127.0.0.1."""
+    dbg = Debugger.build(load_params(), seed=0)
+    trace = tmp_path_factory.mktemp("cockpit") / "trace.jsonl"
+    session = Session(dbg, speed=None, running=False, scenarios=scenario_dir_files(SCENARIOS), trace_path=trace)
+    server, thread, url = serve(session)
+    try:
+        yield Cockpit(url, session, server)
+    finally:
+        server.should_exit = True
+        thread.join(30)

@@ -1,0 +1,172 @@
+"""The chart cockpit in a real browser (Debian's Chromium through Playwright): what a person sees.
+
+One session for the module (``cockpit``, as fast as it goes when run); each test
+drives it through the page, as a student would, and compares what the page
+shows with a debugger of its own run to the same point (same seed).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import pytest
+
+from ttt_sm.debug.debugger import Debugger
+from ttt_sm.debug.views import fmt_value
+from ttt_sm.params import load_params
+from ttt_sm.scenario.loader import load_scenario
+from ttt_sm.scenario.suite import coverage_dict, run_scenarios
+
+from .conftest import SCENARIOS, Cockpit
+
+TIMEOUT_MS = 60_000
+
+
+def open_cockpit(page: Any, cockpit: Cockpit) -> None:
+    page.set_default_timeout(TIMEOUT_MS)
+    page.goto(cockpit.page_url("/charts"))
+    page.wait_for_selector("[data-state]")
+    page.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'")
+
+
+def show(page: Any, chart: str) -> None:
+    """Show a chart's whole picture (every state drawn)."""
+    page.get_by_role("button", name=f"chart {chart}:").click()
+    whole = page.locator('[data-role="view-bar"]').get_by_role("button", name="every sub-chart open, nested")
+    if whole.count():
+        whole.click()
+    page.wait_for_function("(() => { const d = document.querySelector('[data-role=diagram]');"
+                           f" return d.dataset.chart === '{chart}' && d.dataset.view === 'whole'"
+                           " && !d.dataset.loading; })()")
+
+
+def shown_tick(page: Any) -> int:
+    return int(page.locator('[data-role="tick"]').text_content())
+
+
+def go_to_tick(page: Any, tick: int) -> None:
+    """Replay to a chart tick with the time slider."""
+    page.locator('[data-role="slider"]').fill(str(tick))
+    page.wait_for_function(f"document.querySelector('[data-role=tick]').textContent === '{tick}'"
+                           " && document.querySelector('[data-role=mode]').textContent === 'paused'")
+
+
+def active_shown(page: Any) -> set[str]:
+    return set(page.eval_on_selector_all('[data-role="diagram"] [data-state][data-active="true"]',
+                                         "els => els.map(e => e.dataset.stateId)"))
+
+
+def test_the_index_links_every_page_and_controls_have_names(page: Any, cockpit: Cockpit) -> None:
+    page.goto(cockpit.page_url("/"))
+    assert page.get_by_role("link", name="Charts").get_attribute("href") == "/charts"
+    open_cockpit(page, cockpit)
+    for name in ("Run", "Pause", "Step", "Tick", "Next"):
+        assert page.get_by_role("button", name=name, exact=True).is_visible()
+    assert page.get_by_role("combobox", name="Speed").is_visible()
+    assert page.get_by_role("slider", name="Time slider").is_visible()
+    float(page.locator('[data-role="sim-time"]').text_content())
+
+
+def test_the_highlighted_states_are_the_robots_configuration_at_the_paused_tick(
+        page: Any, cockpit: Cockpit) -> None:
+    open_cockpit(page, cockpit)
+    go_to_tick(page, 0)
+    page.get_by_label("Breakpoint spec").fill("when DriveInit1.pos_Encoder > 90deg")
+    page.get_by_role("button", name="Add", exact=True).click()
+    page.get_by_role("button", name="Run", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
+    tick = shown_tick(page)
+    where = cockpit.session.call(lambda d: (d.robot.chart_ticks, d.where()))
+    assert tick == where[0] > 0
+    for chart, states in where[1].items():
+        show(page, chart)
+        assert active_shown(page) == set(states), chart
+    cockpit.session.call(lambda d: d.delete())
+
+
+def test_a_click_breakpoint_stops_the_run_at_the_tick_the_state_is_entered(page: Any, cockpit: Cockpit) -> None:
+    ref = Debugger.build(load_params(), seed=0)
+    ref.add_breakpoint("enter DriveInit1.turn_back")
+    expected = ref.run(30).chart_ticks
+    open_cockpit(page, cockpit)
+    go_to_tick(page, 0)
+    show(page, "DriveInit1")
+    page.locator('[data-state="DriveInit1.run.initialise.turn_back"]').click()
+    page.get_by_role("menuitem", name="Break on entering DriveInit1.run.initialise.turn_back").click()
+    page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
+    page.get_by_role("button", name="Run", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
+    assert shown_tick(page) == expected
+    assert page.locator('[data-state="DriveInit1.run.initialise.turn_back"]').get_attribute("data-active") == "true"
+    edge = page.locator('[data-transition~="DriveInit1.turn_fwd->turn_back"]').first
+    assert int(edge.get_attribute("data-taken-count")) == 1
+    cockpit.session.call(lambda d: d.delete())
+
+
+def test_step_and_tick_advance_by_one(page: Any, cockpit: Cockpit) -> None:
+    open_cockpit(page, cockpit)
+    go_to_tick(page, 10)
+    t0 = float(page.locator('[data-role="sim-time"]').text_content())
+    page.get_by_role("button", name="Step", exact=True).click()
+    page.wait_for_function(f"parseFloat(document.querySelector('[data-role=sim-time]').textContent) > {t0}")
+    assert float(page.locator('[data-role="sim-time"]').text_content()) == pytest.approx(t0 + 0.001)
+    tick = shown_tick(page)
+    page.get_by_role("button", name="Tick", exact=True).click()
+    page.wait_for_function(f"document.querySelector('[data-role=tick]').textContent === '{tick + 1}'")
+    assert shown_tick(page) == tick + 1
+
+
+def test_the_slider_replays_to_the_tick_asked_for_and_shows_its_data(page: Any, cockpit: Cockpit) -> None:
+    open_cockpit(page, cockpit)
+    cockpit.session.call(lambda d: d.furthest_tick >= 1000 or d.run(3.0))
+    ref = Debugger.build(load_params(), seed=0)
+    ref.step(ref.steps_of_tick(700))
+    expected = fmt_value(ref.robot.charts["DriveInit1"].pos_out, "rad")
+    show(page, "DriveInit1")
+    go_to_tick(page, 700)
+    row = page.locator('[data-role="watch"] tr[data-datum="DriveInit1.pos_out"] [data-role="value"]')
+    page.wait_for_function("document.querySelector('[data-datum=\"DriveInit1.pos_out\"] [data-role=value]')"
+                           f".textContent === {json.dumps(expected)}")
+    assert row.text_content() == expected
+    assert active_shown(page) == set(ref.where()["DriveInit1"])
+    assert "chart tick 700" in page.locator('[data-role="status"]').text_content()
+
+
+def test_coverage_colours_equal_the_report(page: Any, cockpit: Cockpit, tmp_path: Any) -> None:
+    name = "drive_1_turns_back_at_a_hard_stop.yaml"
+    report = run_scenarios([load_scenario(SCENARIOS / name)], load_params(), coverage=True)
+    assert report.coverage is not None
+    expected = coverage_dict(report.coverage)["DriveInit1"]
+    open_cockpit(page, cockpit)
+    show(page, "DriveInit1")
+
+    def colours() -> tuple[set[str], set[str]]:
+        entered = set(page.eval_on_selector_all('[data-role="diagram"] [data-state][data-coverage="entered"]',
+                                                "els => els.map(e => e.dataset.stateId)"))
+        never = set(page.eval_on_selector_all('[data-role="diagram"] [data-state][data-coverage="never"]',
+                                              "els => els.map(e => e.dataset.stateId)"))
+        return entered, never
+
+    # Run from the page
+    page.get_by_label("Scenario files").select_option(name)
+    page.get_by_role("button", name="Run scenarios").click()
+    page.wait_for_function("document.querySelector('[data-role=coverage-summary]').textContent.includes('passed')",
+                           timeout=120_000)
+    entered, never = colours()
+    assert entered == set(expected["entered"])
+    assert never == set(expected["missing_states"])
+    edges = page.eval_on_selector_all('[data-role="diagram"] [data-index]',
+                                      "els => els.map(e => [e.dataset.index, e.dataset.coverage])")
+    labels = {t.label: t.index for t in cockpit.session.chart_classes["DriveInit1"].structure().transitions}
+    taken = {labels[x] for x in expected["taken"]}
+    assert edges and all(
+        colour == ("taken" if any(int(i) in taken for i in index.split()) else "never") for index, colour in edges)
+    # Load the same report, as `ttt-sm scenario run --coverage --json` writes it
+    page.get_by_role("button", name="Clear coverage").click()
+    page.wait_for_function("document.querySelector('[data-role=diagram]').dataset.coverage === 'off'")
+    path = tmp_path / "coverage.json"
+    path.write_text(json.dumps(report.to_dict()))
+    page.get_by_label("Coverage report").set_input_files(str(path))
+    page.wait_for_function("document.querySelector('[data-role=diagram]').dataset.coverage === 'on'")
+    assert colours() == (entered, never)

@@ -169,6 +169,15 @@ def bench_game(params: ArmParams, seed: int = 0, games: int = 3) -> dict[str, An
     }
 
 
+def bench_gui_section(params: ArmParams, seed: int = 0, quick: bool = False, soak_min: float = 0.0) -> dict[str, Any]:
+    """The browser cockpit in Chromium: frame latency at x1, speed with a page attached, frame size
+    (see ttt_sm/web/bench.py); ``soak_min`` adds the memory after 1 and after that many minutes at x10."""
+    from .web.bench import bench_gui
+
+    return bench_gui(params, seed=seed, x1_s=10.0 if quick else 60.0, max_s=3.0 if quick else 15.0,
+                     soak_min=soak_min)
+
+
 SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "steps": lambda p, a: bench_steps(p, a["out"]),
     "ik": lambda p, a: bench_ik_section(p, a["seed"]),
@@ -180,11 +189,13 @@ SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "vision": lambda p, a: bench_vision_section(p, a["seed"]),
     "ai": lambda p, a: bench_ai_section(p, a["seed"]),
     "game": lambda p, a: bench_game(p, a["seed"], a["games"]),
+    "gui": lambda p, a: bench_gui_section(p, a["seed"], a["quick"], a["gui_soak_min"]),
 }
 
 
 def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, quick: bool = False,
-              out: Path = Path("out/bench"), progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+              out: Path = Path("out/bench"), progress: Callable[[str], None] | None = None,
+              gui_soak_min: float = 0.0) -> dict[str, Any]:
     """Run the chosen sections (all by default) and return one flat result dict.
 
     `quick` shortens the timed runs (for tests of the command, not for the
@@ -196,7 +207,7 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
         raise ValueError(f"unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
     args = {"seed": seed, "out": out, "loop_seconds": 2.0 if quick else 20.0,
             "pacing_seconds": 1.0 if quick else 10.0, "init_starts": 5 if quick else 200,
-            "games": 1 if quick else 3}
+            "games": 1 if quick else 3, "quick": quick, "gui_soak_min": gui_soak_min}
     result: dict[str, Any] = {
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
                     "numba_jit": os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"},
@@ -206,6 +217,10 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
         if progress:
             progress(f"bench: {name} ...")
         result.update(SECTIONS[name](params, args))
+    if "gui_realtime_factor_max" in result and "game_motion_realtime_factor" in result:
+        # the issue's target: as fast as it goes with a page attached, against the same run's motion
+        result["gui_realtime_ratio_to_motion"] = round(
+            result["gui_realtime_factor_max"] / result["game_motion_realtime_factor"], 2)
     return result
 
 

@@ -285,7 +285,7 @@ def test_the_trace_is_saved_when_the_session_stops(tmp_path) -> None:
 
 def refused(client: TestClient, path: str, headers: dict[str, str] | None = None) -> int:
     """The close code of a WebSocket the server refuses before accepting it."""
-    with pytest.raises(WebSocketDisconnect) as err, client.websocket_connect(path, headers=headers) as ws:
+    with pytest.raises(WebSocketDisconnect) as err, client.websocket_connect(path, headers=headers or {}) as ws:
         ws.receive_text()
     return err.value.code
 
@@ -323,3 +323,18 @@ def test_diagrams_are_served_annotated_and_unknown_ones_are_404(client: TestClie
     assert client.get("/api/diagram/Nothing").status_code == 404
     assert "no sub-chart 'Nope'" in client.get("/api/diagram/Control?open=Nope").text
     assert client.get("/api/diagram/DriveInit2?view=overview").status_code == 200  # its one picture
+
+
+def test_the_timeline_of_a_chart_is_the_debuggers(client: TestClient, session: Session) -> None:
+    with client.websocket_connect("/ws") as ws:
+        page = Page(ws)
+        page.join()
+        page.answer(page.send(type="step", n=4000))
+        page.send(type="timeline", chart="DriveInit1", seconds=20)
+        while (m := ws.receive_json())["type"] != "timeline":
+            pass
+    window = session.call(lambda d: d.timeline("DriveInit1", 20))
+    shown = {(row["state"], a, b) for row in m["rows"] for a, b in row["intervals"]}
+    assert shown == {(iv.state, max(iv.entered, window.first), iv.left) for iv in window.intervals}
+    assert ("turn_fwd", 1, None) in shown or any(s == "turn_back" for s, _, _ in shown)
+    assert next(r for r in m["rows"] if r["state"] == "run")["qname"] == "DriveInit1.run"

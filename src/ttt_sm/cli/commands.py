@@ -107,8 +107,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
     params = load_arm(args.params)
     only = [s.strip() for s in args.only.split(",")] if args.only else None
     try:
+        if args.gui_soak is not None and not args.gui_soak > 0:
+            raise ValueError(f"--gui-soak: expected a positive number of minutes, got {args.gui_soak}")
         result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
-                           progress=progress(True))
+                           progress=progress(True), gui_soak_min=args.gui_soak or 0.0)
     except ValueError as exc:
         raise CliError(str(exc)) from exc
     emit(result, args.json)
@@ -212,8 +214,10 @@ def register(sub: Any) -> None:
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
     sp = add_command(sub, "bench", cmd_bench, "measure the speed and quality targets")
     sp.add_argument("--only", default=None,
-                    help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game")
+                    help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
+    sp.add_argument("--gui-soak", metavar="MIN", type=float, default=None,
+                    help="gui section: also run MIN minutes at x10 and report the memory after 1 and after MIN")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
     sp = add_command(sub, "ik", cmd_ik, "solve inverse kinematics for one tool pose")
     sp.add_argument("x", type=float, help="mm")

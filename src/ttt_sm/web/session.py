@@ -439,8 +439,19 @@ class Session:
         self._resync = True
         return {"text": result.describe(), "identical": result.identical}
 
-    def _cmd_timeline(self, cid: int, chart: str, seconds: float) -> dict[str, Any]:
-        raise DebugError("timeline: not available in this version")
+    def _cmd_timeline(self, cid: int, chart: str, seconds: float) -> None:
+        window = self.debugger.timeline(chart, seconds)
+        qnames = {s["id"]: s["qname"] for c in self.info["charts"] if c["name"] == chart for s in c["states"]}
+        rows: dict[str, list[tuple[int, int | None]]] = {}
+        for state in self.debugger.state_history.states(chart):
+            rows[state] = []
+        for iv in window.intervals:
+            rows.setdefault(iv.state, []).append((max(iv.entered, window.first), iv.left))
+        self._send_to(cid, {"type": "timeline", "chart": chart, "first": window.first, "last": window.last,
+                            "period_s": window.period_s, "dropped": window.dropped,
+                            "rows": [{"state": st, "qname": qnames.get(st, st), "intervals": ivs}
+                                     for st, ivs in rows.items() if ivs]})
+        return None
 
     def _coverage_job(self, cid: int, cmd: str, job: Callable[[], dict[str, Any]]) -> dict[str, Any]:
         if self._coverage_busy:

@@ -586,8 +586,10 @@ role("slider").addEventListener("change", () => {
 });
 
 function drawTimeline(m) {
+  if (m.chart !== S.chart) return;
   const box = role("timeline");
-  role("timeline-chart").textContent = m.chart ? `of ${m.chart}` : "";
+  const secs = ((m.last - m.first) * m.period_s).toFixed(1);
+  role("timeline-chart").textContent = `of ${m.chart}: the last ${secs} s (chart ticks ${m.first} to ${m.last})`;
   box.replaceChildren();
   if (!m.rows) return;
   const span = Math.max(1, m.last - m.first);
@@ -698,5 +700,12 @@ role("speed").addEventListener("change", (e) => {
   const v = e.target.value;
   link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });
 });
+
+// The timeline of the shown chart: asked for once a second while the page is open.
+setInterval(() => {
+  if (S.chart && S.joined && document.visibilityState === "visible") {
+    link.send({ type: "timeline", chart: S.chart, seconds: 20 });
+  }
+}, 1000);
 
 link.connect();

@@ -1,0 +1,162 @@
+"""The cockpit measured in a real browser: frame latency, speed with a page attached, frame size, memory.
+
+``ttt-sm bench --only gui`` serves a session on a loopback port, opens the
+Charts page in Debian's Chromium (Playwright, ``executable_path``; the same
+flags as the browser tests) and measures:
+
+- ``gui_frame_latency_ms_p95``: from a transition in the simulation (stamped by
+  the session's listener when the chart takes it) to the page having set its
+  highlight: the page acknowledges each frame with transitions from a
+  ``requestAnimationFrame`` callback, and the session takes the time the
+  acknowledgement arrives (one clock, the server's; the way back is included),
+  at x1 while the drives initialise and the field is drawn;
+- ``gui_drift_ms_per_min``: simulated time against wall time at x1 over that run;
+- ``gui_realtime_factor_max``: simulated over wall time, as fast as it goes,
+  with the page attached and drawing;
+- ``gui_frame_bytes_median``: the frames the page received;
+- with ``soak_min`` (``ttt-sm bench --only gui --gui-soak MIN``): the server's
+  resident memory after 1 minute and after ``soak_min`` minutes at x10.
+
+Playwright is a test dependency: without it (or without Chromium) the section
+says what to install instead of measuring.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import statistics
+import threading
+import time
+from typing import Any
+
+from ..debug.debugger import Debugger
+from ..params import ArmParams
+from .server import create_app
+from .session import Session
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_FLAGS = ("--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--disable-background-networking",
+                  "--disable-component-update", "--disable-sync", "--disable-quic", "--no-first-run")
+
+
+def rss_mb() -> float:
+    """This process's resident memory, MB (Linux)."""
+    with open("/proc/self/statm", encoding="ascii") as f:
+        pages = int(f.read().split()[1])
+    return pages * os.sysconf("SC_PAGE_SIZE") / 1e6
+
+
+def _serve(session: Session) -> tuple[Any, threading.Thread, str]:
+    import uvicorn
+
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    sock.bind(("127.0.0.1", 0))
+    port = sock.getsockname()[1]
+    app = create_app(session, hosts=[f"127.0.0.1:{port}"])
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 60
+    while not server.started:
+        if time.monotonic() > deadline:
+            raise RuntimeError("the cockpit's server did not start")
+        time.sleep(0.02)
+    return server, thread, f"http://127.0.0.1:{port}"
+
+
+def bench_gui(params: ArmParams, seed: int = 0, x1_s: float = 60.0, max_s: float = 15.0,
+              soak_min: float = 0.0) -> dict[str, Any]:
+    """Measure the cockpit in Chromium (see the module's docstring)."""
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        return {"gui_skipped": "Playwright is not installed: pip install -e '.[test]'"}
+    executable = os.environ.get("TTT_SM_CHROMIUM") or (CHROMIUM if os.access(CHROMIUM, os.X_OK)
+                                                       else shutil.which("chromium"))
+    if not executable:
+        return {"gui_skipped": "Chromium is not installed: sh scripts/setup.sh (Debian's chromium)"}
+    dbg = Debugger.build(params, seed=seed)
+    dbg.run(0.01)  # the numba-compiled loop warmed up, not timed
+    session = Session(dbg, speed=1.0, running=False)
+    server, thread, url = _serve(session)
+    sizes: list[int] = []
+    out: dict[str, Any] = {}
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=executable, args=list(CHROMIUM_FLAGS))
+            page = browser.new_page(viewport={"width": 1600, "height": 1000})
+
+            def on_frame(payload: str | bytes) -> None:
+                text = payload if isinstance(payload, str) else payload.decode("utf-8", "replace")
+                if text.startswith('{"type": "frame"'):
+                    sizes.append(len(text.encode("utf-8")))
+
+            def on_ws(ws: Any) -> None:
+                ws.on("framereceived", on_frame)
+
+            page.on("websocket", on_ws)
+            page.goto(url + "/charts")
+            page.wait_for_selector("[data-state]", timeout=60_000)
+            page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'paused'")
+
+            # x1: real time while the drives initialise and the Control chart starts drawing
+            t0 = session.call(lambda d: d.robot.t)
+            wall0 = time.perf_counter()
+            page.get_by_role("button", name="Run", exact=True).click()
+            time.sleep(x1_s)
+            page.get_by_role("button", name="Pause", exact=True).click()
+            page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'paused'")
+            stats = session.clock.stats()
+            t1 = session.call(lambda d: d.robot.t)
+            wall1 = time.perf_counter()
+            latency = sorted(session.latency_ms())
+            run_wall = wall1 - wall0
+            out.update({
+                "gui_x1_seconds": round(run_wall, 1),
+                "gui_frame_latency_ms_p95": round(latency[int(0.95 * (len(latency) - 1))], 1) if latency else None,
+                "gui_frame_latency_ms_median": round(statistics.median(latency), 1) if latency else None,
+                "gui_frame_latency_samples": len(latency),
+                # the run started and paused by the page: the clicks' own delays are part of the difference
+                "gui_drift_ms_per_min": round(((t1 - t0) - run_wall) * 1e3 * 60.0 / run_wall, 1),
+                "gui_pace_lag_max_ms": round(stats.lag_max_s * 1e3, 2),
+                "gui_pace_overruns": stats.overruns,
+                "gui_pace_slips": stats.slips,
+            })
+
+            # as fast as it goes, with the page attached
+            session.submit(0, _command("speed", value=None))
+            t0 = session.call(lambda d: d.robot.t)
+            wall0 = time.perf_counter()
+            page.get_by_role("button", name="Run", exact=True).click()
+            time.sleep(max_s)
+            t1 = session.call(lambda d: d.robot.t)
+            wall1 = time.perf_counter()
+            out["gui_realtime_factor_max"] = round((t1 - t0) / (wall1 - wall0), 1)
+            page.get_by_role("button", name="Pause", exact=True).click()
+
+            out["gui_frame_bytes_median"] = int(statistics.median(sizes)) if sizes else None
+            out["gui_frames_received"] = len(sizes)
+
+            if soak_min > 0:
+                session.submit(0, _command("speed", value=10.0))
+                page.get_by_role("button", name="Run", exact=True).click()
+                time.sleep(60.0)
+                out["gui_rss_mb_1min"] = round(rss_mb(), 1)
+                time.sleep(max(0.0, soak_min * 60.0 - 60.0))
+                out["gui_rss_mb_end"] = round(rss_mb(), 1)
+                out["gui_soak_minutes"] = soak_min
+                out["gui_soak_sim_s"] = round(session.call(lambda d: d.robot.t), 1)
+                page.get_by_role("button", name="Pause", exact=True).click()
+            browser.close()
+    finally:
+        server.should_exit = True
+        thread.join(30)
+    return out
+
+
+def _command(kind: str, **args: Any) -> Any:
+    from .protocol import Command
+
+    return Command(kind, args)

@@ -16,7 +16,7 @@ import webbrowser
 from pathlib import Path
 from typing import Any
 
-from .common import CliError
+from .common import CliError, seed
 
 DEFAULT_PORT = 8765
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
@@ -30,7 +30,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
     sp.add_argument("--host", default="127.0.0.1",
                     help="address to listen on (default 127.0.0.1; any other needs the printed token)")
     sp.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default {DEFAULT_PORT}; 0: any free one)")
-    sp.add_argument("--seed", type=int, default=0, help="seed of the simulated arm (default 0)")
+    sp.add_argument("--seed", type=seed, default=0, help="seed of the simulated arm (default 0)")
+    sp.add_argument("--game", action="store_true",
+                    help="a whole game: the Game and AlgorithmActivator charts too, a simulated person plays X")
     sp.add_argument("--speed", default="1",
                     help="times real time, 0.1 to 10, or 'max' for as fast as it goes (default 1)")
     sp.add_argument("--paused", action="store_true", help="start paused at power-on")
@@ -93,7 +95,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
         raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
     port = sock.getsockname()[1]
     print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
-    dbg = Debugger.build(params, seed=args.seed)
+    dbg = Debugger.build(params, seed=args.seed, game=args.game)
     session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
                       trace_path=Path(args.trace))
     shown = f"[{args.host}]" if ":" in args.host else args.host
@@ -109,5 +111,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
         threading.Timer(1.0, webbrowser.open, args=(url,)).start()
     config = uvicorn.Config(app, log_level="warning", ws_max_size=1 << 20, lifespan="on")
     server = uvicorn.Server(config)
-    server.run(sockets=[sock])
+    try:
+        server.run(sockets=[sock])
+    except KeyboardInterrupt:
+        pass  # uvicorn shut down (the session stopped, the trace saved), then passed the Ctrl-C on
+    print("ttt-sm gui: stopped", flush=True)
     return 0

@@ -1,0 +1,54 @@
+"""``ttt-sm gui`` as a person starts it: the printed address serves the pages, Ctrl-C stops it and saves the trace."""
+
+from __future__ import annotations
+
+import re
+import signal
+import subprocess
+import sys
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+from ttt_sm.cli.gui import needs_token
+
+
+def test_gui_serves_the_printed_address_and_ctrl_c_saves_the_trace(tmp_path: Path) -> None:
+    trace = tmp_path / "trace.jsonl"
+    proc = subprocess.Popen([sys.executable, "-m", "ttt_sm.cli", "gui", "--port", "0", "--speed", "max",
+                             "--trace", str(trace)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        url = None
+        for _ in range(10):
+            line = proc.stdout.readline()
+            found = re.search(r"(http://127\.0\.0\.1:\d+/charts)", line)
+            if found:
+                url = found.group(1)
+                break
+        assert url is not None, "no address printed"
+        for _ in range(600):  # the server starts after the robot is built
+            try:
+                page = urllib.request.urlopen(url, timeout=5).read().decode()
+                break
+            except OSError:
+                import time
+                time.sleep(0.1)
+        assert 'data-role="sim-time"' in page
+        index = urllib.request.urlopen(url.replace("/charts", "/"), timeout=5).read().decode()
+        assert 'href="/charts"' in index
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 0, err
+    assert f"trace saved to {trace}" in out
+    assert trace.is_file()
+
+
+@pytest.mark.parametrize("host, token", [("127.0.0.1", False), ("localhost", False), ("::1", False),
+                                         ("0.0.0.0", True), ("192.168.1.5", True), ("robot.lab", True)])
+def test_every_host_but_loopback_needs_the_token(host: str, token: bool) -> None:
+    assert needs_token(host) is token

@@ -32,8 +32,8 @@ def open_cockpit(page: Any, cockpit: Cockpit) -> None:
 
 def show(page: Any, chart: str) -> None:
     """Show a chart's whole picture (every state drawn)."""
-    page.get_by_role("button", name=f"chart {chart}:").click()
-    whole = page.locator('[data-role="view-bar"]').get_by_role("button", name="every sub-chart open, nested")
+    page.locator('[data-role="chart-tabs"]').get_by_role("button", name=chart, exact=True).click()
+    whole = page.locator('[data-role="view-bar"]').get_by_role("button", name="Whole chart")
     if whole.count():
         whole.click()
     page.wait_for_function("(() => { const d = document.querySelector('[data-role=diagram]');"

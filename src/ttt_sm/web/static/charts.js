@@ -67,7 +67,8 @@ function onSession(info) {
   const tabs = role("chart-tabs");
   tabs.replaceChildren();
   for (const c of info.charts) {
-    const b = button(c.name, () => showChart(c.name), `chart ${c.name}: ${c.doc}`);
+    const b = button(c.name, () => showChart(c.name));
+    b.title = `${c.name}: ${c.doc}`;
     b.dataset.chart = c.name;
     tabs.append(b);
   }
@@ -133,6 +134,7 @@ function onFrame(f) {
 function onCoverage(m) {
   S.coverage = m.cleared ? null : m;
   drawCoverage();
+  say(m.cleared ? "coverage cleared" : `coverage shown: ${role("coverage-summary").textContent}`);
 }
 
 function onTimeline(m) {
@@ -201,7 +203,8 @@ function drawViewBar() {
   const bar = role("view-bar");
   bar.replaceChildren();
   if (!chart.subcharts.length) { bar.append(fitButton()); return; }
-  const overview = button("Overview", () => setView("overview", []), "all sub-charts closed");
+  const overview = button("Overview", () => setView("overview", []));
+  overview.title = "all sub-charts closed";
   overview.setAttribute("aria-pressed", String(S.view === "overview" && !S.opened.length));
   bar.append(overview);
   for (const sub of chart.subcharts) {
@@ -219,7 +222,8 @@ function drawViewBar() {
     group.append(inPlace, alone);
     bar.append(group);
   }
-  const whole = button("Whole chart", () => setView("whole", []), "every sub-chart open, nested");
+  const whole = button("Whole chart", () => setView("whole", []));
+  whole.title = "every sub-chart open, nested";
   whole.setAttribute("aria-pressed", String(S.view === "whole"));
   bar.append(whole);
   bar.append(fitButton());

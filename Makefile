@@ -3,7 +3,7 @@
 PY := .venv/bin/python
 TTT := .venv/bin/ttt-sm
 
-.PHONY: setup play test gui soak fuzz lint bench tune clean
+.PHONY: setup play test gui screenshots soak fuzz lint bench tune clean
 
 setup:
 	@sh scripts/setup.sh
@@ -16,6 +16,10 @@ test: setup
 
 gui: setup
 	$(TTT) gui --open
+
+# The pictures of docs/gui.md, taken in Chromium from a live cockpit.
+screenshots: setup
+	TTT_SM_SCREENSHOTS=docs/img $(PY) -m pytest -q tests/web/test_gui_screenshots.py
 
 soak: setup
 	$(PY) -m pytest -q -m soak; rc=$$?; [ $$rc -eq 5 ] && echo "no soak tests" || exit $$rc

@@ -25,9 +25,15 @@ def folder(tmp_path: Path) -> Path:
     return Path(wanted) if wanted else tmp_path
 
 
-def wait_ready(page: Any) -> None:
+def wait_ready(page: Any, top: str | None = None) -> None:
+    """Wait for the diagram; scroll the side bar up and the diagram to its top, or to state ``top``."""
     page.wait_for_function("!document.querySelector('[data-role=diagram]').dataset.loading")
-    page.evaluate("document.querySelector('.side').scrollTop = 0")
+    page.evaluate("document.querySelector('.side').scrollTop = 0;"
+                  " document.querySelector('[data-role=diagram]').scrollTop = 0")
+    if top is not None:  # past the legend, to the states a picture is about
+        page.evaluate("(top) => { const d = document.querySelector('[data-role=diagram]');"
+                      " const s = d.querySelector(`[data-state=\"${top}\"]`);"
+                      " d.scrollTop = s.getBoundingClientRect().top - d.getBoundingClientRect().top - 8; }", top)
     page.wait_for_timeout(300)
 
 
@@ -53,6 +59,7 @@ def test_the_screenshots_of_the_guide(browser: Any, cockpit: Cockpit, folder: Pa
         # 3. A click on a state: its breakpoints
         go_to_tick(page, 0)
         show(page, "DriveInit1")
+        wait_ready(page, top="DriveInit1.run")
         page.locator('[data-state="DriveInit1.run.initialise.turn_back"]').click()
         page.wait_for_selector('[data-role="menu"]:not([hidden])')
         page.screenshot(path=str(folder / SHOTS[2]))
@@ -63,7 +70,7 @@ def test_the_screenshots_of_the_guide(browser: Any, cockpit: Cockpit, folder: Pa
         page.get_by_role("button", name="Run scenarios").click()
         page.wait_for_function("document.querySelector('[data-role=coverage-summary]').textContent"
                                ".includes('passed')", timeout=120_000)
-        wait_ready(page)
+        wait_ready(page, top="DriveInit1.run")
         page.screenshot(path=str(folder / SHOTS[3]))
         page.get_by_role("button", name="Clear coverage").click()
     finally:

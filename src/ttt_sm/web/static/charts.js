@@ -189,6 +189,7 @@ function showChart(name) {
   loadDiagram();
   buildWatch();
   drawCoverageSummary();
+  askTimeline();
 }
 
 function setView(view, opened = []) {
@@ -705,11 +706,12 @@ role("speed").addEventListener("change", (e) => {
   link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });
 });
 
-// The timeline of the shown chart: asked for once a second while the page is open.
-setInterval(() => {
+// The timeline of the shown chart: asked for when a chart is shown and once a second while the page is open.
+function askTimeline() {
   if (S.chart && S.joined && document.visibilityState === "visible") {
     link.send({ type: "timeline", chart: S.chart, seconds: 20 });
   }
-}, 1000);
+}
+setInterval(askTimeline, 1000);
 
 link.connect();

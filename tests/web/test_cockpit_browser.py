@@ -170,3 +170,68 @@ def test_coverage_colours_equal_the_report(page: Any, cockpit: Cockpit, tmp_path
     page.get_by_label("Coverage report").set_input_files(str(path))
     page.wait_for_function("document.querySelector('[data-role=diagram]').dataset.coverage === 'on'")
     assert colours() == (entered, never)
+
+
+def test_a_click_on_a_transition_breaks_when_it_is_taken(page: Any, cockpit: Cockpit) -> None:
+    ref = Debugger.build(load_params(), seed=0)
+    ref.add_breakpoint("transition DriveInit1 turn_fwd->turn_back")
+    expected = ref.run(30).chart_ticks
+    open_cockpit(page, cockpit)
+    go_to_tick(page, 0)
+    show(page, "DriveInit1")
+    edge = page.locator('[data-role="diagram"] [data-transition~="DriveInit1.turn_fwd->turn_back"]').first
+    edge.locator("text").first.click()  # its label, as a person clicks it
+    page.get_by_role("menuitem", name="Break when DriveInit1.turn_fwd->turn_back is taken").click()
+    page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
+    page.get_by_role("button", name="Run", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
+    assert shown_tick(page) == expected
+    assert edge.get_attribute("data-taken-count") == "1"
+    cockpit.session.call(lambda d: d.delete())
+
+
+def test_an_event_posted_from_the_page_stops_at_its_event_breakpoint(page: Any, cockpit: Cockpit) -> None:
+    ref = Debugger.build(load_params(), seed=0)
+    ref.add_breakpoint("event Control.button")
+    ref.post("Control", "button", symbol=1.0)  # as `post Control button symbol=1` reads it
+    expected = ref.run(30)
+    assert expected.kind == "breakpoint"
+    open_cockpit(page, cockpit)
+    go_to_tick(page, 0)
+    show(page, "Control")
+    page.get_by_label("Event breakpoint").select_option("Control.button")
+    page.get_by_role("button", name="Add event breakpoint").click()
+    page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
+    page.get_by_label("Event to post").select_option("Control.button")
+    page.get_by_label("Event data").fill("symbol=1")
+    page.get_by_role("button", name="Post", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=actions]').textContent.includes('button')")
+    assert cockpit.session.call(lambda d: [a.describe() for a in d.actions]) == [a.describe() for a in ref.actions]
+    page.get_by_role("button", name="Run", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
+    assert shown_tick(page) == expected.chart_ticks
+    assert "Control.button" in page.locator('[data-role="status"]').text_content()
+    cockpit.session.call(lambda d: (d.delete(), d.replay(0)))
+
+
+def test_an_input_set_forced_and_released_from_the_watch(page: Any, cockpit: Cockpit) -> None:
+    open_cockpit(page, cockpit)
+    go_to_tick(page, 10)
+    show(page, "DriveInit1")
+    row = page.locator('[data-role="watch"] tr[data-datum="DriveInit1.stop"]')
+    row.get_by_label("value for DriveInit1.stop").fill("1")
+    row.get_by_role("button", name="Force DriveInit1.stop").click()
+    page.wait_for_function("document.querySelector('[data-datum=\"DriveInit1.stop\"]').dataset.forced === 'true'")
+    page.get_by_role("button", name="Tick", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-state=\"DriveInit1.stopped\"]').dataset.active === 'true'")
+    assert row.locator('[data-role="value"]').text_content() == "True"
+    assert cockpit.session.call(lambda d: d.where()["DriveInit1"]) == ["stopped"]
+    row.get_by_role("button", name="Release DriveInit1.stop").click()
+    page.wait_for_function("document.querySelector('[data-datum=\"DriveInit1.stop\"]').dataset.forced === 'false'")
+    row.get_by_label("value for DriveInit1.stop").fill("0")
+    row.get_by_role("button", name="Set DriveInit1.stop").click()
+    page.wait_for_function("document.querySelector('[data-role=actions]').textContent.includes('stop')")
+    page.get_by_role("button", name="Tick", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-state=\"DriveInit1.stopped\"]').dataset.active === 'false'")
+    assert "stopped" not in cockpit.session.call(lambda d: d.where()["DriveInit1"])
+    cockpit.session.call(lambda d: d.replay(0))

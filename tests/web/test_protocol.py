@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import random
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -338,3 +339,47 @@ def test_the_timeline_of_a_chart_is_the_debuggers(client: TestClient, session: S
     assert shown == {(iv.state, max(iv.entered, window.first), iv.left) for iv in window.intervals}
     assert ("turn_fwd", 1, None) in shown or any(s == "turn_back" for s, _, _ in shown)
     assert next(r for r in m["rows"] if r["state"] == "run")["qname"] == "DriveInit1.run"
+
+
+# -- frames: throttled, never one per tick --------------------------------------------------------------
+
+
+class _TimedSession(Session):
+    """A Session that notes when each frame is published (its one place that sends frames)."""
+
+    published: list[float]
+
+    def _publish(self) -> None:
+        self.published.append(time.perf_counter())
+        super()._publish()
+
+
+def test_frames_are_throttled_and_carry_every_transition_since_the_last() -> None:
+    session = _TimedSession(Debugger.build(load_params(), seed=0), speed=None, running=False)
+    session.published = []
+    frames: list[dict[str, Any]] = []
+    cid = session.connect(lambda text: frames.append(json.loads(text)))
+    session.start()
+    try:
+        session.submit(cid, parse_command('{"type": "hello"}'))
+        first = session.call(lambda d: len(d.trace.records))
+        session.submit(cid, parse_command('{"type": "run"}'))
+        # as fast as it goes until the three drives are initialised: thousands of chart ticks
+        while not session.call(lambda d: d.robot.initialised):
+            time.sleep(0.05)
+        session.submit(cid, parse_command('{"type": "pause"}'))
+        steps, ticks, active, records = session.call(lambda d: (
+            d.robot.steps, d.robot.chart_ticks,
+            {n: sorted(c.configuration_values) for n, c in d.robot.charts.items()}, list(d.trace.records)[first:]))
+        while not [f for f in frames if f["type"] == "frame" and f["steps"] == steps and f["mode"] == "paused"]:
+            time.sleep(0.05)  # the frame of the pause
+    finally:
+        session.stop()
+    gaps = [b - a for a, b in zip(session.published, session.published[1:], strict=False)]
+    assert len(gaps) >= 3 and min(gaps) >= session.frame_period * 0.999  # at most 30 frames a second
+    live = [f for f in frames if f["type"] == "frame" and not f["full"]]
+    assert ticks > 10 * len(live)  # never a frame per tick
+    assert all(f["transitions_total"] == len(f["transitions"]) for f in live)  # none left out
+    seen = [(t["chart"], t["source"], t["target"], t["tick"]) for f in live for t in f["transitions"]]
+    assert seen == [(r.chart, r.source, r.target, r.tick) for r in records] and len(seen) >= 10
+    assert live[-1]["active"] == active  # the latest state

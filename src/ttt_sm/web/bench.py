@@ -101,16 +101,20 @@ def bench_gui(params: ArmParams, seed: int = 0, x1_s: float = 60.0, max_s: float
             page.wait_for_selector("[data-state]", timeout=60_000)
             page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'paused'")
 
-            # x1: real time while the drives initialise and the Control chart starts drawing
-            t0 = session.call(lambda d: d.robot.t)
-            wall0 = time.perf_counter()
+            # x1: real time while the drives initialise and the Control chart starts drawing.
+            # Drift: simulated against wall time, both read in the simulation thread between two
+            # control steps of one paced run (the clicks' own delays are not in it).
+            def sample(d: Debugger) -> tuple[float, float, float]:
+                return d.robot.t, time.perf_counter(), session.clock.stats().lost_s
+
             page.get_by_role("button", name="Run", exact=True).click()
+            page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'running'")
+            t0, wall0, lost0 = session.call(sample)
             time.sleep(x1_s)
+            t1, wall1, lost1 = session.call(sample)
             page.get_by_role("button", name="Pause", exact=True).click()
             page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'paused'")
             stats = session.clock.stats()
-            t1 = session.call(lambda d: d.robot.t)
-            wall1 = time.perf_counter()
             latency = sorted(session.latency_ms())
             run_wall = wall1 - wall0
             out.update({
@@ -118,8 +122,9 @@ def bench_gui(params: ArmParams, seed: int = 0, x1_s: float = 60.0, max_s: float
                 "gui_frame_latency_ms_p95": round(latency[int(0.95 * (len(latency) - 1))], 1) if latency else None,
                 "gui_frame_latency_ms_median": round(statistics.median(latency), 1) if latency else None,
                 "gui_frame_latency_samples": len(latency),
-                # the run started and paused by the page: the clicks' own delays are part of the difference
-                "gui_drift_ms_per_min": round(((t1 - t0) - run_wall) * 1e3 * 60.0 / run_wall, 1),
+                "gui_drift_ms_per_min": round(((t1 - t0) - run_wall) * 1e3 * 60.0 / run_wall, 2),
+                # time given up by slips (more than 0.25 s behind): part of the drift above, never hidden
+                "gui_pace_lost_s": round(lost1 - lost0, 3),
                 "gui_pace_lag_max_ms": round(stats.lag_max_s * 1e3, 2),
                 "gui_pace_overruns": stats.overruns,
                 "gui_pace_slips": stats.slips,

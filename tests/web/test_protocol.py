@@ -383,3 +383,18 @@ def test_frames_are_throttled_and_carry_every_transition_since_the_last() -> Non
     seen = [(t["chart"], t["source"], t["target"], t["tick"]) for f in live for t in f["transitions"]]
     assert seen == [(r.chart, r.source, r.target, r.tick) for r in records] and len(seen) >= 10
     assert live[-1]["active"] == active  # the latest state
+
+
+def test_a_game_session_shows_the_game_charts_too() -> None:
+    game = Session(Debugger.build(load_params(), seed=0, game=True), speed=None, running=False)
+    game.start()
+    try:
+        with TestClient(create_app(game, manage_session=False)) as c, c.websocket_connect("/ws") as ws:
+            page = Page(ws)
+            info, full = page.join()
+            assert {"Game", "AlgorithmActivator", "Control", "DriveInit1"} <= {ch["name"] for ch in info["charts"]}
+            assert full["active"]["Game"] == game.call(lambda d: sorted(d.robot.charts["Game"].configuration_values))
+            assert 'data-state="Game.' in c.get("/api/diagram/Game?view=whole").text
+            assert page.answer(page.send(type="tick", n=3))["ok"]
+    finally:
+        game.stop()

@@ -235,3 +235,36 @@ def test_an_input_set_forced_and_released_from_the_watch(page: Any, cockpit: Coc
     page.wait_for_function("document.querySelector('[data-state=\"DriveInit1.stopped\"]').dataset.active === 'false'")
     assert "stopped" not in cockpit.session.call(lambda d: d.where()["DriveInit1"])
     cockpit.session.call(lambda d: d.replay(0))
+
+
+def test_sub_charts_open_in_place_and_on_their_own_and_stay_lit(page: Any, cockpit: Cockpit) -> None:
+    open_cockpit(page, cockpit)
+    go_to_tick(page, 0)
+    page.get_by_label("Breakpoint spec").fill("enter Control.field_pen_down")
+    page.get_by_role("button", name="Add", exact=True).click()
+    page.get_by_role("button", name="Run", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
+    active = set(cockpit.session.call(lambda d: d.where()["Control"]))
+    assert {"Drawing_playing_field", "field_pen_down"} <= active
+    page.locator('[data-role="chart-tabs"]').get_by_role("button", name="Control", exact=True).click()
+    bar = page.locator('[data-role="view-bar"]')
+    diagram = page.locator('[data-role="diagram"]')
+
+    def shown(view: str) -> set[str]:
+        page.wait_for_function("(() => { const d = document.querySelector('[data-role=diagram]');"
+                               f" return d.dataset.view === '{view}' && !d.dataset.loading; }})()")
+        return set(diagram.locator("[data-state]").evaluate_all("els => els.map(e => e.dataset.stateId)"))
+
+    bar.get_by_role("button", name="Overview").click()
+    closed = shown("overview")
+    assert "Drawing_playing_field" in closed and "field_pen_down" not in closed  # the overview: sub-charts closed
+    assert active_shown(page) == active & closed  # the closed sub-chart the chart is in is lit
+    bar.get_by_role("button", name="open sub-chart Drawing_playing_field in place").click()
+    opened = shown("overview+Drawing_playing_field")
+    assert {"field_pen_down", "to_line"} <= opened and "wait_1" not in opened  # the others stay closed
+    assert active_shown(page) == active & opened
+    bar.get_by_role("button", name="open sub-chart Drawing_playing_field on its own").click()
+    alone = shown("Drawing_playing_field")
+    assert "field_pen_down" in alone and not {"start_stop", "Erase", "Drawing_X"} & alone
+    assert active_shown(page) == active & alone
+    cockpit.session.call(lambda d: d.delete())

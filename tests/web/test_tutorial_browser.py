@@ -59,4 +59,8 @@ def test_the_tutorials_browser_path_stops_where_it_says(page: Any, cockpit: Cock
     page.wait_for_function("document.querySelector('[data-datum=\"DriveInit1.pos_out\"] [data-role=value]')"
                            f".textContent === {json.dumps(expected)}")
     assert pos_out.text_content() == expected
+    # the values that Tick changed are marked, the others not
+    watch = page.locator('[data-role="watch"]')
+    assert watch.locator('tr[data-datum="DriveInit1.pos_out"]').get_attribute("data-changed") == "true"
+    assert watch.locator('tr[data-datum="DriveInit1.ini2"]').get_attribute("data-changed") == "false"
     cockpit.session.call(lambda d: d.delete())

@@ -106,6 +106,7 @@ def test_a_click_breakpoint_stops_the_run_at_the_tick_the_state_is_entered(page:
 
 def test_step_and_tick_advance_by_one(page: Any, cockpit: Cockpit) -> None:
     open_cockpit(page, cockpit)
+    cockpit.session.call(lambda d: d.furthest_tick >= 1000 or d.run(3.0))
     go_to_tick(page, 10)
     t0 = float(page.locator('[data-role="sim-time"]').text_content())
     page.get_by_role("button", name="Step", exact=True).click()
@@ -115,6 +116,16 @@ def test_step_and_tick_advance_by_one(page: Any, cockpit: Cockpit) -> None:
     page.get_by_role("button", name="Tick", exact=True).click()
     page.wait_for_function(f"document.querySelector('[data-role=tick]').textContent === '{tick + 1}'")
     assert shown_tick(page) == tick + 1
+    # Next: to the next chart tick that takes a transition, as the debugger's next does
+    ref = Debugger.build(load_params(), seed=0)
+    ref.step(ref.steps_of_tick(tick + 1))
+    expected = ref.next(10.0)
+    assert expected.kind == "transition"
+    page.get_by_role("button", name="Next", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'transition'")
+    assert shown_tick(page) == expected.chart_ticks
+    newest = page.locator('[data-role="trace"] tbody tr').first.locator("td").first.text_content()
+    assert int(newest) == ref.trace.records[-1].tick, (newest, expected.chart_ticks)
 
 
 def test_the_slider_replays_to_the_tick_asked_for_and_shows_its_data(page: Any, cockpit: Cockpit) -> None:
@@ -216,6 +227,7 @@ def test_an_event_posted_from_the_page_stops_at_its_event_breakpoint(page: Any, 
 
 def test_an_input_set_forced_and_released_from_the_watch(page: Any, cockpit: Cockpit) -> None:
     open_cockpit(page, cockpit)
+    cockpit.session.call(lambda d: d.furthest_tick >= 1000 or d.run(3.0))
     go_to_tick(page, 10)
     show(page, "DriveInit1")
     row = page.locator('[data-role="watch"] tr[data-datum="DriveInit1.stop"]')

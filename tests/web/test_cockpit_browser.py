@@ -280,3 +280,24 @@ def test_sub_charts_open_in_place_and_on_their_own_and_stay_lit(page: Any, cockp
     assert "field_pen_down" in alone and not {"start_stop", "Erase", "Drawing_X"} & alone
     assert active_shown(page) == active & alone
     cockpit.session.call(lambda d: d.delete())
+
+
+def test_a_stall_at_real_time_is_counted_and_shown_never_hidden(page: Any, cockpit: Cockpit) -> None:
+    import time
+
+    open_cockpit(page, cockpit)
+    page.get_by_label("Speed", exact=True).select_option("1")
+    page.get_by_role("button", name="Run", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'running'")
+    before = cockpit.session.clock.stats()
+    cockpit.session.call(lambda d: time.sleep(0.4))  # the simulation thread stalls 0.4 s at x1
+    # the next paced step is late by the stall: the page shows it
+    page.wait_for_function(f"Number(document.querySelector('[data-role=pace]').dataset.overruns) > {before.overruns}")
+    page.get_by_role("button", name="Pause", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'paused'")
+    after = cockpit.session.clock.stats()
+    assert after.overruns > before.overruns and after.slips > before.slips and after.lost_s >= before.lost_s + 0.25
+    pace = page.locator('[data-role="pace"]')
+    page.wait_for_function(f"document.querySelector('[data-role=pace]').dataset.overruns === '{after.overruns}'")
+    assert f"{after.slips} slip" in pace.text_content() and "s lost" in pace.text_content()
+    page.get_by_label("Speed", exact=True).select_option("max")

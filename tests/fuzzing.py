@@ -13,10 +13,9 @@ its message is one line that names the file, line or argument.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from typing import Any
-
-import os
 
 import pytest
 from hypothesis import HealthCheck, given, settings

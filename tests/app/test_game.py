@@ -168,3 +168,28 @@ def test_two_symbols_at_once_end_the_game_with_a_clear_error_and_the_record_kept
     rejected = [e for e in events if e["event"] == "detection_rejected"]
     assert len(rejected) == 1 and "only one per turn" in rejected[0]["message"]
     assert (tmp_path / "board_final.png").stat().st_size > 0
+
+
+def test_the_camera_link_is_silent_between_readings_without_a_silence_warning(caplog):
+    """The person thinks for longer than the watchdog's limit: the camera was not asked, no warning."""
+    import logging
+    import time
+
+    from ttt_sm.app.camera_link import CameraLink
+    from ttt_sm.twin.whiteboard import Whiteboard
+    from ttt_sm.vision.scenes import draw_field
+
+    caplog.set_level(logging.WARNING, logger="ttt_sm.seriallink")
+    board = Whiteboard(P, seed=2)
+    draw_field(board)
+    link = CameraLink(P, board, seed=2, mode="serial", silence_s=0.2)
+    try:
+        link.read()
+        time.sleep(0.5)  # the person at the terminal, typing; the camera is idle by design
+        board.draw_symbol("X", 2, 3)
+        link.read()
+        stats = link.stats()
+    finally:
+        link.close()
+    assert stats["silences"] == 0 and stats["frames_ok"] == 2
+    assert not [r.getMessage() for r in caplog.records if "no valid frame" in r.getMessage()]

@@ -244,3 +244,26 @@ def test_a_closed_reader_says_so(camera, open_reader):
     reader.close()
     with pytest.raises(SerialLinkError, match="is closed"):
         reader.read_frame(0.1)
+
+
+def test_a_link_idle_by_design_is_not_silence_but_a_frame_asked_for_and_missing_is(camera, open_reader, values,
+                                                                                    caplog):
+    caplog.set_level(logging.WARNING, logger=LOGGER)
+    reader = open_reader(camera.port, silence_s=0.2)
+    camera.send_frame(values(0))
+    assert reader.read_frame().seq == 0
+    reader.expect_frames(False)  # a camera that sends only when asked: nothing comes until the next request
+    for _ in range(4):
+        assert reader.read_frame(0.15) is None and reader.latest().seq == 0
+    assert reader.stats.silences == 0
+    # asked again after the long pause: the frame that answers in time is no silence ...
+    reader.expect_frames(True)
+    camera.send_frame(values(1))
+    assert reader.read_frame().seq == 1
+    assert reader.stats.silences == 0
+    assert not any("no valid frame for" in r.getMessage() for r in caplog.records)
+    # ... but a frame asked for that does not come is
+    for _ in range(4):
+        assert reader.read_frame(0.15) is None
+    assert reader.stats.silences == 1
+    assert sum("no valid frame for" in r.getMessage() for r in caplog.records) == 1

@@ -13,7 +13,9 @@ photographs while the simulation is paused for a reading (a lock, and an event
 that says a reading is wanted), and a reading taken for a decision is always a
 frame photographed after the last change.  Between readings the camera waits:
 a frame photographed while the game thread takes the board back would only
-cost it time.
+cost it time.  So the reader's silence watchdog runs only while a reading
+waits for its frame: a link idle while the person thinks is not a camera
+that stopped.
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ class CameraLink:
     """Per-cell percentages of the board, in board order, from a photo taken now."""
 
     def __init__(self, params: ArmParams, board: Whiteboard, seed: int = 0, mode: str = "serial",
-                 rate_hz: float = 50.0) -> None:
+                 rate_hz: float = 50.0, silence_s: float = 2.0) -> None:
         if mode not in ("direct", "serial"):
             raise ValueError(f"camera mode must be 'direct' or 'serial', got {mode!r}")
         self.mode = mode
@@ -56,9 +58,9 @@ class CameraLink:
         self._reader: Any = None
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
         if mode == "serial":
-            self._start_serial(rate_hz)
+            self._start_serial(rate_hz, silence_s)
 
-    def _start_serial(self, rate_hz: float) -> None:
+    def _start_serial(self, rate_hz: float, silence_s: float) -> None:
         from ..seriallink import CameraEmulator, SerialCameraReader
 
         def source() -> list[float]:
@@ -80,7 +82,8 @@ class CameraLink:
 
         self._tmp = tempfile.TemporaryDirectory(prefix="ttt_sm_camera_")
         self._emulator = CameraEmulator(source, rate_hz=rate_hz, link=Path(self._tmp.name) / "camera").start()
-        self._reader = SerialCameraReader(self._emulator.port, 5.0)
+        self._reader = SerialCameraReader(self._emulator.port, 5.0, silence_s=silence_s)
+        self._reader.expect_frames(False)  # the camera sends only when a reading asks
 
     @property
     def port(self) -> str | None:
@@ -102,6 +105,7 @@ class CameraLink:
         # Frames photographed before now may still wait in the port: only a
         # frame numbered from `fresh` on shows the board as it is now.
         fresh = self._made
+        self._reader.expect_frames(True)
         self._wanted.set()
         self.lock.release()
         try:
@@ -118,6 +122,7 @@ class CameraLink:
                     break
         finally:
             self._wanted.clear()
+            self._reader.expect_frames(False)
             self.lock.acquire()
         cells = self._symbols_by_seq.pop(frame.seq, None)
         self._symbols_by_seq.clear()

@@ -15,7 +15,10 @@ what the thesis' set-up got from the hardware being well behaved:
   gives up with :class:`~.errors.LinkLost` after ``max_attempts`` or
   ``max_duration_s``, whichever comes first;
 - an open port with no valid frame for ``silence_s`` is reported once (a
-  pulled cable on a built-in COM port looks like that, not like an error).
+  pulled cable on a built-in COM port looks like that, not like an error),
+  but only while frames are expected: a camera that sends only when asked
+  (the game's, between two readings) is idle by design, and
+  :meth:`SerialCameraReader.expect_frames` says so.
 
 Every call is bounded in time: reads use the port's timeout and a deadline,
 reconnect attempts are bounded in number and time.  One thread uses a reader.
@@ -178,6 +181,8 @@ class SerialCameraReader:
         self._latest: Frame | None = None
         self._latest_at: float | None = None
         self._last_frame_at = 0.0
+        self._expecting = True
+        self._expected_since = 0.0
         self._silent = False
         self._last_seq: int | None = None
         self._n = _Counters()
@@ -204,6 +209,20 @@ class SerialCameraReader:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+    def expect_frames(self, expected: bool) -> None:
+        """Say whether frames should be arriving now: the silence watchdog only runs while they should.
+
+        A reader expects frames from the start (a camera that streams).  A
+        camera that sends a frame only when asked (the game's: one photo per
+        reading) is idle by design between two requests: call
+        ``expect_frames(False)`` when done with a reading and
+        ``expect_frames(True)`` when asking for the next; the silence is then
+        measured from the request, not from the last frame before the pause.
+        """
+        if expected and not self._expecting:
+            self._expected_since = time.monotonic()
+        self._expecting = expected
 
     @property
     def connected(self) -> bool:
@@ -465,7 +484,9 @@ class SerialCameraReader:
         self._say(reason.value, "rejected %s: %s; line %s", reason.value, detail, snippet(raw))
 
     def _check_silence(self) -> None:
-        if not self._silent and time.monotonic() - self._last_frame_at > self._silence_s:
+        if not self._expecting or self._silent:
+            return
+        if time.monotonic() - max(self._last_frame_at, self._expected_since) > self._silence_s:
             self._silent = True
             self._n.silences += 1
             self._log.warning("camera %s: port open but no valid frame for %.1f s (%s); camera stopped or"

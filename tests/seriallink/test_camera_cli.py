@@ -104,3 +104,28 @@ def test_serve_refuses_to_replace_a_real_file(tmp_path, capsys):
     real.write_text("mine")
     assert run("camera", "serve", "--link", str(real), "--duration", "0") == 2
     assert "not a symlink" in capsys.readouterr().err and real.read_text() == "mine"
+
+
+def test_read_json_that_loses_its_link_still_prints_the_frames_it_read(tmp_path, capsys):
+    from ttt_sm.seriallink import Fault
+
+    with CameraEmulator(board_source("...../...../..O../...../....."), rate_hz=50, link=tmp_path / "cam") as cam:
+        def pull_the_cable() -> None:
+            give_up = time.monotonic() + 15
+            while cam.stats.frames_sent < 20 and time.monotonic() < give_up:
+                time.sleep(0.02)
+            cam.inject(Fault.disconnect(60.0))  # gone for longer than the reader tries to reopen it
+
+        puller = threading.Thread(target=pull_the_cable)
+        puller.start()
+        try:
+            status = run("camera", "read", "--port", cam.port, "--count", "100000", "--give-up", "0.5", "--json")
+        finally:
+            puller.join(30)
+    captured = capsys.readouterr()
+    assert status == 2
+    doc = json.loads(captured.out)  # one strict JSON document, though the link was lost
+    assert doc["complete"] is False and "never came back" in doc["error"]
+    assert len(doc["frames"]) == doc["stats"]["frames_ok"] >= 1 and doc["stats"]["disconnects"] == 1
+    last = captured.err.strip().splitlines()[-1]
+    assert last.startswith("ttt-sm camera read: error: camera port") and f"{len(doc['frames'])} of 100000" in last

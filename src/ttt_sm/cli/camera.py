@@ -138,6 +138,7 @@ def cmd_camera_read(args: argparse.Namespace) -> int:
         return _fail("read", f"--timeout must be > 0 and --give-up >= 0 seconds, got {args.timeout}, {args.give_up}")
     policy = ReconnectPolicy(max_duration_s=args.give_up)
     frames = []
+    error: SerialLinkError | None = None
     reader = SerialCameraReader(args.port, args.timeout, baudrate=args.baud, reconnect=policy)
     try:
         with _log_to_stderr(logging.INFO if args.verbose else logging.WARNING):
@@ -146,15 +147,19 @@ def cmd_camera_read(args: argparse.Namespace) -> int:
                 if not args.json:
                     print(_grid(frame), flush=True)
     except SerialLinkError as exc:
-        return _fail("read", str(exc))
+        error = exc
     finally:
         reader.close()
     stats = reader.stats
     if args.json:
+        # The frames read before the link was lost are kept: the document says what came and why it stopped.
         doc = {"port": args.port, "frames": [{"seq": f.seq, "percentages": list(f.percentages)} for f in frames],
-               "stats": {**dataclasses.asdict(stats), "rejected_total": stats.rejected_total}}
+               "stats": {**dataclasses.asdict(stats), "rejected_total": stats.rejected_total},
+               "complete": error is None, "error": None if error is None else str(error)}
         print_json(doc)
-    else:
+    if error is not None:
+        return _fail("read", f"{error} ({len(frames)} of {args.count} frames read)")
+    if not args.json:
         why = ", ".join(f"{k} {v}" for k, v in sorted(stats.rejected.items()))
         print(f"{stats.frames_ok} frames, rejected {stats.rejected_total}{f' ({why})' if why else ''},"
               f" gaps {stats.gaps} ({stats.frames_missed} frames missed), reconnects {stats.reconnects}",

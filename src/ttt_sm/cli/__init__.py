@@ -2,7 +2,11 @@
 
 Every result-producing subcommand has `--json` (one JSON document on
 standard output, progress on standard error).  Errors are one readable line
-on standard error and exit status 2.
+on standard error and exit status 2, never a traceback (:func:`main`): a
+project error is its message, an operating-system error on a path names the
+path and what to do, a closed pipe (``ttt-sm params | head``) ends quietly,
+Ctrl-C says "interrupted" (status 130).  Anything else is a bug, reported in
+one line that says so (status 70; ``TTT_SM_TRACEBACK=1`` shows the traceback).
 
 The package: :mod:`.common` holds what every subcommand shares (the
 one-line :class:`~.common.CliError`, the ``--json``/``--seed`` options, the
@@ -21,12 +25,13 @@ this module, and nothing below the CLI imports the CLI.
 from __future__ import annotations
 
 import argparse
+import errno
+import os
 import sys
 from collections.abc import Sequence
 
-from ..params import ParameterError
 from . import ai, camera, commands, debug, docs, gui, scenario, vision
-from .common import CliError, join_negative_values
+from .common import join_negative_values
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
 SUBCOMMANDS = (commands, scenario, debug, gui, camera, vision, ai, docs)
@@ -43,17 +48,69 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the `ttt-sm` console script."""
-    from ..twin.kinematics import IKError
+#: Exit status of an error that is a bug of ttt_sm, not of its input (EX_SOFTWARE of sysexits.h).
+BUG_STATUS = 70
 
-    parser = build_parser()
-    args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else argv))
+#: What to do about an operating-system error on a path, by errno.
+_OS_ADVICE = {
+    errno.ENOENT: "check the path: it does not exist",
+    errno.EACCES: "check its permissions, or choose another path",
+    errno.EPERM: "check its permissions, or choose another path",
+    errno.EROFS: "it is on a read-only file system: choose another path",
+    errno.EISDIR: "it is a folder where a file belongs: name a file",
+    errno.ENOTDIR: "a part of it is a file where a folder belongs: choose another path",
+    errno.ENOSPC: "the disk is full: free some space or choose another path",
+    errno.EEXIST: "something of that name is already there: choose another path",
+    errno.ENAMETOOLONG: "the name is too long: choose a shorter path",
+}
+
+
+def error_line(command: str, exc: BaseException) -> tuple[str, int]:
+    """The one line (without the newline) and the exit status the CLI gives for ``exc``."""
+    where = f"ttt-sm {command}"
+    if isinstance(exc, OSError) and (exc.filename is not None or exc.errno in _OS_ADVICE):
+        path = exc.filename if exc.filename is not None else "a path"
+        other = f" -> {exc.filename2}" if exc.filename2 is not None else ""
+        reason = exc.strerror or str(exc)
+        advice = _OS_ADVICE.get(exc.errno or 0, "check the path and try again")
+        return f"{where}: error: {path}{other}: {reason}; {advice}", 2
+    if type(exc).__module__.startswith("ttt_sm.") or isinstance(exc, (ValueError, OSError)):
+        text = " ".join(str(exc).split("\n")) or type(exc).__name__
+        return f"{where}: error: {text}", 2
+    text = " ".join(str(exc).splitlines())[:300]
+    return (f"{where}: internal error (a bug of ttt_sm, please report it): {type(exc).__name__}: {text}"
+            f" (TTT_SM_TRACEBACK=1 shows where)"), BUG_STATUS
+
+
+def _quiet_stdout() -> None:
+    """After a closed pipe: send what is still buffered to /dev/null, so exiting does not complain."""
     try:
-        return int(args.func(args))
-    except (ParameterError, IKError, CliError) as exc:
-        print(f"ttt-sm {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # no stdout at all
+        pass
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the `ttt-sm` console script: run the subcommand, turn every error into one line."""
+    command = "?"
+    try:
+        parser = build_parser()
+        args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else argv))
+        command = args.command
+        status = int(args.func(args))
+        if sys.stdout is not None:
+            sys.stdout.flush()  # a closed pipe shows here, not at exit
+        return status
+    except BrokenPipeError:
+        _quiet_stdout()
+        return 141  # as if killed by SIGPIPE (128 + 13), what `head` expects of a writer
     except KeyboardInterrupt:
-        print(f"ttt-sm {args.command}: interrupted", file=sys.stderr)
+        print(f"ttt-sm {command}: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:
+        if os.environ.get("TTT_SM_TRACEBACK"):
+            raise
+        line, status = error_line(command, exc)
+        print(line, file=sys.stderr)
+        return status

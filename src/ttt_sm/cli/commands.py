@@ -47,8 +47,12 @@ def cmd_play(args: argparse.Namespace) -> int:
     params = load_arm(args.params)
     say = progress(True)
     opponent = args.opponent
+    stdin_open = sys.stdin is not None and not sys.stdin.closed
     if opponent == "auto":
-        opponent = "terminal" if sys.stdin.isatty() and not args.json else "simulated"
+        opponent = "terminal" if stdin_open and sys.stdin.isatty() and not args.json else "simulated"
+    elif opponent == "terminal" and not stdin_open:
+        raise CliError("--opponent terminal: standard input is closed, so no one can type a move;"
+                       " give it a terminal, or play against --opponent simulated")
     person = TerminalPerson() if opponent == "terminal" else SimulatedPerson(args.seed, say)
     say(f"ttt-sm play: the robot plays {args.robot_symbol} ({args.engine} engine) against a "
         f"{'person at this terminal' if opponent == 'terminal' else 'simulated person'}; "

@@ -120,7 +120,7 @@ def test_a_person_at_the_terminal_is_asked_again_after_a_bad_cell():
     assert "not a cell: 'nonsense'" in text
     person_moves = [(m["row"], m["column"]) for m in report["moves"] if m["by"] == "person"]
     assert person_moves[:1] == [(3, 3)]
-    assert report["winner"] == "abandoned" and report["erased"] is True
+    assert report["winner"] == "robot" and report["outcome"] == "given_up" and report["erased"] is True
     assert MSG_YOUR_TURN in text
 
 

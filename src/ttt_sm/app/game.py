@@ -8,15 +8,24 @@ emulated smart camera on a pseudo-terminal by default), percent-process
 turns them into the person's moves, the game algorithm answers, and the
 Control chart draws the answer.  The Game chart shows the GUI's messages,
 announces the result, erases the board and turns the arm off.
+
+The game's record (:class:`~.game_record.GameRecord`) is written as it
+happens when the session has an ``out_dir``; the board picture is taken when
+the result is known, before the sponge erases it.  A game stops at a chart
+step's end when asked to (:meth:`GameSession.interrupt`, from a signal
+handler; at once while it waits for the person), and its record then ends
+with the ``interrupted`` event; every game is bounded in simulated time
+(``time_limit_s``).
 """
 
 from __future__ import annotations
 
 import gc
+import hashlib
 import sys
 import time
 from collections.abc import Callable, Generator, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -26,12 +35,13 @@ from ..charts.game import AlgorithmActivator, Game
 from ..game.bitboard import FULL, bits, cell_index, cell_of, win_cells
 from ..game.rules import is_full, parse_board, winner
 from ..params import ArmParams
-from ..runtime.jsonable import dumps
+from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
 from ..sched.scheduler import Signals
 from ..twin.board_picture import save_board_picture
 from ..vision import MoveError, percent_process
 from .camera_link import CameraLink
+from .game_record import GameRecord, params_digest
 from .robot import Robot
 from .wires import GAME_WIRES
 from .wiring import Wiring, not_wired
@@ -39,8 +49,24 @@ from .wiring import Wiring, not_wired
 Cell = tuple[int, int]
 
 
+#: Longest a game may run, in simulated seconds, unless told otherwise: a whole game of 25 moves
+#: takes about 450 s (a usual one about 190 s), so only a game that is stuck reaches it.
+DEFAULT_TIME_LIMIT_S = 1200.0
+
+#: The strengths of the simulated person (``ttt-sm play --person``).
+PERSON_STRENGTHS = ("random", "greedy", "thesis", "perfect")
+
+
 class GameError(RuntimeError):
     """The game cannot go on (a chart did not finish its job in time, the camera went silent)."""
+
+
+class GameInterrupted(Exception):
+    """The game was stopped from outside (:meth:`GameSession.interrupt`: Ctrl-C, SIGTERM); ``why`` says how."""
+
+    def __init__(self, why: str) -> None:
+        super().__init__(f"interrupted ({why})")
+        self.why = why
 
 
 class Person(Protocol):
@@ -68,13 +94,36 @@ def result_of(board: str) -> str | None:
 
 
 class SimulatedPerson:
-    """A person at the board: wins when one move wins, blocks when one move loses, else random."""
+    """A simulated person at the board, at one of :data:`PERSON_STRENGTHS`:
 
-    def __init__(self, seed: int = 0, say: Callable[[str], None] | None = None) -> None:
+    - ``random``: any free cell;
+    - ``greedy`` (the default): wins when one move wins, blocks when one move loses, else random;
+    - ``thesis``: the thesis' three-ply minimax (:class:`~ttt_sm.game.thesis_engine.ThesisEngine`);
+    - ``perfect``: never a move that lets the robot force a win, else random
+      (:class:`~ttt_sm.game.opponents.PerfectEngine`): against the strong engine, a draw.
+    """
+
+    def __init__(self, seed: int = 0, say: Callable[[str], None] | None = None, strength: str = "greedy") -> None:
+        if strength not in PERSON_STRENGTHS:
+            raise ValueError(f"unknown person strength {strength!r}; choose from {', '.join(PERSON_STRENGTHS)}")
         self.rng = np.random.default_rng(seed)
         self.say = say
+        self.strength = strength
+        self.name = f"simulated {strength}"
+        self._engine: Any = None
+        if strength != "greedy":
+            from ..game.opponents import PerfectEngine, RandomEngine
+            from ..game.thesis_engine import ThesisEngine
+
+            self._engine = {"random": lambda: RandomEngine(seed), "thesis": ThesisEngine,
+                            "perfect": lambda: PerfectEngine(seed)}[strength]()
 
     def choose(self, board: str, symbol: str) -> Cell | None:
+        if self._engine is not None:
+            from ..game.engine import GameOver
+
+            answer = self._engine.move(board, symbol)
+            return None if isinstance(answer, GameOver) else (answer.row, answer.column)
         x, o = _masks(board)
         mine, theirs = (x, o) if symbol == "X" else (o, x)
         empty = FULL & ~(x | o)
@@ -91,6 +140,8 @@ class SimulatedPerson:
 
 class TerminalPerson:
     """The person at the terminal: types a cell ("2 3" = row 2, column 3); q gives up."""
+
+    name = "terminal"
 
     def __init__(self, stdin: Any = None, stdout: Any = None) -> None:
         self.stdin = stdin or sys.stdin
@@ -123,16 +174,6 @@ def _board_picture(board: str) -> str:
     for r in range(5):
         rows.append(f"  {r + 1} " + " ".join(board[5 * r:5 * r + 5]))
     return "\n".join(rows)
-
-
-@dataclass
-class GameRecord:
-    """What happened, for the JSON Lines record."""
-
-    events: list[dict[str, Any]] = field(default_factory=list)
-
-    def add(self, t: float, kind: str, **data: Any) -> None:
-        self.events.append({"t": round(t, 4), "event": kind, **data})
 
 
 @dataclass(frozen=True)
@@ -270,9 +311,12 @@ class GameSession:
     def __init__(self, params: ArmParams, seed: int = 0, robot_symbol: str = "O", person: Person | None = None,
                  engine: str = "strong", camera: str = "serial", record_trace: bool = True,
                  progress: Callable[[str], None] | None = None, q_start: Sequence[float] | None = None,
-                 settle_s: float = 0.0) -> None:
+                 settle_s: float = 0.0, out_dir: Path | None = None, time_limit_s: float = DEFAULT_TIME_LIMIT_S,
+                 status: Callable[[str], None] | None = None, record: GameRecord | None = None) -> None:
         if robot_symbol not in ("X", "O"):
             raise ValueError(f"robot symbol must be X or O, got {robot_symbol!r}")
+        if not 0 < time_limit_s < float("inf"):
+            raise ValueError(f"the time limit must be a positive number of seconds, got {time_limit_s}")
         setup0 = time.perf_counter()
         self.params = params
         self.say = progress or (lambda _m: None)
@@ -299,13 +343,30 @@ class GameSession:
         self.pending_move: Cell | None = None
         self.detections_correct = 0
         self.detections_wrong = 0
-        self.record = GameRecord()
+        #: What happened (``record``: one already open, e.g. before the robot was built).
+        self.record = record or GameRecord()
+        self.record.trace = self.trace
+        #: Where the record and the board pictures go (None: only in memory, until :meth:`save`).
+        self.out_dir = out_dir
+        if out_dir is not None:
+            self.record.attach(out_dir / "game.jsonl")
+        self.time_limit_s = float(time_limit_s)
+        #: Shows where a long run is (a terminal's status line), about once per simulated second.
+        self.status = status
+        #: Stop at the end of this chart tick (a replay of a record), else None.
+        self.stop_at_tick: int | None = None
+        self._stop_request: str | None = None
+        self._waiting_for_person = False
+        self._ending = False
+        self._wait: Wait | None = None
+        self.pictures: dict[str, str] = {}
         self.moves: list[dict[str, Any]] = []
         #: 'X', 'O', 'draw' or 'abandoned' once the flow has seen the game end, else None.
         self.outcome: str | None = None
         #: Plays the flow from inside the chart steps (:meth:`drive`), else None.
         self.driver: GameDriver | None = None
         self._last_message = ""
+        self._given_up = False
         #: The Session block's output `play_again`: one game per session.
         self.play_again = False
         self.robot.add_charts((self.activator, self.game), GAME_WIRES, GameStage(self))
@@ -326,7 +387,7 @@ class GameSession:
         c.row, c.column, c.symbol = row, column, 1 if self.robot_symbol == "X" else 0
         self.robot.post("Control", "button")
         self.pending_move = (row, column)
-        self.record.add(self.robot.t, "robot_move", row=row, column=column, think_ms=round(ms, 2))
+        self._event("robot_move", row=row, column=column, think_ms=round(ms, 2))
 
     # -- running -----------------------------------------------------------------------
 
@@ -337,7 +398,7 @@ class GameSession:
             if msg != self._last_message:
                 self._last_message = msg
                 self.person.tell(msg)
-                self.record.add(self.robot.t, "message", text=msg)
+                self._event("message", text=msg)
         return wait.until()
 
     def wait_failed(self, wait: Wait) -> GameError:
@@ -346,8 +407,50 @@ class GameSession:
         return GameError(f"{wait.what} did not happen within {wait.timeout_s:.0f} s of simulated time "
                          f"(Control: {control}, Game: {game})")
 
+    def _event(self, kind: str, **data: Any) -> dict[str, Any]:
+        return self.record.add(self.robot.t, kind, tick=self.robot.chart_ticks, **data)
+
+    def interrupt(self, why: str) -> None:
+        """Stop the game (a signal handler's call; ``why``: e.g. ``SIGINT``).
+
+        While the charts run, the game stops at the end of the chart step (a
+        state a replay reaches again); while it waits for the person, or when
+        asked a second time, at once: :class:`GameInterrupted` is raised here.
+        """
+        if self._ending:
+            return  # the record's last line is being written: it says how the game ended already
+        if self._waiting_for_person or self._stop_request is not None:
+            self._stop_request = why
+            raise GameInterrupted(why)
+        self._stop_request = why
+
+    def _check_stop(self) -> None:
+        if self._stop_request is not None:
+            raise GameInterrupted(self._stop_request)
+        if self.stop_at_tick is not None and self.robot.chart_ticks >= self.stop_at_tick:
+            raise GameInterrupted(f"replayed to tick {self.stop_at_tick}")
+
     def _run(self, wait: Wait) -> None:
-        if not self.robot.run_until(lambda: self.watch(wait), wait.timeout_s):
+        self._wait = wait
+        robot = self.robot
+        left = self.time_limit_s - robot.t
+        if left <= 0:
+            raise GameError(f"the game did not end within {self.time_limit_s:g} s of simulated time (its time"
+                            f" limit), while waiting for {wait.what}")
+        status, every = self.status, max(1, robot.sched.ticks_for(1.0))
+
+        def until() -> bool:
+            # A stop is honoured here only, right after a chart step and before the game goes on with what
+            # it waited for: a state a replay to the same chart tick reaches again.
+            self._check_stop()
+            if status is not None and robot.chart_ticks % every == 0:
+                status(f"t = {robot.t:.0f} s simulated: {wait.what}")
+            return self.watch(wait)
+
+        if not robot.run_until(until, min(wait.timeout_s, left)):
+            if wait.timeout_s > left:
+                raise GameError(f"the game did not end within {self.time_limit_s:g} s of simulated time (its time"
+                                f" limit), while waiting for {wait.what}")
             raise self.wait_failed(wait)
 
     def _waiting(self) -> bool:
@@ -373,13 +476,61 @@ class GameSession:
         # What exists now (the twin, the charts, the engine, the modules) lives for the
         # whole game: keep it out of the collector's full passes (one of ~90 ms a game).
         gc.freeze()
+        self._event("game", seed=self.robot.seed, robot_symbol=self.robot_symbol, engine=self.engine_name,
+                    person=getattr(self.person, "name", type(self.person).__name__), camera=self.camera.mode,
+                    params_sha256=params_digest(self.params), time_limit_s=self.time_limit_s, max_moves=max_moves)
         try:
             wall0 = time.perf_counter()
             for wait in self.flow(max_moves):
                 self._run(wait)
-            return self.report(time.perf_counter() - wall0)
+            report = self.report(time.perf_counter() - wall0)
+        except GameInterrupted as exc:
+            self._end("interrupted", signal=exc.why, boundary=True)
+            raise
+        except KeyboardInterrupt:  # no handler sent it through interrupt(): anywhere in a chart step
+            self._end("interrupted", signal="SIGINT", boundary=False)
+            raise
+        except Exception as exc:
+            self._end("error", message=str(exc) if isinstance(exc, GameError) else f"{type(exc).__name__}: {exc}",
+                      boundary=isinstance(exc, GameError))
+            raise
         finally:
             gc.unfreeze()
+        self._end("finished", outcome=report["outcome"], boundary=True)
+        return report
+
+    def _end(self, how: str, **data: Any) -> None:
+        """The record's last event (where the game stood, and its state), and the board picture of the moment."""
+        if self.record.ended is not None:
+            return
+        self._ending = True
+        wait = self._wait
+        where = {"waiting_for": wait.what if wait is not None else "the start of the game",
+                 "control": sorted(self.robot.active("Control")), "game": sorted(self.robot.active("Game"))}
+        if how != "finished":
+            self._save_board("final" if "final" not in self.pictures else "erased", ending=how)
+        self._event(how, **data, **({} if how == "finished" else where), pictures=dict(self.pictures),
+                    state=self.checkpoint())
+        self.record.close()
+
+    def _save_board(self, which: str, ending: str | None = None) -> None:
+        """The board picture ``board_<which>.png`` in ``out_dir`` (nothing without one)."""
+        if self.out_dir is None:
+            return
+        robot = self.robot
+        ink = robot.board.ink_area_mm2()
+        if which == "final":
+            how = {None: f"the game over ({self.outcome})", "interrupted": "the game interrupted",
+                   "error": "the game stopped by an error"}[ending]
+            title = f"The whiteboard at the end of the game: {how}, {len(self.moves)} moves played"
+        else:
+            title = "The whiteboard after erasing" if ending is None else \
+                f"The whiteboard while erasing: {'interrupted' if ending == 'interrupted' else 'an error'}"
+        path = save_board_picture(
+            robot.board, self.out_dir / f"board_{which}.png", title,
+            f"the robot plays {self.robot_symbol} (blue ink), the person {self.person_symbol} (black ink); "
+            f"seed {robot.seed}, simulated time {robot.t:.1f} s, {ink:.0f} mm² of ink on the board")
+        self.pictures[which] = str(path)
 
     def drive(self, max_moves: int = 25) -> GameDriver:
         """Play the game from inside the chart steps from now on: whoever steps the robot plays it.
@@ -399,10 +550,9 @@ class GameSession:
         :meth:`play` runs it with ``Robot.run_until``, a :class:`GameDriver`
         from inside the chart steps.
         """
-        robot = self.robot
         self.say("initialising, then drawing the field")
         yield Wait(self._waiting, 300.0, "initialising and drawing the field")
-        self.record.add(robot.t, "field_drawn")
+        self._event("field_drawn")
         to_move = "X"
         while result_of(self.board) is None and len(self.moves) < max_moves:
             if to_move == self.person_symbol:
@@ -411,21 +561,21 @@ class GameSession:
             else:
                 yield from self._robot_turn()
             to_move = "O" if to_move == "X" else "X"
-        outcome = result_of(self.board) or "abandoned"
+        outcome = result_of(self.board) or ("given_up" if self._given_up else "abandoned")
         self.outcome = outcome
-        if outcome == "abandoned":
-            self.person.tell("You gave up: the manipulator erases the board.")
-        self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3}.get(outcome, 3)
-        self.record.add(robot.t, "result", outcome=outcome)
+        self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3, "given_up": 4}.get(outcome, 3)
+        self._event("result", outcome=outcome)
+        self._save_board("final")  # the board as the game ended, before the sponge
         self.say(f"result: {outcome}; erasing and turning off")
         yield Wait(lambda: self.game.ended, 600.0, "erasing and turning off")
+        self._save_board("erased")
 
     def report(self, wall_s: float) -> dict[str, Any]:
         """What a game reports (docs/play.md, "What it reports"); `wall_s`: the wall time it took."""
         robot = self.robot
         outcome = self.outcome or "abandoned"
         ink_left = robot.board.ink_area_mm2()
-        winner = {self.robot_symbol: "robot", self.person_symbol: "person"}.get(outcome, outcome)
+        winner = {self.robot_symbol: "robot", self.person_symbol: "person", "given_up": "robot"}.get(outcome, outcome)
         return {
             "winner": winner,
             "outcome": outcome,
@@ -445,6 +595,32 @@ class GameSession:
             "ignored_play_clicks": self.activator.ignored_triggers,
         }
 
+    def checkpoint(self) -> dict[str, Any]:
+        """The state of a game at a chart-step boundary, as a record keeps it: readable parts and one digest.
+
+        Readable: the chart tick, simulated time, both boards, the moves, every
+        chart's active states.  ``digest``: SHA-256 over all of that plus every
+        chart's data, the session's flags and the simulated arm's ground truth
+        (joint and motor angles, currents, speeds, the encoders, the duties),
+        float for float; a replay that reaches the same digest reached the same state.
+        """
+        robot = self.robot
+        charts = {name: sorted(str(s) for s in c.configuration_values) for name, c in robot.charts.items()}
+        state: dict[str, Any] = {"tick": robot.chart_ticks, "steps": robot.steps, "t": robot.t,
+                                 "board": self.board, "truth": self.truth, "moves": len(self.moves),
+                                 "charts": charts}
+        full = {**state, "data": {name: jsonable(c.snapshot()) for name, c in robot.charts.items()},
+                "session": jsonable(self.state())}
+        sim = robot.sim
+        if sim is not None:
+            arrays = [sim.q_encoder, sim.duty, sim.truth.q, sim.truth.q_motor, sim.truth.current_a,
+                      sim.truth.speed_motor, sim.truth.speed_load]
+            full["twin"] = hashlib.sha256(b"".join(np.ascontiguousarray(a, dtype=np.float64).tobytes()
+                                                   for a in arrays)).hexdigest()
+        state["t"] = round(robot.t, 6)
+        state["digest"] = hashlib.sha256(dumps(full, sort_keys=True).encode()).hexdigest()
+        return state
+
     def state(self) -> dict[str, Any]:
         """The session's own state (boards, moves, flags), plain data: what a replay must reproduce too."""
         return {"board": self.board, "truth": self.truth, "moves": [dict(m) for m in self.moves],
@@ -461,13 +637,20 @@ class GameSession:
         # The Game chart shows whose turn it is before the person is asked.
         yield Wait(lambda: True, step, "the Game chart to show whose turn it is", tell=False)
         yield Wait(lambda: True, step, "the person's move")
-        cell = self.person.choose(self.truth, self.person_symbol)
+        self._waiting_for_person = True  # an interrupt now stops the game at once
+        try:
+            if self._stop_request is not None:
+                raise GameInterrupted(self._stop_request)
+            cell = self.person.choose(self.truth, self.person_symbol)
+        finally:
+            self._waiting_for_person = False
         if cell is None:
-            self.record.add(robot.t, "person_gave_up")
+            self._given_up = True
+            self._event("given_up", moves=len(self.moves))
             return False
         robot.board.draw_symbol(self.person_symbol, *cell)
         self._place(cell, self.person_symbol, "truth")
-        self.record.add(robot.t, "person_drew", row=cell[0], column=cell[1])
+        self._event("person_drew", row=cell[0], column=cell[1])
         percentages, symbols = self._look()
         try:
             seen = percent_process(percentages, self.robot_cells, self.person_cells, robot_ink=self.robot_ink,
@@ -476,12 +659,12 @@ class GameSession:
             self.detections_wrong += 1
             message = getattr(exc, "message_for_person", str(exc))
             self.person.tell(message)
-            self.record.add(robot.t, "detection_rejected", message=message)
+            self._event("detection_rejected", message=message)
             raise GameError(f"the camera's view was refused: {message}") from exc
         ok = seen.new == cell
         self.detections_correct += ok
         self.detections_wrong += not ok
-        self.record.add(robot.t, "detected", row=seen.new[0] if seen.new else None,
+        self._event("detected", row=seen.new[0] if seen.new else None,
                         column=seen.new[1] if seen.new else None, correct=ok,
                         percentages=[round(p, 1) for p in percentages])
         if seen.new is not None:
@@ -515,29 +698,36 @@ class GameSession:
                            "t": round(robot.t, 3)})
         self.person.tell(f"The manipulator drew {self.robot_symbol} in row {cell[0]}, column {cell[1]}.")
 
-    def save(self, out_dir: Path) -> dict[str, str]:
-        """Write the game record (JSON Lines: events, then the chart trace) and the final board PNG."""
-        out_dir.mkdir(parents=True, exist_ok=True)
-        record = out_dir / "game.jsonl"
-        with record.open("w") as f:
-            for e in self.record.events:
-                f.write(dumps(e) + "\n")
-            if self.trace is not None:
-                for rec in self.trace.records:
-                    f.write(dumps({"event": "transition", **asdict(rec)}) + "\n")
-        robot = self.robot
-        ink = robot.board.ink_area_mm2()
-        png = save_board_picture(
-            robot.board, out_dir / "board_final.png",
-            f"The whiteboard when the game was saved, {len(self.moves)} moves played"
-            + ("" if ink else ": erased, no ink left"),
-            f"the robot plays {self.robot_symbol} (blue ink), the person {self.person_symbol} (black ink); "
-            f"seed {robot.seed}, simulated time {robot.t:.1f} s, {ink:.0f} mm² of ink on the board")
-        return {"record": str(record), "board_png": str(png)}
+    def save(self, out_dir: Path | None = None) -> dict[str, str]:
+        """The files of the game: the record (``game.jsonl``) and the board pictures.
+
+        A session with an ``out_dir`` wrote them as the game went; one without
+        writes them now to ``out_dir`` (the record of what happened so far, the
+        board as it is now).
+        """
+        if self.out_dir is None:
+            if out_dir is None:
+                raise ValueError("save() needs a folder: the session was made without out_dir")
+            self.out_dir = out_dir
+            self.record.attach(out_dir / "game.jsonl")
+            if "final" not in self.pictures:
+                ended = self.record.ended
+                self._save_board("final", ending=ended if ended in ("interrupted", "error") else None)
+        files = {"record": str(self.record.path)}
+        if "final" in self.pictures:
+            files["board_png"] = self.pictures["final"]
+        if "erased" in self.pictures:
+            files["board_erased_png"] = self.pictures["erased"]
+        return files
 
     def close(self) -> None:
-        """Stop the camera emulator."""
-        self.camera.close()
+        """Stop the camera emulator; close the record (a game not played to its end: ended as interrupted)."""
+        try:
+            if self.record.attached and self.record.ended is None and self.record.events:
+                self._end("interrupted", signal="closed before the end", boundary=True)
+            self.record.close()
+        finally:
+            self.camera.close()
 
 
 def engine_for(name: str) -> Callable[[str, str], Cell]:

@@ -70,7 +70,8 @@ SESSION = Block("Session", "the game around the charts: GUI, engine, the camera'
     Port("erasing", "bool", "the Control chart erases"),
     Port("field_drawn", "bool", "the playing field is drawn"),
 ), outputs=(
-    Port("result", "1", "0: game on; 1: the manipulator won; 2: the person won; 3: draw", attr="result_code"),
+    Port("result", "1", "0: game on; 1: the manipulator won; 2: the person won; 3: draw; 4: the person gave up",
+         attr="result_code"),
     Port("erased", "bool", "the board has been erased since the game ended", attr="erased_seen"),
     Port("play_again", "bool", "start a new game after erasing"),
     Port("o_pos", "1", "the person's moves, one bit per cell"),

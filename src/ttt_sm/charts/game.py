@@ -23,7 +23,9 @@ MSG_YOUR_TURN = "If it is your turn to play draw your next move, otherwise click
 MSG_DRAWING = "The manipulator is drawing."
 MSG_ERASING = "The manipulator is erasing."
 MSG_TURNING_OFF = "The manipulator is being turned off."
-RESULT_MESSAGES = {1: "The manipulator wins.", 2: "You win.", 3: "Draw: the board is full."}
+#: 4 is not the thesis': its GUI had no way to give up; ``ttt-sm play`` has (``q``), and says so.
+RESULT_MESSAGES = {1: "The manipulator wins.", 2: "You win.", 3: "Draw: the board is full.",
+                   4: "You gave up: the manipulator erases the board."}
 
 
 class AlgorithmActivator(TickChart):
@@ -80,7 +82,7 @@ class Game(TickChart):
         Data("initialised", "bool", False, "every drive is initialised (init charts)"),
         Data("ready", "bool", False, "the Control chart waits in wait_1 with the field drawn"),
         Data("busy", "bool", False, "the Control chart is drawing, erasing or moving"),
-        Data("result", "1", 0, "0: game on; 1: the manipulator won; 2: the person won; 3: draw"),
+        Data("result", "1", 0, "0: game on; 1: the manipulator won; 2: the person won; 3: draw; 4: the person gave up"),
         Data("erased", "bool", False, "the Control chart has erased the board and left Erase"),
         Data("play_again", "bool", False, "start a new game after erasing instead of turning off"),
         Data("finished", "bool", False, "the Control chart is back at its start pose"),

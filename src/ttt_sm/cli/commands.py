@@ -15,9 +15,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..params import ArmParams
-from .common import CliError, add_command, emit, out_dir, progress
+from .common import CliError, add_command, clear_status, emit, out_dir, progress, status_line
 
 if TYPE_CHECKING:
+    from ..app.game import GameSession
     from ..runtime.export import ExtraDiagram
 
 
@@ -41,38 +42,81 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 def cmd_play(args: argparse.Namespace) -> int:
-    from ..app.game import GameError, GameSession, SimulatedPerson, TerminalPerson
+    import signal
 
+    from ..app.game import GameInterrupted, GameSession, SimulatedPerson, TerminalPerson
+    from ..app.game_record import GameRecord
+
+    if not 0 < args.time_limit < float("inf"):
+        raise CliError(f"--time-limit must be a positive number of seconds, got {args.time_limit}")
+    # The record is opened before anything runs: a folder that cannot take it is said now, not after the game.
     out = out_dir(args.out)
-    params = load_arm(args.params)
-    say = progress(True)
-    opponent = args.opponent
-    stdin_open = sys.stdin is not None and not sys.stdin.closed
-    if opponent == "auto":
-        opponent = "terminal" if stdin_open and sys.stdin.isatty() and not args.json else "simulated"
-    elif opponent == "terminal" and not stdin_open:
-        raise CliError("--opponent terminal: standard input is closed, so no one can type a move;"
-                       " give it a terminal, or play against --opponent simulated")
-    person = TerminalPerson() if opponent == "terminal" else SimulatedPerson(args.seed, say)
-    say(f"ttt-sm play: the robot plays {args.robot_symbol} ({args.engine} engine) against a "
-        f"{'person at this terminal' if opponent == 'terminal' else 'simulated person'}; "
-        f"camera {'behind a serial port' if args.camera == 'serial' else 'read directly'}")
-    session = GameSession(params, seed=args.seed, robot_symbol=args.robot_symbol, person=person,
-                          engine=args.engine, camera=args.camera, progress=say)
+    record = GameRecord.open(out / "game.jsonl")
+    session: GameSession | None = None
+
+    def stop(signum: int, _frame: object) -> None:
+        why = signal.Signals(signum).name
+        if session is None:
+            raise GameInterrupted(why)  # nothing runs yet: stop setting up at once
+        session.interrupt(why)
+
+    handlers = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        report = session.play()
-        files = session.save(out)
-    except GameError as exc:
-        # what happened up to the failure is kept: the record and the board as it is
-        saved = session.save(out)
-        raise CliError(f"{exc} (the game so far: {saved['record']}, {saved['board_png']})") from exc
+        try:
+            params = load_arm(args.params)
+            say = progress(True)
+            opponent = args.opponent
+            stdin_open = sys.stdin is not None and not sys.stdin.closed
+            if opponent == "auto":
+                opponent = "terminal" if stdin_open and sys.stdin.isatty() and not args.json else "simulated"
+            elif opponent == "terminal" and not stdin_open:
+                raise CliError("--opponent terminal: standard input is closed, so no one can type a move;"
+                               " give it a terminal, or play against --opponent simulated")
+            person = TerminalPerson() if opponent == "terminal" else SimulatedPerson(args.seed, say, args.person)
+            say(f"ttt-sm play: the robot plays {args.robot_symbol} ({args.engine} engine) against a "
+                f"{'person at this terminal' if opponent == 'terminal' else f'simulated person ({args.person})'}; "
+                f"camera {'behind a serial port' if args.camera == 'serial' else 'read directly'}")
+            session = GameSession(params, seed=args.seed, robot_symbol=args.robot_symbol, person=person,
+                                  engine=args.engine, camera=args.camera, progress=say, out_dir=out,
+                                  time_limit_s=args.time_limit, status=status_line(), record=record)
+        except BaseException as exc:  # before the game: the record says so in its one line
+            how = "interrupted" if isinstance(exc, (GameInterrupted, KeyboardInterrupt)) else "error"
+            record.add(0.0, how, tick=0, waiting_for="setting up the robot (nothing ran yet)",
+                       **({"signal": getattr(exc, "why", "SIGINT")} if how == "interrupted" else
+                          {"message": str(exc) or type(exc).__name__}))
+            record.close()
+            raise
+        report = _play_game(session)
+    except GameInterrupted as exc:
+        clear_status()
+        t = session.robot.t if session is not None else 0.0
+        files = session.save() if session is not None else {"record": str(record.path)}
+        print(f"ttt-sm play: interrupted ({exc.why}) at t = {t:.1f} s of simulated time; the game so far: "
+              f"{', '.join(files.values())}", file=sys.stderr)
+        return 128 + (signal.SIGTERM if exc.why == "SIGTERM" else signal.SIGINT)
     finally:
-        session.close()
-    report.update(files)
-    report["opponent"] = opponent
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
+        clear_status()
+        if session is not None:
+            session.close()
+    assert session is not None
+    report.update(session.save())
+    report["opponent"] = opponent if opponent == "terminal" else f"simulated {args.person}"
     lines = [f"  {k}: {v}" for k, v in report.items() if k not in ("moves", "camera_link")]
     emit(report, args.json, "play:\n" + "\n".join(lines))
     return 0
+
+
+def _play_game(session: GameSession) -> dict[str, Any]:
+    from ..app.game import GameError
+
+    try:
+        return session.play()
+    except GameError as exc:
+        # what happened up to the failure is kept: the record and the board as it is
+        files = session.save()
+        raise CliError(f"{exc} (the game so far: {', '.join(files.values())})") from exc
 
 
 def cmd_draw(args: argparse.Namespace) -> int:
@@ -203,7 +247,12 @@ def register(sub: Any) -> None:
     sp.add_argument("--engine", choices=["strong", "thesis"], default="strong", help="the game algorithm")
     sp.add_argument("--camera", choices=["serial", "direct"], default="serial",
                     help="serial (default): the smart camera emulated on a pseudo-terminal; direct: in-process")
-    sp.add_argument("--out", default="out/play", help="folder for the game record and the board PNG")
+    sp.add_argument("--person", choices=["random", "greedy", "thesis", "perfect"], default="greedy",
+                    help="how the simulated person plays (default greedy: wins and blocks when it can; "
+                         "perfect never lets the robot force a win); see docs/play.md")
+    sp.add_argument("--time-limit", type=float, default=1200.0, metavar="SECONDS",
+                    help="longest the game may run in simulated seconds (default 1200; a game takes ~190)")
+    sp.add_argument("--out", default="out/play", help="folder for the game record and the board PNGs")
     sp = add_command(sub, "demo", cmd_demo, "initialise, draw the field, an X and an O, erase, finish (no game)")
     sp.add_argument("--out", default="out/demo", help="folder for the board PNGs (default out/demo)")
     sp = add_command(sub, "draw", cmd_draw,

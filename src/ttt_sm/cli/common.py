@@ -7,7 +7,8 @@
   as one strict JSON document (:mod:`ttt_sm.runtime.jsonable`: NaN and
   infinity are ``null``, never the bare ``NaN`` that JSON readers refuse).
 - :func:`progress`: progress lines on standard error, so ``--json`` output
-  stays one document.
+  stays one document; :func:`status_line`: where a long run is, one line
+  rewritten in place, on a terminal only.
 - :func:`join_negative_values`: ``--start -120,0,0`` read as ``--start=-120,0,0``.
 """
 
@@ -17,6 +18,7 @@ import argparse
 import os
 import re
 import sys
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -108,12 +110,45 @@ def out_dir(path: str, what: str = "--out") -> Path:
     return folder
 
 
+#: Whether a status line is on show (the next progress line first clears it).
+_status_shown = False
+
+
 def progress(enabled: bool) -> Callable[[str], None]:
     """A ``say(msg)`` that writes progress lines to standard error (or nothing)."""
     def say(msg: str) -> None:
         if enabled:
+            clear_status()
             print(msg, file=sys.stderr, flush=True)
     return say
+
+
+def status_line(every_s: float = 0.25) -> Callable[[str], None] | None:
+    """A ``show(text)`` that rewrites one status line on standard error at most every ``every_s`` seconds
+    of wall time, or None when standard error is not a terminal (a log or a pipe gets no status lines)."""
+    stream = sys.stderr
+    if stream is None or not stream.isatty():
+        return None
+    last = [0.0]
+
+    def show(text: str) -> None:
+        global _status_shown
+        now = time.monotonic()
+        if now - last[0] >= every_s:
+            last[0] = now
+            stream.write("\r\033[K  " + text[:150])
+            stream.flush()
+            _status_shown = True
+    return show
+
+
+def clear_status() -> None:
+    """Take the status line off the terminal (before a line of its own, and at the end)."""
+    global _status_shown
+    if _status_shown and sys.stderr is not None:
+        sys.stderr.write("\r\033[K")
+        sys.stderr.flush()
+        _status_shown = False
 
 
 def print_json(data: Any) -> None:

@@ -138,7 +138,7 @@ def game_lines(dbg: Debugger, last_events: int = 8) -> list[str]:
     events = [e for e in game.record.events if e["event"] not in ("detected",)][-last_events:]
     for e in events:
         rest = str(e["text"]) if "text" in e else \
-            ", ".join(f"{k} {v}" for k, v in e.items() if k not in ("t", "event", "think_ms"))
+            ", ".join(f"{k} {v}" for k, v in e.items() if k not in ("t", "tick", "event", "think_ms"))
         lines.append(f"  t = {e['t']:.3f} s  {e['event']}" + (f": {rest}" if rest else ""))
     return lines
 

@@ -1,0 +1,129 @@
+"""The record of a game (``game.jsonl``): written as it happens, ended however the game ends, replayable.
+
+:class:`GameRecord` keeps the game's events and, once :meth:`~GameRecord.attach`\\ ed
+to a file, appends each one as it happens, one JSON object per line, flushed:
+first the chart transitions that happened since the last line, then the
+event.  A game that is interrupted (Ctrl-C, SIGTERM) or fails still leaves
+every line it wrote, and its last line says how it ended:
+
+- the first line, ``event: "game"``: what a replay needs (seed, robot symbol,
+  engine, person, camera, the parameters' SHA-256, the time limit);
+- events of the game (``message``, ``field_drawn``, ``person_drew``, ...),
+  each with ``t`` (simulated s) and ``tick`` (chart steps since power-on);
+- the last line: ``finished``, ``interrupted`` (which signal, and what the
+  game was waiting for) or ``error`` (why), each with a checkpoint of the
+  state at that moment (:meth:`~.game.GameSession.checkpoint`).
+
+:func:`~.game_replay.replay_record` plays the game again from the record's
+seed and the person's recorded moves up to the last line's tick and compares
+the state with the recorded checkpoint (docs/reliability.md, "Records that
+survive").
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict
+from pathlib import Path
+from typing import IO, Any
+
+from ..params import ArmParams
+from ..runtime.jsonable import dumps
+from ..runtime.listeners import Trace
+
+#: The events that end a record.
+ENDINGS = ("finished", "interrupted", "error")
+
+
+def params_digest(params: ArmParams) -> str:
+    """SHA-256 of the parameters in force (their SI values as JSON): which arm a record was made on."""
+    return hashlib.sha256(dumps(asdict(params), sort_keys=True).encode()).hexdigest()
+
+
+class GameRecord:
+    """The game's events in memory and, once attached to a file, appended to it as they happen.
+
+    ``trace``: the chart transitions to interleave (a :class:`Trace` the
+    session's charts report to); each line written is flushed, so what was
+    written survives whatever ends the process next.
+    """
+
+    def __init__(self, trace: Trace | None = None) -> None:
+        self.events: list[dict[str, Any]] = []
+        self.trace = trace
+        self.path: Path | None = None
+        self._sink: IO[str] | None = None
+        self._marks: list[int] = []  # len(trace.records) when each event was added
+        self._traced = 0
+        self.ended: str | None = None
+
+    @classmethod
+    def open(cls, path: Path) -> GameRecord:
+        """A record written to ``path`` from the start (its folder made; OSError if it cannot be written)."""
+        record = cls()
+        record.attach(path)
+        return record
+
+    @property
+    def attached(self) -> bool:
+        return self._sink is not None
+
+    def attach(self, path: Path) -> None:
+        """Write to ``path`` from now on (what was recorded before first); raises OSError if it cannot."""
+        if self._sink is not None:
+            if path != self.path:
+                raise ValueError(f"the record is written to {self.path} already, not {path}")
+            return
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self._sink = path.open("w", encoding="utf-8")
+        self.path = path
+        for event, mark in zip(self.events, self._marks, strict=True):
+            self._write_transitions(mark)
+            self._write(event)
+        self._write_transitions(len(self.trace.records) if self.trace is not None else 0)
+        self._sink.flush()
+
+    def add(self, t: float, kind: str, tick: int | None = None, **data: Any) -> dict[str, Any]:
+        """Record an event at simulated time ``t`` (and chart tick ``tick``); written and flushed if attached."""
+        event = {"t": round(t, 4), **({} if tick is None else {"tick": tick}), "event": kind, **data}
+        self.events.append(event)
+        self._marks.append(len(self.trace.records) if self.trace is not None else 0)
+        if self._sink is not None:
+            self._write_transitions(self._marks[-1])
+            self._write(event)
+            self._sink.flush()
+        if kind in ENDINGS:
+            self.ended = kind
+        return event
+
+    def close(self) -> None:
+        """Write what is left of the trace and close the file."""
+        if self._sink is not None:
+            self._write_transitions(len(self.trace.records) if self.trace is not None else 0)
+            self._sink.close()
+            self._sink = None
+
+    def _write(self, event: dict[str, Any]) -> None:
+        assert self._sink is not None
+        self._sink.write(dumps(event) + "\n")
+
+    def _write_transitions(self, upto: int) -> None:
+        if self.trace is None or self._sink is None:
+            return
+        records = self.trace.records
+        for rec in records[self._traced:upto]:
+            self._sink.write(dumps({"event": "transition", **asdict(rec)}) + "\n")
+        self._traced = max(self._traced, upto)
+
+
+def read_record(path: Path) -> list[dict[str, Any]]:
+    """Every line of a record, parsed (a line that does not parse raises ValueError naming it)."""
+    lines = []
+    with path.open(encoding="utf-8") as f:
+        for n, line in enumerate(f, 1):
+            try:
+                lines.append(json.loads(line))
+            except json.JSONDecodeError as exc:
+                raise ValueError(f"{path}:{n}: not a JSON line ({exc.msg})") from None
+    return lines

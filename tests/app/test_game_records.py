@@ -1,0 +1,176 @@
+"""A game's record survives: written as it happens, ended however the game ends, replayable to its last tick.
+
+The interrupted games run `ttt-sm play` in a subprocess and send it SIGINT or
+SIGTERM at a random moment (after a random number of the record's lines);
+every line of the record must parse, the last must say how the game ended,
+and replaying the record's seed to that line's chart tick must reach the
+same state (docs/reliability.md, "Records that survive").  The default run
+interrupts a few games; the soak run (`make soak`) fifty.
+"""
+
+from __future__ import annotations
+
+import io
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from ttt_sm.app.game import GameSession, SimulatedPerson, TerminalPerson
+from ttt_sm.app.game_record import ENDINGS, read_record
+from ttt_sm.app.game_replay import replay_record
+from ttt_sm.charts.game import RESULT_MESSAGES
+from ttt_sm.params import load_params
+
+P = load_params()
+TTT = Path(sys.executable).with_name("ttt-sm")
+needs_script = pytest.mark.skipif(not TTT.exists(), reason="the ttt-sm console script is not installed beside python")
+
+
+def _game_events(path: Path) -> list[dict]:
+    return [e for e in read_record(path) if e["event"] != "transition"]
+
+
+def test_giving_up_ends_the_game_as_given_up_with_a_message_that_says_so(tmp_path):
+    shown = io.StringIO()
+    person = TerminalPerson(stdin=io.StringIO("3 3\nq\n"), stdout=shown)
+    session = GameSession(P, seed=2, person=person, camera="direct", out_dir=tmp_path)
+    try:
+        report = session.play()
+    finally:
+        session.close()
+    text = shown.getvalue()
+    assert report["outcome"] == "given_up" and report["winner"] == "robot"
+    assert RESULT_MESSAGES[4] in text and "Draw" not in text
+    events = _game_events(tmp_path / "game.jsonl")
+    kinds = [e["event"] for e in events]
+    assert "given_up" in kinds and kinds[-1] == "finished" and events[-1]["outcome"] == "given_up"
+    assert {"event": "result", "outcome": "given_up"}.items() <= next(e for e in events
+                                                                      if e["event"] == "result").items()
+
+
+def _dark_pixels(png: str) -> int:
+    image = cv2.imread(png, cv2.IMREAD_GRAYSCALE)
+    assert image is not None
+    return int(np.count_nonzero(image < 80))
+
+
+def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_has_its_own_name(tmp_path):
+    session = GameSession(P, seed=4, camera="direct", out_dir=tmp_path)
+    try:
+        session.play()
+        files = session.save()
+    finally:
+        session.close()
+    assert Path(files["board_png"]).name == "board_final.png"
+    assert Path(files["board_erased_png"]).name == "board_erased.png"
+    # the person's black ink and the robot's dark blue are on the final board, not on the erased one
+    assert _dark_pixels(files["board_png"]) > 2 * _dark_pixels(files["board_erased_png"])
+    events = _game_events(tmp_path / "game.jsonl")
+    assert events[-1]["pictures"] == {"final": files["board_png"], "erased": files["board_erased_png"]}
+
+
+@pytest.mark.parametrize("strength", ["random", "greedy", "thesis", "perfect"])
+def test_the_simulated_person_plays_free_cells_at_each_strength(strength):
+    person = SimulatedPerson(seed=1, strength=strength)
+    board = "XX.X." + "OO.O." + "." * 15
+    cell = person.choose(board, "X")
+    assert cell is not None and board[(cell[0] - 1) * 5 + cell[1] - 1] == "."
+    if strength != "random":
+        assert cell == (1, 3)  # four in a row: X X _ X -> the gap wins
+
+
+def test_a_perfect_person_is_not_beaten_quickly(tmp_path):
+    session = GameSession(P, seed=1, camera="direct", person=SimulatedPerson(1, strength="perfect"),
+                          record_trace=False)
+    try:
+        report = session.play()
+    finally:
+        session.close()
+    assert report["outcome"] == "draw" and len(report["moves"]) == 25  # the board full: nobody could force a win
+
+
+def test_every_game_is_bounded_in_simulated_time():
+    from ttt_sm.app.game import GameError
+
+    session = GameSession(P, seed=0, camera="direct", record_trace=False, time_limit_s=20.0)
+    try:
+        with pytest.raises(GameError, match=r"did not end within 20 s of simulated time \(its time limit\)"):
+            session.play()
+        assert session.record.ended == "error" and session.robot.t <= 20.0 + 1e-9
+    finally:
+        session.close()
+
+
+def _interrupt_games(tmp_path: Path, seeds: list[int]) -> dict[str, int]:
+    """Run each game in a subprocess, signal it after a random number of record lines, check its record."""
+    counts = {"SIGINT": 0, "SIGTERM": 0, "finished": 0, "records": 0, "replayed": 0}
+    for seed in seeds:
+        rng = random.Random(seed)
+        out = tmp_path / f"game{seed}"
+        sig = rng.choice([signal.SIGINT, signal.SIGTERM])
+        camera = "serial" if seed % 2 else "direct"
+        proc = subprocess.Popen([str(TTT), "play", "--opponent", "simulated", "--seed", str(seed), "--camera", camera,
+                                 "--person", rng.choice(["random", "greedy"]), "--out", str(out)],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+        record = out / "game.jsonl"
+        after_lines = rng.randint(1, 150)  # game events and transitions: a whole game writes about 170
+        give_up = time.monotonic() + 300
+        try:
+            while proc.poll() is None and time.monotonic() < give_up:
+                try:
+                    with record.open("rb") as f:
+                        if sum(1 for _ in f) >= after_lines:
+                            break
+                except FileNotFoundError:
+                    pass
+                time.sleep(0.02)
+            time.sleep(rng.uniform(0.0, 1.0))
+            proc.send_signal(sig)
+            status = proc.wait(timeout=120)
+            err = proc.stderr.read() if proc.stderr else ""
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+        assert "Traceback" not in err, err
+        lines = read_record(record)  # every line parses
+        counts["records"] += 1
+        last = lines[-1]
+        assert last["event"] in ENDINGS, last
+        assert lines[0]["event"] == "game" and lines[0]["seed"] == seed
+        if last["event"] == "finished":  # the game ended before the signal came
+            assert status == 0
+            counts["finished"] += 1
+        else:
+            assert last["event"] == "interrupted" and last["signal"] == sig.name and last["boundary"] is True, last
+            assert status == 128 + sig, (status, err)
+            assert f"interrupted ({sig.name})" in err.strip().splitlines()[-1]
+            assert last["waiting_for"] and last["pictures"]
+            assert all(Path(p).is_file() for p in last["pictures"].values())
+            counts[sig.name] += 1
+        check = replay_record(record, P)
+        assert check.identical, check.describe()
+        counts["replayed"] += 1
+    return counts
+
+
+@needs_script
+def test_interrupted_games_keep_a_record_that_replays_to_its_last_tick(tmp_path):
+    counts = _interrupt_games(tmp_path, [11, 12, 13])
+    assert counts["records"] == counts["replayed"] == 3
+    assert counts["SIGINT"] + counts["SIGTERM"] >= 2
+
+
+@pytest.mark.soak
+@needs_script
+def test_fifty_interrupted_games_lose_no_record(tmp_path):
+    counts = _interrupt_games(tmp_path, list(range(100, 150)))
+    print(f"interrupted games: {counts}")
+    assert counts["records"] == counts["replayed"] == 50
+    assert counts["SIGINT"] + counts["SIGTERM"] >= 45

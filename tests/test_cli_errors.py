@@ -48,6 +48,13 @@ def test_an_os_error_on_a_path_names_the_path_and_what_to_do():
     assert line.endswith("out/game.jsonl: Is a directory; it is a folder where a file belongs: name a file")
 
 
+def test_a_path_or_a_message_with_line_breaks_stays_one_line():
+    line, status = error_line("play", PermissionError(errno.EACCES, "Permission denied", "out\rdir\n/game.jsonl"))
+    assert status == 2 and len(line.splitlines()) == 1 and "'out\\rdir\\n/game.jsonl'" in line
+    line, status = error_line("draw", ValueError("first\rsecond\nthird"))
+    assert (line, status) == ("ttt-sm draw: error: first second third", 2)
+
+
 def test_a_bug_is_one_line_that_says_so(monkeypatch, capsys):
     import ttt_sm.cli.commands as commands
 

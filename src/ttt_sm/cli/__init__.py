@@ -30,6 +30,7 @@ import os
 import sys
 from collections.abc import Sequence
 
+from ..params import shown_path
 from . import ai, camera, commands, debug, docs, gui, scenario, vision
 from .common import join_negative_values
 
@@ -69,13 +70,13 @@ def error_line(command: str, exc: BaseException) -> tuple[str, int]:
     """The one line (without the newline) and the exit status the CLI gives for ``exc``."""
     where = f"ttt-sm {command}"
     if isinstance(exc, OSError) and (exc.filename is not None or exc.errno in _OS_ADVICE):
-        path = exc.filename if exc.filename is not None else "a path"
-        other = f" -> {exc.filename2}" if exc.filename2 is not None else ""
+        path = shown_path(exc.filename) if exc.filename is not None else "a path"
+        other = f" -> {shown_path(exc.filename2)}" if exc.filename2 is not None else ""
         reason = exc.strerror or str(exc)
         advice = _OS_ADVICE.get(exc.errno or 0, "check the path and try again")
         return f"{where}: error: {path}{other}: {reason}; {advice}", 2
     if type(exc).__module__.startswith("ttt_sm.") or isinstance(exc, (ValueError, OSError)):
-        text = " ".join(str(exc).split("\n")) or type(exc).__name__
+        text = " ".join(str(exc).splitlines()) or type(exc).__name__  # \r too: one line, whatever the message
         return f"{where}: error: {text}", 2
     text = " ".join(str(exc).splitlines())[:300]
     return (f"{where}: internal error (a bug of ttt_sm, please report it): {type(exc).__name__}: {text}"

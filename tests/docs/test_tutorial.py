@@ -13,7 +13,8 @@ TUTORIAL = (Path(__file__).resolve().parents[2] / "docs" / "tutorial.md").read_t
 def test_the_debugger_session_stops_where_drive_1_turns_back(tmp_path, capsys):
     block = re.search(r"```\n\$ \.venv/bin/ttt-sm debug\n(.*?)```", TUTORIAL, re.S)
     assert block, "the tutorial's debugger session is missing"
-    commands = [line.removeprefix("(ttt-sm) ") for line in block.group(1).splitlines() if line.strip()]
+    commands = [line.removeprefix("(ttt-sm) ") for line in block.group(1).splitlines()
+                if line.startswith("(ttt-sm) ")]
     assert commands[0] == "break enter DriveInit1.turn_back"
     script = tmp_path / "tutorial.txt"
     script.write_text("\n".join(commands) + "\n")

@@ -295,22 +295,26 @@ class PageRunner:
         prose = _BLOCKS.sub("", text)
         for m in _INLINE_COMMAND.finditer(" ".join(prose.split("\n"))):
             command = m.group(1)
-            if any(c in command for c in "[]|<>") or "..." in command:
-                continue  # a synopsis, not a command
+            if any(c in command for c in "[]|<>") or "..." in command \
+                    or any(re.fullmatch(r"[A-Z][A-Z0-9_,]*", w) for w in command.split()):
+                continue  # a synopsis (ttt-sm ik X Y Z, --commands FILE), not a command
             line = text.count("\n", 0, text.find(command.split()[-1])) + 1
             self.parse_only(command, line)
 
     def parse_only(self, command: str, line: int) -> None:
-        error = _parse(shlex.split(command)[1:])
-        if error and "the following arguments are required" in error:
-            error = None  # `ttt-sm draw` names the command; what it leaves out is not wrong
+        words = shlex.split(command)
+        error = _parse(words[1:])
+        if error and ("the following arguments are required" in error
+                      or (words[-1].startswith("-") and "expected one argument" in error)):
+            error = None  # `ttt-sm draw`, `ttt-sm ai move --board` name a command or an option
         if error:
             raise DocError(f"{self.where(line)}: `{command}` is not a command ttt-sm takes: {error}")
         self.report.parsed_only += 1
 
     def paths(self, text: str) -> None:
-        """Every repository path and relative link in the prose names something that exists."""
-        prose = _BLOCKS.sub("", text)
+        """Every repository path and relative link in the prose names something that exists (a marker's
+        path is the marker's to check)."""
+        prose = _MARKER.sub("", _BLOCKS.sub("", text))
         for m in _LINK.finditer(prose):
             target = m.group(1)
             if "://" in target or target.startswith(("mailto:", "#")):

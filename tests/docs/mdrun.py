@@ -17,7 +17,9 @@ A page is read top to bottom; each fenced code block is one of:
 - ``yaml`` with ``steps:``: a scenario, loaded and checked (names, units,
   conditions) against the charts; ``json``: parsed;
 - anything else (formulas, grammars, a command's synopsis, file formats):
-  text, not run.
+  text, not run, and counted in the report.  A text block may not hold what
+  would run elsewhere: ``>>>`` examples belong in a ``python`` block, a
+  ``$ `` command in a transcript.
 
 Matching: line by line after collapsing runs of spaces; ``...`` alone on a
 line stands for any number of lines, ``...`` inside a line for any text
@@ -35,6 +37,10 @@ Markers are HTML comments outside the code blocks (GitHub does not show them):
   printed numbers may differ by that much (relative or absolute);
 - ``<!-- doc-test: printed by the block above -->`` before a text block: it is
   what the ``python`` block before it prints, compared as a transcript is;
+- ``<!-- doc-test: file NAME -->`` before a block: the block is a file the
+  reader saves as NAME (a scenario of their own, one with mistakes in it);
+  it is written to the scratch folder for the commands below it, and not
+  checked itself (they show what the program says of it);
 - ``<!-- check: CONDITION -->`` after a debugger session: a claim the prose
   makes, written in the condition language of scenarios and ``break when``
   (``abs(q_true[1] - 170deg) < 0.5deg``, ``DriveInit1.direction == -1``),
@@ -111,6 +117,8 @@ class Report:
     checks: int = 0
     paths: int = 0
     parsed_only: int = 0
+    files_written: int = 0
+    text_blocks: int = 0
     run_elsewhere: list[str] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
 
@@ -119,7 +127,8 @@ class Report:
                  f"{self.python_blocks} python blocks", f"{self.doctest_examples} doctest examples",
                  f"{self.scenarios_checked} scenarios loaded", f"{self.json_checked} JSON parsed",
                  f"{self.outputs_compared} outputs compared", f"{self.checks} checks",
-                 f"{self.paths} paths found", f"{self.parsed_only} commands parsed, not run"]
+                 f"{self.paths} paths found", f"{self.parsed_only} commands parsed, not run",
+                 f"{self.files_written} files written", f"{self.text_blocks} text blocks (not code)"]
         text = f"{self.page}: " + ", ".join(parts)
         if self.run_elsewhere:
             text += f"; run by other tests: {', '.join(self.run_elsewhere)}"
@@ -339,7 +348,7 @@ class PageRunner:
         for marker in block.markers:
             if marker.startswith("numbers within"):
                 tol = Tolerance.parse(marker, where)
-            elif marker.startswith(("skip:", "run by ")) or marker == "printed by the block above":
+            elif marker.startswith(("skip:", "run by ", "file ")) or marker == "printed by the block above":
                 if action is not None:
                     raise DocError(f"{where}: {action!r} and {marker!r}: one of them")
                 action = marker
@@ -360,6 +369,9 @@ class PageRunner:
             if not path.is_file() or self.page.name not in path.read_text(encoding="utf-8"):
                 raise DocError(f"{where}: 'run by {test}': no such test file naming {self.page.name}")
             self.report.run_elsewhere.append(f"line {block.line} by {test}")
+            return
+        if action is not None and action.startswith("file "):
+            self.save(block, action[len("file "):].strip(), where)
             return
         if action == "printed by the block above":
             if self.printed is None:
@@ -383,8 +395,31 @@ class PageRunner:
             except ValueError as exc:
                 raise DocError(f"{self.where(block.line)}: this JSON does not parse: {exc}") from None
             self.report.json_checked += 1
+        else:
+            self.text(block)
         if block.checks:
             self.check(block)
+
+    def save(self, block: Block, name: str, where: str) -> None:
+        """A file the reader saves: written to the scratch folder, where the commands below read it."""
+        path = Path(name)
+        if not name or path.is_absolute() or ".." in path.parts:
+            raise DocError(f"{where}: 'file {name}': a file name inside the folder the commands run in")
+        target = self.scratch / path
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text("\n".join(block.lines) + "\n", encoding="utf-8")
+        self.report.files_written += 1
+
+    def text(self, block: Block) -> None:
+        """A block that is not run: it may not hold what would run in another block."""
+        for k, line in enumerate(block.lines):
+            if line.lstrip().startswith(">>> "):
+                raise DocError(f"{self.where(block.line + k)}: a '>>>' example in a block that does not run:"
+                               " write it in a ```python block (a doctest)")
+            if line.startswith("$ "):
+                raise DocError(f"{self.where(block.line + k)}: a '$ ' command in a ```{block.info} block:"
+                               " a transcript is a ``` or ```sh block")
+        self.report.text_blocks += 1
 
     # -- transcripts ------------------------------------------------------------------------
 

@@ -101,3 +101,37 @@ def test_a_python_block_that_fails_names_its_page(tmp_path: Path) -> None:
     runner = _page(tmp_path, "```python\nx = 1\n```\n\n```python\nassert x == 2, 'x is 1'\n```\n")
     with pytest.raises(AssertionError, match="x is 1"):
         runner.run()
+
+
+def test_a_file_the_reader_saves_is_there_for_the_commands_below(tmp_path: Path) -> None:
+    runner = _page(tmp_path, """\
+<!-- doc-test: file scenarios/mine.yaml -->
+```yaml
+name: mine
+steps:
+  - run: {chart_steps: 1}
+  - expect: "DriveInit1.turn_back"
+```
+
+```
+$ ttt-sm scenario check scenarios/mine.yaml
+ok mine  (scenarios/mine.yaml; 3 steps)
+```
+""")
+    with pytest.raises(DocError) as caught:
+        runner.run()
+    assert str(caught.value) == ("page.md:11: `ttt-sm scenario check scenarios/mine.yaml`: the page says"
+                                 " 'ok mine  (scenarios/mine.yaml; 3 steps)', it printed"
+                                 " 'ok mine  (scenarios/mine.yaml; 2 steps)' (printed line 1)")
+    assert runner.report.files_written == 1
+    with pytest.raises(DocError, match="a file name inside the folder the commands run in"):
+        _page(tmp_path / "up", "<!-- doc-test: file ../x.yaml -->\n```\nx\n```\n").run()
+
+
+def test_a_block_that_does_not_run_may_not_hold_what_would(tmp_path: Path) -> None:
+    runner = _page(tmp_path, "```\nexpr := or\n```\n\n```\n>>> 1 + 1\n3\n```\n")
+    with pytest.raises(DocError, match=r"page.md:6: a '>>>' example in a block that does not run"):
+        runner.run()
+    assert runner.report.text_blocks == 1
+    with pytest.raises(DocError, match=r"page.md:2: a '\$ ' command in a ```text block"):
+        _page(tmp_path / "b", "```text\n$ ttt-sm ai move\n```\n").run()

@@ -54,6 +54,17 @@ def test_numbers_carry_units_converted_to_si() -> None:
     assert ev("q_true[1] < -45deg") is True
 
 
+def test_a_name_compared_with_numbers_of_one_unit_is_read_in_that_unit() -> None:
+    q1, stop = Ref(None, "q_true", 1), Ref("DriveInit1", "stop")
+    assert parse("q_true[1] > 175deg").unit_of(q1) == "deg"
+    assert parse("abs(q_true[1] - -45deg) < 1deg").unit_of(q1) == "deg"
+    assert parse("DriveInit1.stop or q_true[1] > 20 mm").unit_of(q1) == "mm"
+    assert parse("DriveInit1.stop or q_true[1] > 20 mm").unit_of(stop) is None  # in no comparison
+    assert parse("q_true[1] > 1rad + 10deg").unit_of(q1) is None  # two units: as held, SI
+    assert parse("q_true[1] > 3").unit_of(q1) is None
+    assert parse("q_true[1] > 3 and q_true[2] < 5deg").unit_of(q1) is None  # each comparison on its own
+
+
 def test_references_are_listed_with_their_column() -> None:
     expr = parse("DriveInit1.stop or q_true[2] > t")
     assert expr.refs == (Ref("DriveInit1", "stop", None, 1), Ref(None, "q_true", 2, 20),

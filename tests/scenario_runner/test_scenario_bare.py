@@ -91,9 +91,8 @@ def test_a_failing_bare_scenario_names_its_lines() -> None:
     m = [f.message for f in r.failures]
     assert m[0] == ("expect: 'Game.message == \"Wait for the model to be compiled.\"' is false; t = 0.002 s;"
                     " Game.message = 'The compilation is done wait for the manipulator to be initialized.'")
-    assert m[1].startswith("expect_states: expected Game to enter these states in this order since the start:"
-                           " compiling, your_turn; it entered compiling, initialising (no your_turn after"
-                           " compiling); Game is in initialising")
+    assert m[1] == ("expect_states: Game since the start: expected your_turn (2nd of the sequence) after"
+                    " compiling, got initialising; Game is in initialising")
     assert m[2] == ("run_until: Game did not enter game_over within 0.1 s (from t = 0.002 s to 0.102 s);"
                     " Game is in your_turn; it entered playing, your_turn meanwhile")
 

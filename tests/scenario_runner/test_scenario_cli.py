@@ -82,6 +82,20 @@ def test_a_malformed_file_exits_2_and_nothing_runs(files, capsys) -> None:
     assert json.loads(out)["errors"][0].startswith(f"{files['malformed']}:4: unknown step kind")
 
 
+def test_every_mistake_of_a_file_is_reported_one_line_each(tmp_path: Path, capsys) -> None:
+    path = tmp_path / "typos.yaml"
+    path.write_text("name: typos\nsteps:\n  - run: {seconds: 1}\n  - expect_state: {chart: DriveInit1}\n"
+                    "  - run_until: {entered: DriveInit1.turn_bak, timeout_s: 5}\n")
+    code, out, err = run_cli(capsys, "check", str(path))
+    assert code == 2 and out == ""
+    assert [line.split(": ", 3)[1:3] for line in err.splitlines()] == [
+        ["error", f"{path}:4"], ["error", f"{path}:5"]]
+    assert "unknown step kind 'expect_state'" in err.splitlines()[0]
+    assert "DriveInit1 has no state 'turn_bak' (did you mean 'turn_back'?)" in err.splitlines()[1]
+    code, out, _ = run_cli(capsys, "check", str(path), "--json")
+    assert [e.split(": ")[0] for e in json.loads(out)["errors"]] == [f"{path}:4", f"{path}:5"]
+
+
 def test_coverage_report_lists_entered_taken_and_missing(files, capsys) -> None:
     code, out, _ = run_cli(capsys, "run", str(files["passing"]), "--json", "--coverage")
     assert code == 0

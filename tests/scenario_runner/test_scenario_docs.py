@@ -15,7 +15,11 @@ SCENARIOS = ROOT / "tests" / "scenarios"
 
 
 def test_the_worked_example_is_the_scenario_file_and_every_example_loads() -> None:
-    example, *others = re.findall(r"```yaml\n(.*?)```", DOC, re.S)
+    # A file the reader saves (<!-- doc-test: file NAME -->: one with mistakes too) is run by the page's
+    # commands below it, in tests/docs/test_doc_pages.py; every other example loads.
+    blocks = re.findall(r"(<!-- doc-test: file [^>]*-->\n)?```yaml\n(.*?)```", DOC, re.S)
+    example, *others = [text for marker, text in blocks if not marker]
+    assert len(blocks) > len(others) + 1, "the files the page's commands run"
     assert example == (SCENARIOS / "drive_1_turns_back_at_a_hard_stop.yaml").read_text(encoding="utf-8")
     assert load_scenario_text(example, "docs/scenarios.md").name == "drive 1 turns back at a hard stop"
     assert others, "the bare-chart example"

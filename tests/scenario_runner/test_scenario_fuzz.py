@@ -1,6 +1,6 @@
 """The scenario loader under fuzz: any bytes, any YAML data, damaged files give ScenarioError only.
 
-Each loads to a Scenario or is refused with one line naming the file and
+Each loads to a Scenario or is refused with one line per mistake, naming the file and
 line, within the limits of docs/reliability.md.
 """
 
@@ -40,7 +40,8 @@ def load_text(text: str) -> None:
     try:
         load_scenario_text(text, "fuzz.yaml")
     except ScenarioError as exc:
-        one_line(str(exc), "fuzz.yaml")
+        for mistake in exc.errors:  # a file with several mistakes: one line each
+            one_line(str(mistake), "fuzz.yaml")
 
 
 def load_bytes(data: bytes) -> None:
@@ -50,7 +51,8 @@ def load_bytes(data: bytes) -> None:
         try:
             load_scenario(f)
         except ScenarioError as exc:
-            one_line(str(exc), str(f))
+            for mistake in exc.errors:
+                one_line(str(mistake), str(f))
 
 
 def load_data(doc: dict[str, Any]) -> None:

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from ttt_sm.scenario import ScenarioError, load_scenario, load_scenario_text, scenario_files
+from ttt_sm.scenario import ScenarioError, ScenarioErrors, load_scenario, load_scenario_text, scenario_files
+from ttt_sm.scenario.loader import TOP_KEYS
 from ttt_sm.scenario.model import (
     ExpectStatesStep,
     ExpectStep,
@@ -194,3 +195,46 @@ def test_folders_expand_to_their_yaml_files(tmp_path: Path) -> None:
         (tmp_path / name).write_text("x")
     assert [p.name for p in scenario_files([tmp_path])] == ["a.yml", "b.yaml"]
     assert scenario_files([tmp_path / "b.yaml"]) == [tmp_path / "b.yaml"]
+
+
+def test_every_mistake_of_a_file_is_reported_in_line_order_as_a_compiler_does() -> None:
+    err = error_of("""\
+        name: typos
+        seed: -1
+        steps:
+          - run_until: {entered: DriveInit1.turn_bak, timeout_s: 5}
+          - expect: "q_tru[1] > 165deg and DriveInit1.nothing"
+          - expect_state: {chart: DriveInit1, sequence: [turn_fwd]}
+          - run: {seconds: 1}
+          - expect_states: {chart: DriveInit1, sequence: [turn_fwd, turn_forward, go_parkk]}
+        """)
+    assert isinstance(err, ScenarioErrors)
+    found = [(e.line, e.message.split(" (did you mean")[0].split(";")[0]) for e in err.errors]
+    assert found == [
+        (2, "seed: expected a whole number >= 0, got number -1"),
+        (4, "run_until: DriveInit1 has no state 'turn_bak'"),
+        (5, "expect: unknown name 'q_tru'"),  # two names of one condition: two mistakes
+        (5, "expect: DriveInit1 has no datum or state 'nothing'"),
+        (6, "unknown step kind 'expect_state'"),
+        (8, "expect_states: DriveInit1 has no state 'turn_forward'"),
+        (8, "expect_states: DriveInit1 has no state 'go_parkk'"),
+    ]
+    assert str(err).splitlines() == [str(e) for e in err.errors]  # one FILE:LINE: message each
+    assert all(line.startswith("s.yaml:") for line in str(err).splitlines())
+    assert (err.line, err.message) == (err.errors[0].line, err.errors[0].message)  # the first, for one-line use
+
+
+def test_what_the_rest_cannot_be_read_without_stops_the_reading() -> None:
+    # a misspelt steps: is one mistake, not also a missing steps:
+    err = error_of("name: n\nstep:\n  - run: {seconds: 1}\n")
+    assert [str(e) for e in err.errors] == ["s.yaml:2: scenario: unknown key 'step' (did you mean 'steps'?);"
+                                            " keys: " + ", ".join(TOP_KEYS)]
+    # unknown bare charts: the steps cannot be checked against them; the mistakes before are kept
+    err = error_of("name: n\nseed: x\nchart: Gam\nsteps:\n  - expect: Gam.ready\n")
+    assert [(e.line, e.message.split(" (")[0]) for e in err.errors] == [
+        (2, "seed: expected a whole number >= 0, got text 'x'"), (3, "chart: unknown chart 'Gam'")]
+    # a mistake within a step stops that step only: the next step is checked
+    err = error_of(S + "  - post: {chart: Control, evnt: button, dat: {}}\n  - run: {seconds: -1}\n")
+    assert [(e.line, e.message.split(";")[0]) for e in err.errors] == [
+        (3, "post: unknown key 'evnt' (did you mean 'event'?)"), (3, "post: unknown key 'dat' (did you mean 'data'?)"),
+        (4, "run: seconds must be > 0, got -1")]

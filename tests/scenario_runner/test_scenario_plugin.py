@@ -18,9 +18,10 @@ steps:
   - expect: "DriveInit1.stopped"
 """
 MALFORMED = """\
-name: a typo
+name: two typos
 steps:
   - run_until: {entered: DriveInit1.turn_back}
+  - expect: "q_tru[1] > 0"
 """
 
 
@@ -43,6 +44,7 @@ def test_scenario_files_are_collected_and_fail_with_file_line(pytester) -> None:
         "scenarios/drive_1_turns_back_at_once.yaml::drive_1_turns_back_at_once FAILED*",
         "scenario file is not valid:",
         "  scenarios/a_typo.yaml:3: run_until: missing timeout_s:*",
+        "  scenarios/a_typo.yaml:4: expect: unknown name 'q_tru'*",  # every mistake of the file
         "scenario 'drive 1 turns back at once' failed (3 of 3 steps run, t = 0.004 s):",
         "  scenarios/drive_1_turns_back_at_once.yaml:4: expect: 'DriveInit1.turn_back' is false*",
         "  scenarios/drive_1_turns_back_at_once.yaml:5: expect: 'DriveInit1.stopped' is false*",

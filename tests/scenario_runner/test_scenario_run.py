@@ -60,9 +60,9 @@ def test_failures_name_the_failing_steps_and_expectations_do_not_stop_the_run() 
     texts = [str(f) for f in r.failures]
     assert texts[0].startswith("s.yaml:4: expect: 'DriveInit1.turn_back or q_true[1] > 10deg' is false;")
     assert "t = 0.004 s; DriveInit1.turn_back = false; q_true[1] = " in texts[0]
-    assert texts[1] == ("s.yaml:5: expect_states: expected DriveInit1 to enter these states in this"
-                        " order since the start: turn_fwd, turn_back; it entered run, initialise, power_on,"
-                        " turn_fwd (no turn_back after turn_fwd); DriveInit1 is in turn_fwd")
+    # the first state of the sequence not entered, and what came instead of it (here: nothing)
+    assert texts[1] == ("s.yaml:5: expect_states: DriveInit1 since the start: expected turn_back (2nd of the"
+                        " sequence) after turn_fwd, got nothing; DriveInit1 is in turn_fwd")
     assert texts[2].startswith("s.yaml:6: run_until: DriveInit1 did not enter go_park within 0.2 s"
                                " (from t = 0.004 s to 0.204 s); DriveInit1 is in turn_fwd;"
                                " it entered no state meanwhile")
@@ -125,9 +125,55 @@ def test_mark_starts_a_new_window() -> None:
           - expect_states: {chart: DriveInit1, sequence: [stopped], match: exact}
         """)
     assert lines(r) == [5, 12]
-    assert "since mark 'turning' (line 4)" in r.failures[0].message
-    assert "it entered nothing" in r.failures[0].message
-    assert "it entered stopped, turn_fwd (not exactly those)" in r.failures[1].message
+    assert r.failures[0].message == ("expect_states: DriveInit1 since mark 'turning' (line 4): expected turn_fwd"
+                                     " (1st of the sequence), got nothing; DriveInit1 is in turn_fwd")
+    assert r.failures[1].message == ("expect_states: DriveInit1's 2nd leaf state since mark 'turning' (line 4):"
+                                     " expected none, got turn_fwd (expected stopped, [none]; entered stopped,"
+                                     " [turn_fwd]); DriveInit1 is in turn_fwd")
+
+
+def test_a_failed_condition_shows_values_in_the_unit_it_compares_them_with() -> None:
+    r = run("""\
+        name: too far
+        steps:
+          - run_until: {entered: DriveInit1.turn_back, timeout_s: 5}
+          - expect: "q_true[1] > 175deg or DriveInit1.pos_out > 100"
+          - expect: "abs(DriveInit1.pos_Encoder - 175deg) < 20mm"
+        """)
+    assert [str(f) for f in r.failures] == [
+        # the hard stop at 170 deg, read as the expectation reads it; pos_out beside a bare number: SI (rad)
+        "s.yaml:4: expect: 'q_true[1] > 175deg or DriveInit1.pos_out > 100' is false; t = 3.016 s;"
+        " q_true[1] = 170deg; DriveInit1.pos_out = 2.97021",
+        # two units in one comparison: the value as the chart holds it
+        "s.yaml:5: expect: 'abs(DriveInit1.pos_Encoder - 175deg) < 20mm' is false; t = 3.016 s;"
+        " DriveInit1.pos_Encoder = 2.97021"]
+
+
+def test_expect_states_points_at_the_first_state_that_differs() -> None:
+    r = run("""\
+        name: wrong sequences
+        steps:
+          - run_until: {entered: DriveInit1.turn_back, timeout_s: 5}
+          - expect_states: {chart: DriveInit1, sequence: [power_on, turn_fwd, go_park, wait_23], match: exact}
+          - expect_states: {chart: DriveInit1, sequence: [power_on, turn_fwd, turn_back, go_park], match: exact}
+          - expect_states: {chart: DriveInit1, sequence: [power_on], match: exact}
+          - expect_states: {chart: DriveInit1, sequence: [turn_fwd, go_park, turn_back]}
+          - expect_states: {chart: DriveInit1, sequence: [power_on, turn_fwd, turn_back], match: exact}
+        """)
+    messages = [f.message.split("; DriveInit1 is in ")[0] for f in r.failures]
+    assert lines(r) == [4, 5, 6, 7]
+    assert messages == [
+        # which state (the 3rd), what was expected, what came; the two lists around it
+        "expect_states: DriveInit1's 3rd leaf state since the start: expected go_park, got turn_back"
+        " (expected power_on, turn_fwd, [go_park], wait_23; entered power_on, turn_fwd, [turn_back])",
+        "expect_states: DriveInit1's 4th leaf state since the start: expected go_park, got none"
+        " (expected ..., turn_fwd, turn_back, [go_park]; entered ..., turn_fwd, turn_back, [none])",
+        "expect_states: DriveInit1's 2nd leaf state since the start: expected none, got turn_fwd"
+        " (expected power_on, [none]; entered power_on, [turn_fwd], turn_back)",
+        # in order, others between: the first one missing, and what came after the one before it
+        "expect_states: DriveInit1 since the start: expected go_park (2nd of the sequence) after turn_fwd,"
+        " got turn_back"]
+    assert all(f.message.endswith("; DriveInit1 is in turn_back") for f in r.failures)
 
 
 def test_an_input_the_wiring_feeds_needs_force() -> None:

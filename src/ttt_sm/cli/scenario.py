@@ -51,7 +51,7 @@ def _load_all(files: list[str]) -> tuple[list[Scenario], list[ScenarioError]]:
         try:
             scenarios.append(load_scenario(path))
         except ScenarioError as exc:
-            errors.append(exc)
+            errors.extend(exc.errors)  # every mistake of the file, one line each
     return scenarios, errors
 
 

@@ -165,6 +165,8 @@ class _Parser:
         self.pos = 0
         self.refs: list[Ref] = []
         self.depth = 0
+        self.units: list[str] = []  # the units written after numbers, in order
+        self.ref_units: dict[str, str] = {}  # a name compared with numbers of one unit: that unit
 
     @property
     def tok(self) -> _Tok:
@@ -222,12 +224,18 @@ class _Parser:
         return self.parse_compare()
 
     def parse_compare(self) -> Node:
+        refs0, units0 = len(self.refs), len(self.units)
         operands = [self.parse_sum()]
         ops: list[str] = []
         while self.tok.kind == "op" and self.tok.text in _COMPARE:
             ops.append(self.tok.text)
             self.pos += 1
             operands.append(self.parse_sum())
+        written = set(self.units[units0:])
+        if ops and len(written) == 1:  # q_true[1] > 175deg: q_true[1] is read in degrees
+            unit = written.pop()
+            for ref in self.refs[refs0:]:
+                self.ref_units.setdefault(str(ref), unit)
         return operands[0] if not ops else ("compare", tuple(ops), tuple(operands))
 
     def parse_sum(self) -> Node:
@@ -271,6 +279,7 @@ class _Parser:
             if unit.kind == "name" and unit.text in UNITS:
                 self.pos += 1
                 value = value * UNITS[unit.text]
+                self.units.append(unit.text)
             elif unit.kind == "name" and unit.text not in KEYWORDS:
                 raise self.error(f"unknown unit {unit.text!r}; units: {', '.join(UNITS)}", unit)
             return ("const", value)
@@ -407,6 +416,13 @@ class Expression:
     text: str
     tree: Node
     refs: tuple[Ref, ...]
+    #: Each name compared with numbers written in one unit (``q_true[1] > 175deg``): that unit.
+    units: tuple[tuple[str, str], ...] = ()
+
+    def unit_of(self, ref: Ref) -> str | None:
+        """The unit of the numbers ``ref`` is compared with (``deg``, ``mm`` ...), if they have one:
+        a message shows the value in it (``q_true[1] = 170.002deg`` beside ``175deg``)."""
+        return dict(self.units).get(str(ref))
 
     def bind(self, get: Callable[[Ref], Callable[[], Any]]) -> Callable[[], Any]:
         """A fast evaluator: ``get(ref)`` returns a getter per name, called once per name here.
@@ -433,4 +449,4 @@ def parse(text: str) -> Expression:
                         text[:40] + "...")
     parser = _Parser(text)
     tree = parser.parse()
-    return Expression(text, tree, tuple(parser.refs))
+    return Expression(text, tree, tuple(parser.refs), tuple(parser.ref_units.items()))

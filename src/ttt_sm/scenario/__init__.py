@@ -16,7 +16,7 @@ See ``docs/scenarios.md``.
 """
 
 from ..runtime.conditions import ExprError, Expression, Ref, parse
-from .errors import ScenarioError
+from .errors import ScenarioError, ScenarioErrors
 from .loader import load_scenario, load_scenario_text, scenario_files
 from .model import SIGNALS, Catalog, Scenario
 from .runner import Failure, ScenarioResult, run_scenario
@@ -32,6 +32,7 @@ __all__ = [
     "RunReport",
     "Scenario",
     "ScenarioError",
+    "ScenarioErrors",
     "ScenarioResult",
     "coverage_dict",
     "load_scenario",

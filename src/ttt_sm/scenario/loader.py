@@ -3,8 +3,14 @@
 Every mistake is a :class:`~.errors.ScenarioError` naming the file and the line:
 an unknown step kind, chart, state, datum, event or signal (with the names
 there are, and a guess at what was meant), a value of the wrong type, a missing
-``timeout_s``, a condition that does not parse.  Nothing runs before the whole
-file is known to be right.
+``timeout_s``, a condition that does not parse.  As a compiler does, the loader
+reads the whole file and reports every mistake in one pass
+(:class:`~.errors.ScenarioErrors`, one ``FILE:LINE: message`` each): a mistake
+in one step does not hide those of the next; a mistake within a step stops
+only that part of it (one key, one name of a list).  Only a mistake the rest
+cannot be read without stops the reading: YAML that does not parse, a file
+that is no mapping, ``chart:``/``charts:`` naming no chart.  Nothing runs before
+the whole file is known to be right.
 
 A scenario with ``chart: Name`` or ``charts: [A, B]`` (or ``charts: {a: A, b: A}``,
 instances named by the scenario) runs those charts alone
@@ -15,16 +21,17 @@ them).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import reprlib
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
 from ..runtime import TickChart
 from ..runtime.conditions import KEYWORDS, ExprError, Expression, parse
 from ..runtime.errors import suggest
-from .errors import ScenarioError
+from .errors import ScenarioError, ScenarioErrors
 from .model import (
     DEFAULT_MAX_STEP_S,
     BareCharts,
@@ -93,11 +100,12 @@ def _is_number(value: Any) -> bool:
 
 
 class _Checker:
-    """Turns the YAML data of one file into a :class:`Scenario`, or raises at the first mistake."""
+    """Turns the YAML data of one file into a :class:`Scenario`, or raises with every mistake in it."""
 
     def __init__(self, file: str, catalog: Catalog) -> None:
         self.file = file
         self.catalog = catalog
+        self.mistakes: list[ScenarioError] = []
         self.bare: BareCharts | None = None
         self.max_step_s = DEFAULT_MAX_STEP_S
         #: The charts the steps may name: the robot's, or the bare ones.
@@ -119,38 +127,69 @@ class _Checker:
     def error(self, line: int, message: str) -> ScenarioError:
         return ScenarioError(self.file, line, message)
 
+    @contextlib.contextmanager
+    def going_on(self) -> Iterator[None]:
+        """A part of the file checked on its own: a mistake in it is noted, and checking goes on after it."""
+        try:
+            yield
+        except ScenarioError as exc:
+            self.mistakes.extend(exc.errors)
+
     # -- top level -------------------------------------------------------------------
 
     def scenario(self, doc: Any) -> Scenario:
+        """The scenario, or :class:`ScenarioError` (one mistake) / :class:`ScenarioErrors` (several)."""
+        scenario: Scenario | None = None
+        with self.going_on():  # a mistake that stops the reading is the last one noted
+            scenario = self.whole(doc)
+        if self.mistakes or scenario is None:
+            raise ScenarioErrors.of(self.mistakes)
+        return scenario
+
+    def whole(self, doc: Any) -> Scenario | None:
         if not isinstance(doc, MarkedDict):
             line = getattr(doc, "line", 1)
             raise self.error(line, "a scenario file is a mapping with name: and steps: (got "
                                    f"{_type_name(doc)})")
-        self.keys(doc, TOP_KEYS, "scenario")
+        unknown = [k for k in doc if k not in TOP_KEYS]
+        with self.going_on():
+            self.keys(doc, TOP_KEYS, "scenario")
         for key in ("name", "steps"):
-            if key not in doc:
-                raise self.error(doc.line, f"missing {key}:")
-        name = self.text(doc, "name")
-        description = self.text(doc, "description") if "description" in doc else ""
-        seed = doc.get("seed", 0)
-        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            raise self.error(doc.line_of("seed"),
-                             f"seed: expected a whole number >= 0, got {_type_name(seed)}")
-        if "max_step_s" in doc:
-            self.max_step_s = self.number(doc, "max_step_s", "max_step_s", bounded=False)
-        self.bare = self.bare_charts(doc)
-        if self.bare is not None:
-            self.charts = self.bare.charts
-            if "start" in doc:
-                raise self.error(doc.line_of("start"), f"start: {self.bare_mode}, without the arm: there is"
-                                                       " no pose to start from")
-        start = self.start(doc["start"], doc.line_of("start")) if "start" in doc else Start()
+            if key not in doc and not any(suggest(k, (key,)) for k in unknown):  # 'step:' is told once
+                self.mistakes.append(self.error(doc.line, f"missing {key}:"))
+        name, description, seed, start = "", "", 0, Start()
+        with self.going_on():
+            name = self.text(doc, "name") if "name" in doc else ""
+        with self.going_on():
+            description = self.text(doc, "description") if "description" in doc else ""
+        with self.going_on():
+            seed = doc.get("seed", 0)
+            if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+                raise self.error(doc.line_of("seed"),
+                                 f"seed: expected a whole number >= 0, got {_type_name(seed)}")
+        with self.going_on():
+            if "max_step_s" in doc:
+                self.max_step_s = self.number(doc, "max_step_s", "max_step_s", bounded=False)
+        self.bare = self.bare_charts(doc)  # the steps cannot be checked without knowing their charts
+        with self.going_on():
+            if self.bare is not None:
+                self.charts = self.bare.charts
+                if "start" in doc:
+                    raise self.error(doc.line_of("start"), f"start: {self.bare_mode}, without the arm: there"
+                                                           " is no pose to start from")
+            start = self.start(doc["start"], doc.line_of("start")) if "start" in doc else Start()
+        if "steps" not in doc:
+            return None
         steps_data = doc["steps"]
         if not isinstance(steps_data, MarkedList) or not steps_data:
             raise self.error(doc.line_of("steps"), "steps: expected a list of steps, each starting with '- '")
-        steps = tuple(self.step(item, line) for item, line in zip(steps_data, steps_data.item_lines,
-                                                                      strict=True))
-        return Scenario(name=name, file=self.file, steps=steps, description=description, seed=seed,
+        steps = []
+        for item, line in zip(steps_data, steps_data.item_lines, strict=True):
+            with self.going_on():  # each step on its own: a mistake in one does not hide the next's
+                steps.append(self.step(item, line))
+        if self.mistakes:
+            return None
+        return Scenario(name=name, file=self.file, steps=tuple(steps), description=description, seed=seed,
                         start=start, where=Where(self.file, doc.line), bare=self.bare, max_step_s=self.max_step_s)
 
     def bare_charts(self, doc: MarkedDict) -> BareCharts | None:
@@ -195,11 +234,13 @@ class _Checker:
         return BareCharts(charts, Where(self.file, line))
 
     def keys(self, mapping: MarkedDict, allowed: Iterable[str], what: str) -> None:
+        """Raise at the unknown keys of ``mapping``, all of them."""
         allowed = tuple(allowed)
-        for key in mapping:
-            if key not in allowed:
-                raise self.error(mapping.key_lines[key], f"{what}: unknown key {_r(key)}{suggest(key, allowed)};"
-                                                         f" keys: {', '.join(allowed)}")
+        unknown = [self.error(mapping.key_lines[key], f"{what}: unknown key {_r(key)}{suggest(key, allowed)};"
+                                                      f" keys: {', '.join(allowed)}")
+                   for key in mapping if key not in allowed]
+        if unknown:
+            raise ScenarioErrors.of(unknown)
 
     def text(self, mapping: MarkedDict, key: str) -> str:
         value = mapping[key]
@@ -270,17 +311,21 @@ class _Checker:
             raise self.error(item.line_of("force"), f"force: expected true or false, got {_type_name(force)}")
         values = []
         for key, v in value.items():
-            ref = self.chart_ref(key, value.key_lines[key], "set", want="input")
-            decl = next(d for d in self.charts[ref.chart].declarations() if d.name == ref.name)
-            default = decl.default
-            if isinstance(default, bool) and not isinstance(v, bool):
-                raise self.error(value.line_of(key), f"set: {ref} is a flag: expected true or false,"
-                                                     f" got {_type_name(v)}")
-            if _is_number(default) and not isinstance(default, bool) and not _is_number(v):
-                raise self.error(value.line_of(key), f"set: {ref} is a number ({decl.unit}): expected a"
-                                                     f" number, got {_type_name(v)}")
-            values.append((ref, float(v) if _is_number(default) and not isinstance(default, bool) else v))
+            with self.going_on():  # each input on its own
+                values.append(self.set_value(key, v, value))
         return SetStep(where, tuple(values), force)
+
+    def set_value(self, key: Any, v: Any, value: MarkedDict) -> tuple[ChartRef, Any]:
+        ref = self.chart_ref(key, value.key_lines[key], "set", want="input")
+        decl = next(d for d in self.charts[ref.chart].declarations() if d.name == ref.name)
+        default = decl.default
+        if isinstance(default, bool) and not isinstance(v, bool):
+            raise self.error(value.line_of(key), f"set: {ref} is a flag: expected true or false,"
+                                                 f" got {_type_name(v)}")
+        if _is_number(default) and not isinstance(default, bool) and not _is_number(v):
+            raise self.error(value.line_of(key), f"set: {ref} is a number ({decl.unit}): expected a"
+                                                 f" number, got {_type_name(v)}")
+        return ref, float(v) if _is_number(default) and not isinstance(default, bool) else v
 
     def step_release(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
         if self.bare is not None:
@@ -290,9 +335,11 @@ class _Checker:
         lines = value.item_lines if isinstance(value, MarkedList) else [line]
         if not names:
             raise self.error(line, "release: expected Chart.input or a list of them")
-        refs = tuple(self.chart_ref(n, n_line, "release", want="input") for n, n_line in zip(names, lines,
-                                                                                                 strict=True))
-        return ReleaseStep(where, refs)
+        refs = []
+        for n, n_line in zip(names, lines, strict=True):
+            with self.going_on():  # each name on its own
+                refs.append(self.chart_ref(n, n_line, "release", want="input"))
+        return ReleaseStep(where, tuple(refs))
 
     def step_post(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
         if not isinstance(value, MarkedDict):
@@ -386,11 +433,12 @@ class _Checker:
                                                         f" names, got {_type_name(seq)}")
         states = chart_states(self.charts[chart])
         for name, n_line in zip(seq, seq.item_lines, strict=True):
-            self.state_name(chart, name, n_line, "expect_states", states)
-            if match == "exact" and states[name] == "compound":
-                raise self.error(n_line, f"expect_states: {chart}.{name} is a compound state; an exact"
-                                         " sequence lists the leaf states entered (use match: subsequence"
-                                         " to include compound states)")
+            with self.going_on():  # each name on its own
+                self.state_name(chart, name, n_line, "expect_states", states)
+                if match == "exact" and states[name] == "compound":
+                    raise self.error(n_line, f"expect_states: {chart}.{name} is a compound state; an exact"
+                                             " sequence lists the leaf states entered (use match: subsequence"
+                                             " to include compound states)")
         return ExpectStatesStep(where, chart, tuple(seq), match)
 
     def step_mark(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
@@ -451,8 +499,9 @@ class _Checker:
             expr = parse(text)
         except ExprError as exc:
             raise self.error(line, f"{what}: {exc}") from None
-        for ref in expr.refs:
-            self.expr_ref(ref, expr, line, what)
+        for ref in dict.fromkeys(expr.refs):
+            with self.going_on():  # each name on its own: two typos, two messages
+                self.expr_ref(ref, expr, line, what)
         return expr
 
     def expr_ref(self, ref: Any, expr: Expression, line: int, what: str) -> None:

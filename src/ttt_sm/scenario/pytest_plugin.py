@@ -97,7 +97,7 @@ class ScenarioItem(pytest.Item):
                    f" t = {r.sim_time_s:.3f} s):"
             return "\n".join([head, *(f"  {f}" for f in r.failures)])
         if isinstance(exc, ScenarioError):
-            return f"scenario file is not valid:\n  {exc}"
+            return "scenario file is not valid:\n" + "\n".join(f"  {e}" for e in exc.errors)
         return str(super().repr_failure(excinfo))
 
     def reportinfo(self) -> tuple[Path, int, str]:

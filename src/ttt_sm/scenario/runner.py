@@ -28,7 +28,7 @@ import numpy as np
 
 from ..params import ArmParams
 from ..runtime import TickChart, states_entered_by
-from ..runtime.conditions import ExprError, Expression, Ref
+from ..runtime.conditions import UNITS, ExprError, Expression, Ref
 from ..runtime.listeners import Coverage
 from .model import (
     BareCharts,
@@ -217,9 +217,12 @@ class _Stop(Exception):
     """Ends a scenario at a failure the next steps cannot build on."""
 
 
-def _fmt(value: Any) -> str:
+def _fmt(value: Any, unit: str | None = None) -> str:
+    """A value as a message shows it; a number in ``unit`` (``170.002deg``) when the condition wrote one."""
     if isinstance(value, (bool, np.bool_)):
         return "true" if value else "false"
+    if unit is not None and isinstance(value, (int, float, np.integer, np.floating)):
+        return f"{float(value) / UNITS[unit]:.6g}{unit}"
     if isinstance(value, (float, np.floating)):
         return f"{float(value):.6g}"
     if isinstance(value, (int, np.integer)):
@@ -231,16 +234,45 @@ def _seconds(s: float) -> str:
     return f"{s:g} s"
 
 
-def _subsequence_gap(expected: Sequence[str], actual: Sequence[str]) -> str | None:
-    """None if `expected` is a subsequence of `actual`, else what is missing."""
+def _subsequence_gap(expected: Sequence[str], actual: Sequence[str]) -> tuple[int, int] | None:
+    """None if `expected` is a subsequence of `actual`, else (k, start): expected[k] is not in
+    `actual` from index `start` on (just after where expected[k - 1] was found)."""
     pos = 0
     for k, state in enumerate(expected):
         try:
             pos = actual.index(state, pos) + 1
         except ValueError:
-            after = f" after {expected[k - 1]}" if k else ""
-            return f"no {state}{after}"
+            return k, pos
     return None
+
+
+def _first_difference(expected: Sequence[str], actual: Sequence[str]) -> int | None:
+    """The index where two sequences first differ (or one of them ends), None if they are equal."""
+    for k, (a, b) in enumerate(zip(expected, actual, strict=False)):
+        if a != b:
+            return k
+    return None if len(expected) == len(actual) else min(len(expected), len(actual))
+
+
+def _ordinal(n: int) -> str:
+    suffix = "th" if 10 <= n % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(n % 10, "th")
+    return f"{n}{suffix}"
+
+
+def _around(states: Sequence[str], k: int, width: int = 2) -> str:
+    """The states around index k, the k-th in brackets: ``..., power_on, turn_fwd, [go_park], wait_23``;
+    ``[none]`` where the list has ended."""
+    lo, hi = max(0, k - width), min(len(states), k + width + 1)
+    shown = [f"[{s}]" if i == k else s for i, s in enumerate(states[lo:hi], start=lo)]
+    if k >= len(states):
+        shown.append("[none]")
+    return ", ".join([*(["..."] if lo else []), *shown, *(["..."] if hi < len(states) else [])])
+
+
+def _listed(states: Sequence[str], most: int = 6) -> str:
+    """``a, b, c`` (at most ``most`` of them, then how many more), or ``nothing``."""
+    more = f", ... ({len(states) - most} more)" if len(states) > most else ""
+    return ", ".join(states[:most]) + more if states else "nothing"
 
 
 class _Run:
@@ -352,8 +384,8 @@ class _Run:
         """The names a condition reads, with their values now."""
         seen: dict[str, str] = {}
         for ref in expr.refs:
-            if str(ref) not in seen:
-                seen[str(ref)] = _fmt(self.getter(ref)())
+            if str(ref) not in seen:  # in the unit of the numbers it is compared with: 175deg, degrees
+                seen[str(ref)] = _fmt(self.getter(ref)(), expr.unit_of(ref))
         listed = "; ".join(f"{k} = {v}" for k, v in seen.items())
         return f"t = {self.robot.t:.3f} s" + (f"; {listed}" if listed else "")
 
@@ -442,24 +474,30 @@ class _Run:
             self.fail(step, f"expect: {text!r} is false; {self.values(step.condition)}")
 
     def do_expect_states(self, step: ExpectStatesStep) -> None:
-        entries = self.log.entries.get(step.chart, [])[self.mark.get(step.chart, 0):]
+        """Fail at the first state that is not as expected: which one, what was expected, what came."""
+        chart, since = step.chart, self.mark_label
+        entries = self.log.entries.get(chart, [])[self.mark.get(chart, 0):]
         actual = [e.state for e in entries]
         expected = list(step.sequence)
         if step.match == "exact":
-            kinds = chart_states(type(self.robot.chart(step.chart)))
+            kinds = chart_states(type(self.robot.chart(chart)))
             actual = [s for s in actual if kinds.get(s) == "leaf"]
-            if actual == expected:
+            k = _first_difference(expected, actual)
+            if k is None:
                 return
-            problem = "not exactly those"
+            want = expected[k] if k < len(expected) else "none"
+            got = actual[k] if k < len(actual) else "none"
+            problem = (f"{chart}'s {_ordinal(k + 1)} leaf state since {since}: expected {want}, got {got}"
+                       f" (expected {_around(expected, k)}; entered {_around(actual, k)})")
         else:
             gap = _subsequence_gap(expected, actual)
             if gap is None:
                 return
-            problem = gap
-        order = "exactly these leaf states" if step.match == "exact" else "these states in this order"
-        self.fail(step, f"expect_states: expected {step.chart} to enter {order} since {self.mark_label}:"
-                        f" {', '.join(expected)}; it entered {', '.join(actual) or 'nothing'}"
-                        f" ({problem}); {self.where_is(step.chart)}")
+            k, start = gap
+            after = f" after {expected[k - 1]}" if k else ""
+            problem = (f"{chart} since {since}: expected {expected[k]} ({_ordinal(k + 1)} of the"
+                       f" sequence){after}, got {_listed(actual[start:])}")
+        self.fail(step, f"expect_states: {problem}; {self.where_is(chart)}")
 
     def do_mark(self, step: MarkStep) -> None:
         self.mark = {name: len(self.log.entries.get(name, [])) for name in self.robot.charts}

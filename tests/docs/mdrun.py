@@ -18,8 +18,9 @@ A page is read top to bottom; each fenced code block is one of:
   conditions) against the charts; ``json``: parsed;
 - anything else (formulas, grammars, a command's synopsis, file formats):
   text, not run, and counted in the report.  A text block may not hold what
-  would run elsewhere: ``>>>`` examples belong in a ``python`` block, a
-  ``$ `` command in a transcript.
+  would run elsewhere (``>>>`` examples belong in a ``python`` block, a
+  ``$ `` command in a transcript), nor follow prose that ends in "prints"
+  without the marker that compares it (below).
 
 Matching: line by line after collapsing runs of spaces; ``...`` alone on a
 line stands for any number of lines, ``...`` inside a line for any text
@@ -100,6 +101,7 @@ class Block:
     lines: list[str]
     markers: list[str] = field(default_factory=list)  # doc-test markers just before it
     checks: list[tuple[int, str]] = field(default_factory=list)  # check markers after it, with lines
+    lead: str = ""  # the last line of prose before it ("prints", "Run it:")
 
 
 @dataclass
@@ -156,7 +158,8 @@ def read_blocks(text: str, page: str) -> list[Block]:
         if j == len(lines):
             raise DocError(f"{page}:{i + 1}: a code block that is never closed")
         code = [line[indent:] if not line[:indent].strip() else line.lstrip(" ") for line in lines[i + 1:j]]
-        blocks.append(Block(m.group(2), i + 2, code))
+        prose = [t.strip() for _, t in outside if t.strip() and not _MARKER.fullmatch(t.strip())]
+        blocks.append(Block(m.group(2), i + 2, code, lead=prose[-1] if prose else ""))
         outside.append((i + 1, "\0BLOCK"))
         i = j + 1
     # Markers: a doc-test marker belongs to the next block, a check to the previous one.
@@ -411,7 +414,12 @@ class PageRunner:
         self.report.files_written += 1
 
     def text(self, block: Block) -> None:
-        """A block that is not run: it may not hold what would run in another block."""
+        """A block that is not run: it may not hold what would run in another block, nor be what the prose
+        says a block above prints (``... prints``) without being compared with it."""
+        if re.search(r"\bprints:?$", block.lead):
+            raise DocError(f"{self.where(block.line - 1)}: the page says this is what is printed, but nothing"
+                           " compares it: put '<!-- doc-test: printed by the block above -->' before it (after a"
+                           " python block), or show the command as a transcript ('$ ...')")
         for k, line in enumerate(block.lines):
             if line.lstrip().startswith(">>> "):
                 raise DocError(f"{self.where(block.line + k)}: a '>>>' example in a block that does not run:"

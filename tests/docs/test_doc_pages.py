@@ -135,3 +135,11 @@ def test_a_block_that_does_not_run_may_not_hold_what_would(tmp_path: Path) -> No
     assert runner.report.text_blocks == 1
     with pytest.raises(DocError, match=r"page.md:2: a '\$ ' command in a ```text block"):
         _page(tmp_path / "b", "```text\n$ ttt-sm ai move\n```\n").run()
+    # what the prose says a block prints is compared with it, or refused
+    printed = "```python\nprint(6 * 7)\n```\n\nprints\n\n```\n{}\n```\n"
+    with pytest.raises(DocError, match="page.md:7: the page says this is what is printed, but nothing compares"):
+        _page(tmp_path / "c", printed.format(42)).run()
+    marked = printed.replace("prints\n", "prints\n<!-- doc-test: printed by the block above -->\n")
+    assert _page(tmp_path / "d", marked.format(42)).run().outputs_compared == 1
+    with pytest.raises(DocError, match="the page says '41', it printed '42'"):
+        _page(tmp_path / "e", marked.format(41)).run()

@@ -72,8 +72,8 @@ def test_the_highlighted_states_are_the_robots_configuration_at_the_paused_tick(
         page: Any, cockpit: Cockpit) -> None:
     open_cockpit(page, cockpit)
     go_to_tick(page, 0)
-    page.get_by_label("Breakpoint spec").fill("when DriveInit1.pos_Encoder > 90deg")
-    page.get_by_role("button", name="Add", exact=True).click()
+    page.get_by_label("Condition", exact=True).fill("DriveInit1.pos_Encoder > 90deg")  # the condition language
+    page.get_by_role("button", name="Add condition").click()
     page.get_by_role("button", name="Run", exact=True).click()
     page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
     tick = shown_tick(page)

@@ -41,7 +41,8 @@ def test_serve_then_read_as_json(tmp_path, capsys):
     frames = read_doc["frames"]
     assert len(frames) == 3 and all(len(f["percentages"]) == 25 for f in frames)
     assert frames[0]["percentages"][0] > 10 and frames[0]["percentages"][1] < 10  # the demo board: X at 1,1
-    assert read_doc["stats"]["frames_ok"] == 3 and read_doc["stats"]["rejected_total"] == 0
+    # frames_ok counts every valid frame received: a busy machine may deliver a 4th in the chunk holding the 3rd
+    assert read_doc["stats"]["frames_ok"] >= 3 and read_doc["stats"]["rejected_total"] == 0
     assert serve_doc["stats"]["frames_sent"] >= 3 and serve_doc["link"] == link
 
 

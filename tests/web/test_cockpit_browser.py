@@ -92,13 +92,13 @@ def test_a_click_breakpoint_stops_the_run_at_the_tick_the_state_is_entered(page:
     open_cockpit(page, cockpit)
     go_to_tick(page, 0)
     show(page, "DriveInit1")
-    page.locator('[data-state="DriveInit1.run.initialise.turn_back"]').click()
+    page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]').click()
     page.get_by_role("menuitem", name="Break on entering DriveInit1.run.initialise.turn_back").click()
     page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
     page.get_by_role("button", name="Run", exact=True).click()
     page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
     assert shown_tick(page) == expected
-    assert page.locator('[data-state="DriveInit1.run.initialise.turn_back"]').get_attribute("data-active") == "true"
+    assert page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]').get_attribute("data-active") == "true"
     edge = page.locator('[data-transition~="DriveInit1.turn_fwd->turn_back"]').first
     assert int(edge.get_attribute("data-taken-count")) == 1
     cockpit.session.call(lambda d: d.delete())

@@ -60,7 +60,7 @@ def test_the_screenshots_of_the_guide(browser: Any, cockpit: Cockpit, folder: Pa
         go_to_tick(page, 0)
         show(page, "DriveInit1")
         wait_ready(page, top="DriveInit1.run")
-        page.locator('[data-state="DriveInit1.run.initialise.turn_back"]').click()
+        page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]').click()
         page.wait_for_selector('[data-role="menu"]:not([hidden])')
         page.screenshot(path=str(folder / SHOTS[2]))
         page.keyboard.press("Escape")

@@ -31,14 +31,14 @@ def test_the_tutorials_browser_path_stops_where_it_says(page: Any, cockpit: Cock
     go_to_tick(page, 0)
     page.wait_for_function("document.querySelector('[data-role=status]').textContent.startsWith('replayed to step 0')")
     show(page, "DriveInit1")
-    page.locator('[data-state="DriveInit1.run.initialise.turn_back"]').click()
+    page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]').click()
     page.get_by_role("menuitem", name=menu.group(1)).click()
     page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
     page.get_by_role("button", name="Run", exact=True).click()
     page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
     shown = page.locator('[data-role="status"]').text_content()
     assert " ".join(status.group(1).split()) in shown, shown
-    assert page.locator('[data-state="DriveInit1.run.initialise.turn_back"]').get_attribute("data-active") == "true"
+    assert page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]').get_attribute("data-active") == "true"
     edge = page.locator('[data-transition~="DriveInit1.turn_fwd->turn_back"]').first
     assert edge.get_attribute("data-taken-count") == "1"
     assert "`q_true` (simulation only) at 170 deg" in " ".join(text.split())

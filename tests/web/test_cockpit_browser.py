@@ -301,3 +301,27 @@ def test_a_stall_at_real_time_is_counted_and_shown_never_hidden(page: Any, cockp
     page.wait_for_function(f"document.querySelector('[data-role=pace]').dataset.overruns === '{after.overruns}'")
     assert f"{after.slips} slip" in pace.text_content() and "s lost" in pace.text_content()
     page.get_by_label("Speed", exact=True).select_option("max")
+
+
+def test_a_leaving_breakpoint_by_click_and_the_timeline_of_the_shown_chart(page: Any, cockpit: Cockpit) -> None:
+    ref = Debugger.build(load_params(), seed=0)
+    ref.add_breakpoint("exit DriveInit1.turn_fwd")
+    expected = ref.run(30).chart_ticks
+    open_cockpit(page, cockpit)
+    go_to_tick(page, 0)
+    show(page, "DriveInit1")
+    page.locator('[data-state="DriveInit1.run.initialise.turn_fwd"]').click()
+    page.get_by_role("menuitem", name="Break on leaving DriveInit1.run.initialise.turn_fwd").click()
+    page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
+    page.get_by_role("button", name="Run", exact=True).click()
+    page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
+    assert shown_tick(page) == expected
+    assert page.locator('[data-state="DriveInit1.run.initialise.turn_fwd"]').get_attribute("data-active") == "false"
+    # the timeline of DriveInit1 (asked for once a second): turn_fwd's bar ended, turn_back's runs on
+    page.wait_for_function("document.querySelector('[data-timeline-state=\"DriveInit1.run.initialise.turn_back\"]')"
+                           " !== null")
+    assert "of DriveInit1" in page.locator('[data-role="timeline-chart"]').text_content()
+    window = cockpit.session.call(lambda d: d.timeline("DriveInit1", 20))
+    drawn = page.locator('[data-role="timeline"] [data-timeline-state="DriveInit1.run.initialise.turn_fwd"] .tl-bar')
+    assert drawn.count() == len([iv for iv in window.intervals if iv.state == "turn_fwd"]) >= 1
+    cockpit.session.call(lambda d: d.delete())

@@ -601,7 +601,7 @@ function drawTimeline(m) {
   for (const row of m.rows) {
     const line = document.createElement("div");
     line.className = "tl-row";
-    line.dataset.state = row.qname;
+    line.dataset.timelineState = row.qname;  // not data-state: that names a state drawn in the diagram
     const label = document.createElement("span");
     label.className = "tl-label";
     label.textContent = row.state;

@@ -98,7 +98,8 @@ def test_a_click_breakpoint_stops_the_run_at_the_tick_the_state_is_entered(page:
     page.get_by_role("button", name="Run", exact=True).click()
     page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
     assert shown_tick(page) == expected
-    assert page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]').get_attribute("data-active") == "true"
+    turn_back = page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]')
+    assert turn_back.get_attribute("data-active") == "true"
     edge = page.locator('[data-transition~="DriveInit1.turn_fwd->turn_back"]').first
     assert int(edge.get_attribute("data-taken-count")) == 1
     cockpit.session.call(lambda d: d.delete())

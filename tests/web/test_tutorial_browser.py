@@ -38,7 +38,8 @@ def test_the_tutorials_browser_path_stops_where_it_says(page: Any, cockpit: Cock
     page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
     shown = page.locator('[data-role="status"]').text_content()
     assert " ".join(status.group(1).split()) in shown, shown
-    assert page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]').get_attribute("data-active") == "true"
+    turn_back = page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]')
+    assert turn_back.get_attribute("data-active") == "true"
     edge = page.locator('[data-transition~="DriveInit1.turn_fwd->turn_back"]').first
     assert edge.get_attribute("data-taken-count") == "1"
     assert "`q_true` (simulation only) at 170 deg" in " ".join(text.split())

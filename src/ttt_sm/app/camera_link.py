@@ -26,6 +26,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..params import ArmParams
 from ..seriallink.protocol import SEQ_MODULUS
 from ..twin.whiteboard import Whiteboard
@@ -52,6 +54,8 @@ class CameraLink:
         self.read_wall_s = 0.0  # wall time spent waiting for photos
         self._closing = False
         self._last_percentages: list[float] = [0.0] * 25
+        #: The last photo taken (BGR, as the camera sees the board), None before the first.
+        self.last_photo: np.ndarray | None = None
         self._made = 0  # frames photographed so far = the next frame's sequence number
         self._symbols_by_seq: dict[int, str] = {}
         self._emulator: Any = None
@@ -72,7 +76,9 @@ class CameraLink:
                     if not self._wanted.is_set():
                         continue  # the reading got its frame while this one waited for the board
                     self._wanted.clear()  # one photo per request: the reading asks again if it is lost
-                    d = detect(self.camera.frame())  # no frame (and no sequence number) if this raises
+                    photo = self.camera.frame()
+                    d = detect(photo)  # no frame (and no sequence number) if this raises
+                    self.last_photo = photo
                     # The emulator numbers frames 0, 1, 2 ... in the order they are made.
                     self._symbols_by_seq[self._made % SEQ_MODULUS] = d.cells
                     self._made += 1
@@ -100,7 +106,8 @@ class CameraLink:
 
     def _read(self) -> tuple[tuple[float, ...], str | None]:
         if self.mode == "direct":
-            d: Detection = detect(self.camera.frame())
+            self.last_photo = self.camera.frame()
+            d: Detection = detect(self.last_photo)
             return tuple(board_values(list(d.percentages), self.view)), board_text(d.cells, self.view)
         # Frames photographed before now may still wait in the port: only a
         # frame numbered from `fresh` on shows the board as it is now.

@@ -24,6 +24,7 @@ import gc
 import hashlib
 import sys
 import time
+from collections import deque
 from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,6 +48,9 @@ from .wires import GAME_WIRES
 from .wiring import Wiring, not_wired
 
 Cell = tuple[int, int]
+
+#: How long the game waits for a person at a GUI to draw and click Play, simulated s.
+PERSON_WAIT_S = 24 * 3600.0
 
 
 #: Longest a game may run, in simulated seconds, unless told otherwise: a whole game of 25 moves
@@ -167,6 +171,29 @@ class TerminalPerson:
     def tell(self, message: str) -> None:
         self.stdout.write(message + "\n")
         self.stdout.flush()
+
+
+class RemotePerson:
+    """The person at a GUI (the browser's ``/game`` page): draws by clicking cells, then clicks Play.
+
+    Nothing here decides: the page's clicks reach the :class:`GameSession`
+    (:meth:`GameSession.person_draws`, :meth:`GameSession.press_play`), whose
+    flow waits for them; the simulated hand draws each clicked cell on the
+    whiteboard and the camera reads the board when Play is clicked, as in
+    ``ttt-sm play``.  What the game tells the person is kept for the page.
+    """
+
+    def __init__(self, keep: int = 50) -> None:
+        self.messages: deque[str] = deque(maxlen=keep)
+        #: Messages told so far (the page shows the newest ones).
+        self.told = 0
+
+    def choose(self, board: str, symbol: str) -> Cell | None:
+        raise GameError("the person at the page plays by clicking cells; the flow does not ask them")
+
+    def tell(self, message: str) -> None:
+        self.messages.append(message)
+        self.told += 1
 
 
 def _board_picture(board: str) -> str:
@@ -361,12 +388,25 @@ class GameSession:
         self._wait: Wait | None = None
         self.pictures: dict[str, str] = {}
         self.moves: list[dict[str, Any]] = []
-        #: 'X', 'O', 'draw' or 'abandoned' once the flow has seen the game end, else None.
+        #: 'X', 'O', 'draw', 'given_up', 'abandoned' or 'halted' (Stop) once the flow has seen the game end, else None.
         self.outcome: str | None = None
         #: Plays the flow from inside the chart steps (:meth:`drive`), else None.
         self.driver: GameDriver | None = None
         self._last_message = ""
         self._given_up = False
+        #: A person at a GUI (:class:`RemotePerson`): the game waits for their clicks.
+        self.remote = isinstance(self.person, RemotePerson)
+        #: The cells the person drew in the current turn (a GUI's person), last one last.
+        self.drawn: list[Cell] = []
+        #: The person clicked Play and the game has not taken it yet.
+        self.play_pressed = False
+        #: What the flow waits for from a GUI's person now: "draw" (their move, then Play), "play"
+        #: (Play, the robot opens) or None (nothing: the manipulator moves, or the game is over).
+        self.awaiting: str | None = None
+        #: The camera's last reading: 25 percentages and the symbols read (None: not read), board order.
+        self.last_view: tuple[tuple[float, ...], str | None] | None = None
+        #: Photos the game has taken (the page refreshes the camera's picture when it changes).
+        self.photos = 0
         #: The Session block's output `play_again`: one game per session.
         self.play_again = False
         self.robot.add_charts((self.activator, self.game), GAME_WIRES, GameStage(self))
@@ -456,6 +496,13 @@ class GameSession:
     def _waiting(self) -> bool:
         return bool(self.robot.control.ready)
 
+    def _stopped(self) -> bool:
+        """Stop was clicked (the Game chart's `stop`): the Game chart asks the Control chart to finish."""
+        return bool(self.game.finish)
+
+    def _waiting_or_stopped(self) -> bool:
+        return self._waiting() or self._stopped()
+
     def _place(self, cell: Cell, symbol: str, which: str) -> None:
         i = cell_index(*cell)
         self.truth = self.truth[:i] + symbol + self.truth[i + 1:]
@@ -467,7 +514,55 @@ class GameSession:
         self.board = self.board[:i] + symbol + self.board[i + 1:]
 
     def _look(self) -> tuple[tuple[float, ...], str | None]:
-        return self.camera.read()
+        view = self.camera.read()
+        self.last_view = view
+        self.photos += 1
+        return view
+
+    # -- a person at a GUI (RemotePerson): their clicks, checked against where the game stands --
+
+    @property
+    def symbol_locked(self) -> bool:
+        """The robot's symbol cannot change any more: a move has been made (or drawn)."""
+        return bool(self.moves or self.drawn)
+
+    def set_robot_symbol(self, symbol: str) -> None:
+        """The GUI's Symbol button: the robot plays ``symbol`` ('X' or 'O'), only before the first move."""
+        if symbol not in ("X", "O"):
+            raise ValueError(f"the robot's symbol must be X or O, got {symbol!r}")
+        if self.symbol_locked and symbol != self.robot_symbol:
+            raise GameError(f"the manipulator plays {self.robot_symbol}: the symbol cannot change after the"
+                            " first move")
+        self.robot_symbol = symbol
+        self.person_symbol = "X" if symbol == "O" else "O"
+
+    def person_draws(self, cell: Cell) -> None:
+        """The simulated hand draws the person's symbol in ``cell`` on the whiteboard (the camera must see it)."""
+        row, column = cell
+        if not (1 <= row <= 5 and 1 <= column <= 5):
+            raise ValueError(f"cell (row {row}, column {column}) is not on the 5x5 field")
+        if self.remote and self.awaiting != "draw":
+            raise GameError("it is not your turn to draw: " + (
+                "click Play for the manipulator to move" if self.awaiting == "play" else self.game.message))
+        self.robot.board.draw_symbol(self.person_symbol, row, column)
+        self._place(cell, self.person_symbol, "truth")
+        self._event("person_drew", row=row, column=column)
+        if self.remote:
+            self.drawn.append(cell)
+
+    def press_play(self) -> None:
+        """The GUI's Play button: the manipulator moves (after the person drew theirs, or to open the game)."""
+        if self.awaiting == "play" or (self.awaiting == "draw" and self.drawn):
+            self.play_pressed = True
+            return
+        if self.awaiting == "draw":
+            raise GameError("it is your turn: draw your move (click a cell), then click Play")
+        raise GameError(f"Play is not taken now: {self.game.message}")
+
+    def _remote_wait(self, what: str, symbol: str) -> Wait:
+        """Wait for the person's Play click, or the symbols to change before the first move, or Stop."""
+        return Wait(lambda: self.play_pressed or self.person_symbol != symbol or self._stopped(),
+                    PERSON_WAIT_S, what)
 
     def play(self, max_moves: int = 25) -> dict[str, Any]:
         """Play one game to its end (or until the person gives up); return the report."""
@@ -551,17 +646,19 @@ class GameSession:
         from inside the chart steps.
         """
         self.say("initialising, then drawing the field")
-        yield Wait(self._waiting, 300.0, "initialising and drawing the field")
+        yield Wait(self._waiting_or_stopped, 300.0, "initialising and drawing the field")
         self._event("field_drawn")
-        to_move = "X"
-        while result_of(self.board) is None and len(self.moves) < max_moves:
+        # Each turn adds one move; a GUI's person's turn may end without one (the symbols
+        # changed before the first move, or Stop): X moves when the number of moves is even.
+        while result_of(self.board) is None and len(self.moves) < max_moves and not self._stopped():
+            to_move = "X" if len(self.moves) % 2 == 0 else "O"
             if to_move == self.person_symbol:
                 if not (yield from self._person_turn()):
                     break
             else:
                 yield from self._robot_turn()
-            to_move = "O" if to_move == "X" else "X"
-        outcome = result_of(self.board) or ("given_up" if self._given_up else "abandoned")
+        stopped = self._stopped() and result_of(self.board) is None
+        outcome = result_of(self.board) or ("given_up" if self._given_up else "halted" if stopped else "abandoned")
         self.outcome = outcome
         self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3, "given_up": 4}.get(outcome, 3)
         self._event("result", outcome=outcome)
@@ -637,20 +734,31 @@ class GameSession:
         # The Game chart shows whose turn it is before the person is asked.
         yield Wait(lambda: True, step, "the Game chart to show whose turn it is", tell=False)
         yield Wait(lambda: True, step, "the person's move")
-        self._waiting_for_person = True  # an interrupt now stops the game at once
-        try:
-            if self._stop_request is not None:
-                raise GameInterrupted(self._stop_request)
-            cell = self.person.choose(self.truth, self.person_symbol)
-        finally:
-            self._waiting_for_person = False
-        if cell is None:
-            self._given_up = True
-            self._event("given_up", moves=len(self.moves))
-            return False
-        robot.board.draw_symbol(self.person_symbol, *cell)
-        self._place(cell, self.person_symbol, "truth")
-        self._event("person_drew", row=cell[0], column=cell[1])
+        if self.remote:
+            # The person draws by clicking cells (person_draws), then clicks Play: the camera looks then.
+            self.drawn, self.play_pressed, self.awaiting = [], False, "draw"
+            try:
+                yield self._remote_wait("the person's move and Play", self.person_symbol)
+            finally:
+                self.awaiting = None
+            if not self.play_pressed:
+                return True  # the symbols changed before the first move, or Stop: the flow decides again
+            self.play_pressed = False
+            cell = self.drawn[-1]
+        else:
+            self._waiting_for_person = True  # an interrupt now stops the game at once
+            try:
+                if self._stop_request is not None:
+                    raise GameInterrupted(self._stop_request)
+                chosen = self.person.choose(self.truth, self.person_symbol)
+            finally:
+                self._waiting_for_person = False
+            if chosen is None:
+                self._given_up = True
+                self._event("given_up", moves=len(self.moves))
+                return False
+            cell = chosen
+            self.person_draws(cell)
         percentages, symbols = self._look()
         try:
             seen = percent_process(percentages, self.robot_cells, self.person_cells, robot_ink=self.robot_ink,
@@ -680,15 +788,28 @@ class GameSession:
     def _robot_turn(self) -> Flow:
         robot = self.robot
         if not self.moves:
+            if self.remote:  # the person clicks Play for the manipulator to open the game
+                self.play_pressed, self.awaiting = False, "play"
+                try:
+                    yield self._remote_wait("Play for the manipulator's first move", self.person_symbol)
+                finally:
+                    self.awaiting = None
+                if not self.play_pressed:
+                    return  # the symbols changed, or Stop: the flow decides again
+                self.play_pressed = False
             self._click_play()  # the robot opens: Play without a drawing first
         self.pending_move = None
-        yield Wait(lambda: self.pending_move is not None, 10.0, "the algorithm's answer")
+        yield Wait(lambda: self.pending_move is not None or self._stopped(), 10.0, "the algorithm's answer")
+        if self._stopped():
+            return  # Stop: the manipulator returns to its start pose instead
         cell = self.pending_move
         assert cell is not None
         step = self.params.control.chart_dt
         yield Wait(lambda: True, step, "the Control chart to take the move", tell=False)
         yield Wait(lambda: True, step, "the Control chart to take the move", tell=False)
-        yield Wait(self._waiting, 120.0, f"drawing the robot's move {cell}")
+        yield Wait(self._waiting_or_stopped, 120.0, f"drawing the robot's move {cell}")
+        if self._stopped():
+            return  # Stop in the middle of the stroke: the pen is lifted, the move not made
         self.robot_cells.append(cell)
         self._set_board(cell, self.robot_symbol)
         self._place(cell, self.robot_symbol, "truth")

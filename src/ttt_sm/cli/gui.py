@@ -32,7 +32,11 @@ def register(sub: Any) -> argparse.ArgumentParser:
     sp.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default {DEFAULT_PORT}; 0: any free one)")
     sp.add_argument("--seed", type=seed, default=0, help="seed of the simulated arm (default 0)")
     sp.add_argument("--game", action="store_true",
-                    help="a whole game: the Game and AlgorithmActivator charts too, a simulated person plays X")
+                    help="a whole game: the Game and AlgorithmActivator charts too; the person plays in the"
+                         " /game page")
+    sp.add_argument("--person", choices=("page", "simulated"), default="page",
+                    help="with --game: who plays against the robot, you in the /game page (default) or a"
+                         " simulated person")
     sp.add_argument("--speed", default="1",
                     help="times real time, 0.1 to 10, or 'max' for as fast as it goes (default 1)")
     sp.add_argument("--paused", action="store_true", help="start paused at power-on")
@@ -95,7 +99,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
         raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
     port = sock.getsockname()[1]
     print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
-    dbg = Debugger.build(params, seed=args.seed, game=args.game)
+    dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person)
     session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
                       trace_path=Path(args.trace))
     shown = f"[{args.host}]" if ":" in args.host else args.host
@@ -103,6 +107,8 @@ def cmd_gui(args: argparse.Namespace) -> int:
     app = create_app(session, token=token, hosts=hosts)
     url = f"http://{shown}:{port}/charts" + (f"?token={token}" if token else "")
     print(f"ttt-sm gui: the chart cockpit is at {url}", flush=True)
+    if args.game and args.person == "page":
+        print(f"ttt-sm gui: play at {url.replace('/charts', '/game', 1)}", flush=True)
     if token:
         print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
               flush=True)

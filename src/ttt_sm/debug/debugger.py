@@ -107,15 +107,17 @@ class Debugger:
 
     @classmethod
     def build(cls, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
-              settle_s: float = 0.0, *, game: bool = False, max_run_s: float = DEFAULT_MAX_RUN_S) -> Debugger:
+              settle_s: float = 0.0, *, game: bool = False, person: str = "simulated",
+              max_run_s: float = DEFAULT_MAX_RUN_S) -> Debugger:
         """A debugger on a new robot, with its recipe for :meth:`replay`.
 
         ``game``: the robot plays a game (:class:`~.replay.GameRecipe`: the Game
         and AlgorithmActivator charts, a simulated person, the camera read
-        in-process, the strong engine; the robot draws O).
+        in-process, the strong engine; the robot draws O).  ``person``: who plays
+        against it, ``"simulated"`` or ``"page"`` (a person at the ``/game`` page).
         """
         pose = None if q_start is None else tuple(float(v) for v in q_start)
-        recipe: Recipe = GameRecipe(params, seed, pose, settle_s) if game else \
+        recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person) if game else \
             RobotRecipe(params, seed, pose, settle_s)
         return cls(recipe.build(), recipe, max_run_s=max_run_s)
 

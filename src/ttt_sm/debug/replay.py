@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 from types import MappingProxyType
 from typing import Any, Protocol
 
-from ..app.game import GameSession
+from ..app.game import GameSession, RemotePerson
 from ..app.robot import Robot
 from ..params import ArmParams
 from ..twin.sim import ArmSim
@@ -68,7 +68,9 @@ class GameRecipe:
     The camera is read in-process (``direct``): the debugger steps the robot
     one control step at a time, and the serial link's emulated camera, a
     thread behind a pseudo-terminal, would only add wall time to each reading.
-    The simulated person is seeded with the seed, as in ``ttt-sm play``.
+    The simulated person is seeded with the seed, as in ``ttt-sm play``;
+    ``person="page"``: a person at a GUI plays instead (:class:`RemotePerson`,
+    the ``/game`` page of ``ttt-sm gui``), whose clicks a replay does not repeat.
     """
 
     params: ArmParams
@@ -77,9 +79,14 @@ class GameRecipe:
     settle_s: float = 0.0
     robot_symbol: str = "O"
     engine: str = "strong"
+    person: str = "simulated"
 
     def build(self) -> Robot:
+        if self.person not in ("simulated", "page"):
+            raise ValueError(f"the person is 'simulated' or 'page', got {self.person!r}")
+        person = RemotePerson() if self.person == "page" else None
         session = GameSession(self.params, seed=self.seed, robot_symbol=self.robot_symbol, engine=self.engine,
+                              person=person,
                               camera="direct", record_trace=False, q_start=self.q_start, settle_s=self.settle_s)
         session.drive()
         return session.robot

@@ -40,6 +40,11 @@ The commands, with their fields (``?``: optional, default in brackets):
 ``coverage_load``    ``report``: the JSON of ``ttt-sm scenario run --coverage --json``
 ``coverage_clear``   colour no coverage
 ``ack``              ``frame``: the page has drawn that frame (for the latency figure)
+``game_symbol``      ``symbol``: ``"X"`` or ``"O"``, the manipulator's (the
+                     Tic-tac-toe page's Symbol; before the first move only)
+``game_cell``        ``row``, ``column`` (1..5): the person draws there
+``game_play``        the Tic-tac-toe page's Play
+``game_stop``        its Stop: the arm returns to its start pose, then stops
 ===================  ==========================================================
 
 Every command may carry ``id`` (a number or a short text), echoed in its reply.
@@ -193,6 +198,12 @@ def report(cmd: str, name: str, value: Any) -> dict[str, Any]:
     return value
 
 
+def symbol(cmd: str, name: str, value: Any) -> str:
+    if value not in ("X", "O"):
+        raise ProtocolError(f"{cmd}: {name!r} must be \"X\" or \"O\", got {_describe(value)}")
+    return str(value)
+
+
 @dataclass(frozen=True)
 class Field:
     check: Check
@@ -227,6 +238,10 @@ COMMANDS: Mapping[str, Mapping[str, Field]] = {
     "coverage_load": {"report": Field(report)},
     "coverage_clear": {},
     "ack": {"frame": Field(integer(0, 2**53))},
+    "game_symbol": {"symbol": Field(symbol)},
+    "game_cell": {"row": Field(integer(1, 5)), "column": Field(integer(1, 5))},
+    "game_play": {},
+    "game_stop": {},
 }
 
 

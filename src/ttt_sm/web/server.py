@@ -6,7 +6,8 @@ WebSocket endpoint, static files served from the package, a lifespan to start
 and stop the session, and a test client that speaks the same ASGI (the
 protocol tests run without a browser or a socket).
 
-Routes: ``/`` (links every page), ``/charts`` (the chart cockpit),
+Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
+(the Tic-tac-toe page, :mod:`.game`; its camera picture ``/api/game/photo.png``),
 ``/static/...`` (the pages' scripts and styles, from the package: nothing from
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
 SVG, :mod:`.diagrams`), ``/api/trace.jsonl`` (the trace so far), ``/ws``.
@@ -43,6 +44,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from ..runtime.errors import GraphvizMissingError
 from .diagrams import DiagramError, Diagrams
+from .game import photo_png
 from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
 from .session import Session
 
@@ -132,6 +134,15 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
 
     async def charts(request: Request) -> Response:
         return page("charts.html")
+
+    async def game(request: Request) -> Response:
+        return page("game.html")
+
+    async def game_photo(request: Request) -> Response:
+        png = await asyncio.to_thread(photo_png, session.debugger)
+        if png is None:
+            return PlainTextResponse("no photo yet: the camera looks after each move\n", status_code=404)
+        return Response(png, media_type="image/png", headers={"Cache-Control": "no-store"})
 
     async def diagram(request: Request) -> Response:
         chart = request.path_params["chart"]
@@ -225,6 +236,8 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
     routes = [
         Route("/", index),
         Route("/charts", charts),
+        Route("/game", game),
+        Route("/api/game/photo.png", game_photo),
         Route("/api/diagram/{chart}", diagram),
         Route("/api/trace.jsonl", trace),
         WebSocketRoute("/ws", ws),

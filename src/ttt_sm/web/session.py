@@ -29,6 +29,7 @@ trace is the debugger's (``trace save``; :meth:`Session.stop` writes it).
 
 from __future__ import annotations
 
+import functools
 import gc
 import itertools
 import logging
@@ -54,6 +55,7 @@ from ..runtime.structure import TICK_EVENT_NAME, TICK_EVENT_PREFIX
 from ..sched.clock import PacedClock
 from .catalogue import describe_session
 from .coverage import CoverageError, colouring, load_scenarios, run_for_coverage, scenario_from_text
+from .game import GAME_COMMANDS, game_view
 from .protocol import Command
 
 log = logging.getLogger(__name__)
@@ -326,6 +328,8 @@ class Session:
             self._dirty = True
             return
         handler = getattr(self, f"_cmd_{cmd.type}", None)
+        if handler is None and cmd.type in GAME_COMMANDS:  # the Tic-tac-toe page's (web/game.py)
+            handler = functools.partial(_game_command, GAME_COMMANDS[cmd.type], self.debugger)
         if handler is None:
             self.reply_error(cid, f"{cmd.type}: not handled by this session", cmd)
             return
@@ -549,6 +553,7 @@ class Session:
             "actions": [a.describe() for a in dbg.actions],
             "forced": [f"{c}.{n}" for c, n in dbg.forced],
             "stop": self._stop,
+            "game": game_view(dbg),
         }
 
     def _frame(self, full: bool, state: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -590,7 +595,7 @@ class Session:
         frame["taken"] = {name: {i: c for i, c in counts.items() if sent.get("taken", {}).get(name, {}).get(i) != c}
                           for name, counts in state["taken"].items()}
         frame["taken"] = {name: counts for name, counts in frame["taken"].items() if counts}
-        for key in ("breakpoints", "actions", "forced", "stop"):
+        for key in ("breakpoints", "actions", "forced", "stop", "game"):
             if sent.get(key, _MISSING) != state[key]:
                 frame[key] = state[key]
         return frame
@@ -658,6 +663,11 @@ def _freeze_heap() -> None:
     """
     gc.collect()
     gc.freeze()
+
+
+def _game_command(command: Callable[..., dict[str, Any]], debugger: Debugger, cid: int,
+                  **args: Any) -> dict[str, Any]:
+    return command(debugger, **args)
 
 
 def _number_or_text(value: Any) -> Any:

@@ -1,0 +1,170 @@
+"""The Tic-tac-toe page (``/game``, thesis section 3.7, fig. 3.35) over the session's game.
+
+The page is a view of the same :class:`~.session.Session` as the chart cockpit:
+its buttons are commands of :mod:`.protocol` (``game_symbol``, ``game_cell``,
+``game_play``, ``game_stop``; Run is the session's ``run``), handled here in
+the simulation thread between two control steps, and what it draws comes in
+each frame's ``game`` part (:func:`game_view`), sent when it changed.
+
+A click on a cell is the person's move: the simulated hand draws the person's
+symbol on the simulated whiteboard (:meth:`GameSession.person_draws`); Play
+(:meth:`GameSession.press_play`) lets the game's flow take a photo, read the
+move through percent-process and pull the AlgorithmActivator's trigger, as
+``ttt-sm play`` does.  Nothing here sets the board the robot believes.
+
+The camera's picture is served as PNG at ``/api/game/photo.png``
+(:func:`photo_png`); the frame says how many photos have been taken, and the
+page asks for the picture again when that number changes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import cv2
+
+from ..app.game import GameError, GameSession, RemotePerson
+from ..charts.game import (
+    MSG_COMPILING,
+    MSG_DRAWING,
+    MSG_ERASING,
+    MSG_INITIALISING,
+    MSG_TURNING_OFF,
+    MSG_YOUR_TURN,
+    RESULT_MESSAGES,
+)
+from ..debug.debugger import Debugger
+
+#: Person messages a frame carries at most (the newest).
+MESSAGES_SHOWN = 8
+
+#: Text box2's messages (the Game chart's): the page shows them there, not among what the game told.
+CHART_MESSAGES = frozenset((MSG_COMPILING, MSG_INITIALISING, MSG_YOUR_TURN, MSG_DRAWING, MSG_ERASING,
+                            MSG_TURNING_OFF, *RESULT_MESSAGES.values()))
+
+TEXT_BOX1_FREE = "You can change the manipulator's symbol: it plays {robot}, you play {person}."
+TEXT_BOX1_LOCKED = "The manipulator plays {robot}, you play {person}: the symbol cannot change after the first move."
+
+
+def game_of_debugger(debugger: Debugger) -> GameSession | None:
+    """The game the session's robot plays, or None (a session without ``--game``)."""
+    return debugger.game
+
+
+def game_view(debugger: Debugger) -> dict[str, Any] | None:
+    """The ``game`` part of a frame: what the Tic-tac-toe page shows, plain data (None: no game)."""
+    game = game_of_debugger(debugger)
+    if game is None:
+        return None
+    robot, person = game.robot_symbol, game.person_symbol
+    driver = game.driver
+    view = game.last_view
+    told: list[str] = []
+    told_total = 0
+    if isinstance(game.person, RemotePerson):
+        told = [m for m in game.person.messages if m not in CHART_MESSAGES][-MESSAGES_SHOWN:]
+        told_total = game.person.told
+    return {
+        "message": str(game.game.message),
+        "robot_symbol": robot,
+        "person_symbol": person,
+        "symbol_locked": game.symbol_locked,
+        "text_box1": (TEXT_BOX1_LOCKED if game.symbol_locked else TEXT_BOX1_FREE).format(robot=robot, person=person),
+        "plays_here": game.remote,
+        "awaiting": game.awaiting,
+        "board": game.board,
+        "truth": game.truth,
+        "drawn": [list(c) for c in game.drawn],
+        "moves": len(game.moves),
+        "percentages": None if view is None else [round(float(p), 1) for p in view[0]],
+        "read": None if view is None else view[1],
+        "photos": game.photos,
+        "outcome": game.outcome,
+        "ended": bool(game.game.ended),
+        "error": None if driver is None or driver.error is None else str(driver.error),
+        "told": told,
+        "told_total": told_total,  # all told, Text box2's messages too
+        "engine": game.engine_name,
+    }
+
+
+def photo_png(debugger: Debugger) -> bytes | None:
+    """The camera's last photo as PNG, or None before the first (or without a game)."""
+    game = game_of_debugger(debugger)
+    photo = None if game is None else game.camera.last_photo
+    if photo is None:
+        return None
+    ok, data = cv2.imencode(".png", photo)
+    if not ok:
+        raise RuntimeError("OpenCV could not encode the camera's photo as PNG")
+    return bytes(data)
+
+
+def _game(debugger: Debugger, command: str) -> GameSession:
+    game = game_of_debugger(debugger)
+    if game is None:
+        raise ValueError(f"{command}: this session plays no game (start it with `ttt-sm gui --game`)")
+    if not game.remote:
+        raise ValueError(f"{command}: a simulated person plays this game; start `ttt-sm gui --game`"
+                         " with --person page to play it in the page")
+    return game
+
+
+def _said(command: str, go: Any) -> dict[str, Any]:
+    try:
+        text = go()
+    except GameError as exc:
+        raise ValueError(f"{command}: {exc}") from None
+    return {"text": text}
+
+
+def cmd_game_symbol(debugger: Debugger, symbol: str) -> dict[str, Any]:
+    """Symbol: the manipulator plays ``symbol`` (before the first move only)."""
+    game = _game(debugger, "game_symbol")
+
+    def go() -> str:
+        game.set_robot_symbol(symbol)
+        return f"the manipulator plays {game.robot_symbol}, you play {game.person_symbol}"
+
+    return _said("game_symbol", go)
+
+
+def cmd_game_cell(debugger: Debugger, row: int, column: int) -> dict[str, Any]:
+    """A click on a cell: the simulated hand draws the person's symbol there."""
+    game = _game(debugger, "game_cell")
+
+    def go() -> str:
+        game.person_draws((row, column))
+        return f"you drew {game.person_symbol} in row {row}, column {column}; click Play when you are done"
+
+    return _said("game_cell", go)
+
+
+def cmd_game_play(debugger: Debugger) -> dict[str, Any]:
+    """Play: the manipulator's move (the AlgorithmActivator's trigger, pulled by the game's flow)."""
+    game = _game(debugger, "game_play")
+
+    def go() -> str:
+        game.press_play()
+        return "Play: the camera looks at the board" if game.awaiting == "draw" else "Play: the manipulator moves"
+
+    return _said("game_play", go)
+
+
+def cmd_game_stop(debugger: Debugger) -> dict[str, Any]:
+    """Stop (the thesis' Stop_sim): the Game chart turns the arm off; it returns to its start pose."""
+    game = _game(debugger, "game_stop")
+    if game.game.ended:
+        raise ValueError("game_stop: the game is over and the arm off already")
+    debugger.post(game.game.chart_name, "stop")
+    return {"text": "Stop: the manipulator returns to its start pose avoiding the board, then stops"}
+
+
+#: The page's commands (beside the session's ``run``), by protocol type.
+GAME_COMMANDS: dict[str, Callable[..., dict[str, Any]]] = {
+    "game_symbol": cmd_game_symbol,
+    "game_cell": cmd_game_cell,
+    "game_play": cmd_game_play,
+    "game_stop": cmd_game_stop,
+}

@@ -1,0 +1,158 @@
+// The Tic-tac-toe page (/game): the thesis' fig. 3.35 over the session's game.
+//
+// A view, as every page: the buttons send commands (run, game_symbol, game_cell,
+// game_play, game_stop; checked by ttt_sm.web.protocol, handled by ttt_sm.web.game)
+// and each frame's "game" part (sent when it changed) is drawn.  A click on a cell
+// asks the simulated hand to draw there; the board shows what the game has read
+// through the camera, never what the page guessed.
+
+import { SessionLink } from "/static/session.js";
+
+const $ = (sel) => document.querySelector(sel);
+const role = (name) => $(`[data-role="${name}"]`);
+
+const state = { game: null, mode: "connecting", photos: -1 };
+
+function cellButtons() {
+  const board = role("board");
+  for (let r = 1; r <= 5; r++) {
+    const row = document.createElement("div");
+    row.setAttribute("role", "row");
+    row.style.display = "contents";
+    for (let c = 1; c <= 5; c++) {
+      const b = document.createElement("button");
+      b.type = "button";
+      b.setAttribute("role", "gridcell");
+      b.setAttribute("aria-label", `row ${r}, column ${c}`);
+      b.dataset.row = r;
+      b.dataset.column = c;
+      b.addEventListener("click", () => link.send({ type: "game_cell", row: r, column: c }));
+      row.appendChild(b);
+    }
+    board.appendChild(row);
+  }
+  const reading = role("reading");
+  for (let r = 1; r <= 5; r++) {
+    const row = document.createElement("div");
+    row.setAttribute("role", "row");
+    row.style.display = "contents";
+    for (let c = 1; c <= 5; c++) {
+      const cell = document.createElement("div");
+      cell.setAttribute("role", "cell");
+      cell.dataset.row = r;
+      cell.dataset.column = c;
+      cell.textContent = "–";
+      row.appendChild(cell);
+    }
+    reading.appendChild(row);
+  }
+}
+
+function say(text, error) {
+  const box = role("reply");
+  box.textContent = text;
+  box.dataset.error = error ? "true" : "false";
+}
+
+function drawGame(g) {
+  state.game = g;
+  if (!g) {
+    role("text-box2").textContent = "This session plays no game: start it with `ttt-sm gui --game`.";
+    return;
+  }
+  role("text-box1").textContent = g.text_box1;
+  role("text-box2").textContent = g.message;
+  role("robot-symbol").textContent = g.robot_symbol;
+  role("person-symbol").textContent = g.person_symbol;
+  // What the game told the person besides Text box2's messages (the robot's move, a refused view).
+  const told = g.told.length ? g.told[g.told.length - 1] : "";
+  const toldBox = role("told");
+  toldBox.textContent = g.error ? `${told} (the game cannot go on: ${g.error})` : told;
+  toldBox.dataset.error = g.error ? "true" : "false";
+  const symbolButton = $('[data-cmd="symbol"]');
+  symbolButton.disabled = g.symbol_locked || !g.plays_here;
+  symbolButton.dataset.locked = g.symbol_locked ? "true" : "false";
+  const drawn = new Set(g.drawn.map(([r, c]) => `${r},${c}`));
+  for (const b of role("board").querySelectorAll("button")) {
+    const i = 5 * (b.dataset.row - 1) + (b.dataset.column - 1);
+    const read = g.board[i], there = g.truth[i];
+    let by = "", shown = "";
+    if (read !== ".") {
+      by = read === g.robot_symbol && there === g.robot_symbol ? "robot" : "person";
+      shown = read;
+    }
+    if (there !== "." && (read === "." || drawn.has(`${b.dataset.row},${b.dataset.column}`))) {
+      by = read === "." ? "drawn" : by;
+      shown = read === "." ? there : read;
+    }
+    b.textContent = shown;
+    b.dataset.by = by;
+    b.disabled = !(g.plays_here && g.awaiting === "draw");
+    b.title = by === "drawn" ? "drawn; the camera reads it when you click Play" : "";
+  }
+  $('[data-cmd="play"]').disabled = !(g.plays_here && g.awaiting);
+  $('[data-cmd="stop"]').disabled = !g.plays_here || g.ended;
+  if (g.photos !== state.photos) {
+    state.photos = g.photos;
+    const img = role("photo");
+    if (g.photos > 0) {
+      img.src = `/api/game/photo.png?n=${g.photos}`;
+      img.alt = `the board as the simulated camera sees it, photo ${g.photos}`;
+      img.hidden = false;
+      img.dataset.photo = g.photos;
+      role("photo-count").textContent = `photo ${g.photos}, taken after the last move`;
+    }
+  }
+  if (g.percentages) {
+    for (const cell of role("reading").querySelectorAll('[role="cell"]')) {
+      const i = 5 * (cell.dataset.row - 1) + (cell.dataset.column - 1);
+      const pct = g.percentages[i];
+      const sym = g.read ? g.read[i] : "?";
+      cell.innerHTML = "";
+      const b = document.createElement("b");
+      b.textContent = sym === "." ? "" : sym;
+      cell.append(b, `${pct.toFixed(1)} %`);
+      cell.dataset.occupied = sym !== "." ? "true" : "false";
+      cell.title = `row ${cell.dataset.row}, column ${cell.dataset.column}: ${pct.toFixed(1)} % ink, read ${sym === "." ? "empty" : sym}`;
+    }
+  }
+}
+
+function drawFrame(f) {
+  if (f.mode !== undefined) {
+    state.mode = f.mode;
+    const mode = role("mode");
+    mode.textContent = f.mode;
+    mode.dataset.mode = f.mode;
+    $('[data-cmd="run"]').disabled = f.mode === "running";
+  }
+  if (f.t !== undefined) role("sim-time").textContent = f.t.toFixed(1);
+  if ("game" in f) drawGame(f.game);
+  if (f.stop && f.stop.kind === "game") say(f.stop.text, true);
+  if (f.error) say(f.error, true);
+}
+
+function onMessage(m) {
+  if (m.type === "frame") {
+    drawFrame(m);
+    link.ack(m.seq);
+  } else if (m.type === "reply") {
+    say(m.text || "", false);
+  } else if (m.type === "error") {
+    say(m.error, true);
+  }
+}
+
+const link = new SessionLink(onMessage, (status) => {
+  if (status !== "connected") role("mode").textContent = status;
+});
+
+cellButtons();
+$('[data-cmd="run"]').addEventListener("click", () => link.send({ type: "run" }));
+$('[data-cmd="symbol"]').addEventListener("click", () => {
+  const now = state.game ? state.game.robot_symbol : "O";
+  link.send({ type: "game_symbol", symbol: now === "X" ? "O" : "X" });
+});
+$('[data-cmd="play"]').addEventListener("click", () => link.send({ type: "game_play" }));
+$('[data-cmd="stop"]').addEventListener("click", () => link.send({ type: "game_stop" }));
+link.connect();

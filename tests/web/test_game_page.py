@@ -1,0 +1,239 @@
+"""The Tic-tac-toe page (/game) in Chromium: a person plays the robot by clicking, through the camera.
+
+Each test has a session of its own (a game is played once): the robot with
+the Game and AlgorithmActivator charts, the person at the page
+(``Debugger.build(game=True, person="page")``), paused at power-on, as fast as
+it goes once Run is clicked.  What the tests assert on is the game's own
+state read in the simulation thread (moves, detections, the whiteboard's
+ink), beside what the page shows.
+
+The screenshot of docs/gui.md's ``/game`` section is taken mid-game; ``make
+screenshots`` (``TTT_SM_SCREENSHOTS=docs/img``) writes it into docs/img.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from ttt_sm.charts.game import MSG_ERASING, MSG_TURNING_OFF, MSG_YOUR_TURN, RESULT_MESSAGES
+from ttt_sm.debug.debugger import Debugger
+from ttt_sm.params import load_params
+from ttt_sm.web.session import Session
+
+from .conftest import Cockpit, serve
+
+SHOT = "gui_game.png"
+#: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
+LONG = 240_000
+
+
+@pytest.fixture
+def game_cockpit(tmp_path: Path) -> Iterator[Cockpit]:
+    """A game with the person at the page, paused at power-on, as fast as it goes when run."""
+    dbg = Debugger.build(load_params(), seed=0, game=True, person="page")
+    session = Session(dbg, speed=None, running=False, trace_path=tmp_path / "trace.jsonl")
+    server, thread, url = serve(session)
+    try:
+        yield Cockpit(url, session, server)
+    finally:
+        server.should_exit = True
+        thread.join(30)
+
+
+def text_of(page: Any, role: str) -> str:
+    return str(page.locator(f'[data-role="{role}"]').text_content()).strip()
+
+
+def wait_text(page: Any, role: str, text: str, timeout: int = LONG) -> None:
+    page.wait_for_function("([role, text]) => document.querySelector(`[data-role=\"${role}\"]`)"
+                           ".textContent.trim() === text", arg=[role, text], timeout=timeout)
+
+
+def cell(page: Any, row: int, column: int) -> Any:
+    return page.get_by_role("gridcell", name=f"row {row}, column {column}", exact=True)
+
+
+def game_state(cockpit: Cockpit) -> dict[str, Any]:
+    def read(dbg: Debugger) -> dict[str, Any]:
+        game = dbg.game
+        assert game is not None
+        return {"moves": [dict(m) for m in game.moves], "board": game.board, "truth": game.truth,
+                "robot": game.robot_symbol, "person": game.person_symbol, "outcome": game.outcome,
+                "correct": game.detections_correct, "wrong": game.detections_wrong, "photos": game.photos,
+                "ink_mm2": dbg.robot.board.ink_area_mm2(), "ended": bool(game.game.ended),
+                "active": sorted(dbg.robot.active("Game")), "activations": game.activator.activations}
+    result: dict[str, Any] = cockpit.session.call(read)
+    return result
+
+
+def open_game(page: Any, cockpit: Cockpit) -> None:
+    page.goto(cockpit.page_url("/game"))
+    wait_text(page, "text-box2", "Wait for the model to be compiled.", timeout=30_000)
+
+
+def run_to_first_turn(page: Any) -> None:
+    page.get_by_role("button", name="Run", exact=True).click()
+    wait_text(page, "text-box2", MSG_YOUR_TURN)
+    page.wait_for_function("!document.querySelector('[data-role=board] button').disabled", timeout=LONG)
+
+
+def wait_board(page: Any, board: str) -> None:
+    """Until the page's clean board shows ``board`` (25 characters, '.' for an empty cell)."""
+    page.wait_for_function(
+        "(board) => Array.from(document.querySelectorAll('[data-role=board] button'))"
+        ".map((b) => b.textContent || '.').join('') === board", arg=board, timeout=30_000)
+
+
+def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tmp_path: Path) -> None:
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    try:
+        open_game(page, game_cockpit)
+        assert page.get_by_role("status").filter(has_text="Wait for the model to be compiled.").count() == 1
+        run_to_first_turn(page)
+        symbol = page.get_by_role("button", name="Symbol", exact=True)
+        # Before the first move the symbol may change, and Text box1 says so.
+        assert text_of(page, "text-box1").startswith("You can change the manipulator's symbol: it plays O")
+        symbol.click()
+        wait_text(page, "robot-symbol", "X", timeout=30_000)
+        assert game_state(game_cockpit)["robot"] == "X"
+        symbol.click()
+        wait_text(page, "robot-symbol", "O", timeout=30_000)
+        assert game_state(game_cockpit)["robot"] == "O"
+
+        person_moves = 0
+        photos_seen: list[str] = []
+        while True:
+            state = game_state(game_cockpit)
+            if state["outcome"] is not None:
+                break
+            free = [i for i, v in enumerate(state["truth"]) if v == "."]
+            row, column = divmod(free[0], 5)
+            cell(page, row + 1, column + 1).click()
+            # The hand has drawn: the page shows it drawn, not yet read by the camera.
+            page.wait_for_function(
+                "([r, c]) => document.querySelector(`[data-role=board] button[data-row=\"${r}\"]"
+                "[data-column=\"${c}\"]`).dataset.by === 'drawn'", arg=[row + 1, column + 1], timeout=30_000)
+            page.get_by_role("button", name="Play", exact=True).click()
+            person_moves += 1
+            if person_moves == 1:
+                page.wait_for_function("document.querySelector('[data-cmd=symbol]').disabled", timeout=LONG)
+                assert "cannot change after the first move" in text_of(page, "text-box1")
+            # The camera read the person's cell; the manipulator answers (or the game ends).
+            page.wait_for_function(
+                "([r, c]) => document.querySelector(`[data-role=board] button[data-row=\"${r}\"]"
+                "[data-column=\"${c}\"]`).dataset.by === 'person'", arg=[row + 1, column + 1], timeout=LONG)
+            page.wait_for_function(
+                "() => { const m = document.querySelector('[data-role=\"text-box2\"]').textContent;"
+                " const b = document.querySelector('[data-role=board] button');"
+                " return !m.startsWith('If it is') || !b.disabled; }", timeout=LONG)
+            page.wait_for_function(
+                "() => { const m = document.querySelector('[data-role=\"text-box2\"]').textContent;"
+                " return m !== 'The manipulator is drawing.'; }", timeout=LONG)
+            state = game_state(game_cockpit)
+            if state["outcome"] is None:
+                page.wait_for_function("!document.querySelector('[data-role=board] button').disabled",
+                                       timeout=LONG)
+            photo = page.locator('[data-role="photo"]')
+            photos_seen.append(str(photo.get_attribute("data-photo")))
+            if state["outcome"] is None:
+                # The clean board is the board the game believes: the robot's moves and the moves read.
+                assert state["board"] == state["truth"]
+                wait_board(page, state["board"])
+            if person_moves == 2:
+                shot = Path(os.environ.get("TTT_SM_SCREENSHOTS") or tmp_path) / SHOT
+                page.screenshot(path=str(shot))
+                assert shot.stat().st_size > 20_000
+        state = game_state(game_cockpit)
+        result = {state["robot"]: 1, state["person"]: 2, "draw": 3}[state["outcome"]]
+        wait_text(page, "text-box2", RESULT_MESSAGES[result])
+        wait_text(page, "text-box2", MSG_ERASING)
+        wait_text(page, "text-box2", MSG_TURNING_OFF)
+        page.wait_for_function("document.querySelector('[data-cmd=stop]').disabled", timeout=LONG)
+        state = game_state(game_cockpit)
+        person = [m for m in state["moves"] if m["by"] == "person"]
+        assert len(person) == person_moves
+        # Every cell the person clicked was read through the camera, and read right.
+        assert all(m["detected"] == [m["row"], m["column"]] for m in person)
+        assert state["correct"] == person_moves and state["wrong"] == 0
+        assert len(set(photos_seen)) == len(photos_seen)  # a new photo after every move
+        assert state["ended"] and state["ink_mm2"] == 0.0  # erased, turned off
+    finally:
+        page.close()
+
+
+def test_a_cheat_on_the_robots_cell_is_refused_with_the_games_message(browser: Any,
+                                                                      game_cockpit: Cockpit) -> None:
+    page = browser.new_page()
+    try:
+        open_game(page, game_cockpit)
+        run_to_first_turn(page)
+        # Play before drawing anything is refused: it is the person's turn.
+        page.get_by_role("button", name="Play", exact=True).click()
+        page.wait_for_function("document.querySelector('[data-role=reply]').dataset.error === 'true'",
+                               timeout=30_000)
+        assert "draw your move (click a cell), then click Play" in text_of(page, "reply")
+        cell(page, 3, 3).click()
+        page.get_by_role("button", name="Play", exact=True).click()
+        page.wait_for_function("document.querySelector('[data-role=board] button[data-row=\"3\"][data-column=\"3\"]')"
+                               ".dataset.by === 'person'", timeout=LONG)
+        page.wait_for_function("!document.querySelector('[data-role=board] button').disabled", timeout=LONG)
+        robot = next(m for m in game_state(game_cockpit)["moves"] if m["by"] == "robot")
+        # The person draws over the manipulator's O: the camera sees it, the game refuses it.
+        cell(page, robot["row"], robot["column"]).click()
+        page.get_by_role("button", name="Play", exact=True).click()
+        wanted = f"Cell ({robot['row']}, {robot['column']}) is already mine."
+        status = page.get_by_role("status", name="the game says").filter(has_text=wanted)
+        status.wait_for(timeout=LONG)
+        assert "Please wipe your mark there and draw in an empty cell." in str(status.text_content())
+        assert status.get_attribute("data-error") == "true"
+        state = game_state(game_cockpit)
+        where = 5 * (robot["row"] - 1) + robot["column"] - 1
+        assert state["truth"][where] == "X"  # the hand did draw there ...
+        assert state["board"][where] == "O"  # ... and the game did not take it as the person's move
+        assert state["wrong"] == 1
+        assert len([m for m in state["moves"] if m["by"] == "person"]) == 1
+    finally:
+        page.close()
+
+
+def test_stop_in_the_middle_of_a_stroke_lifts_the_pen_and_returns_the_arm(browser: Any,
+                                                                         game_cockpit: Cockpit) -> None:
+    page = browser.new_page()
+    session = game_cockpit.session
+    try:
+        open_game(page, game_cockpit)
+        session.call(lambda d: d.add_breakpoint("enter Control.field_pen_down"))
+        page.get_by_role("button", name="Run", exact=True).click()
+        page.wait_for_function("document.querySelector('[data-role=mode]').dataset.mode === 'paused'",
+                               timeout=LONG)
+
+        def into_the_stroke(d: Debugger) -> tuple[bool, float]:
+            d.delete(None)
+            while not d.robot.board.contact.pen_touching:
+                d.step(10)
+            d.step(200)  # 0.2 s into the line
+            return d.robot.board.contact.pen_touching, d.robot.board.ink_area_mm2()
+
+        touching, ink = session.call(into_the_stroke)
+        assert touching and ink > 0.0
+        page.get_by_role("button", name="Stop", exact=True).click()
+        page.wait_for_function("document.querySelector('[data-role=reply]').textContent.startsWith('Stop:')",
+                               timeout=30_000)
+        page.get_by_role("button", name="Run", exact=True).click()
+        wait_text(page, "text-box2", MSG_TURNING_OFF)
+        page.wait_for_function("document.querySelector('[data-cmd=stop]').disabled", timeout=LONG)
+        state = game_state(game_cockpit)
+        control = session.call(lambda d: (bool(d.robot.control.at_start), d.robot.board.contact.pen_touching,
+                                          sorted(d.robot.active("Control"))))
+        assert state["ended"] and state["moves"] == []
+        assert control[0] and not control[1], control  # back at the start pose, the pen off the board
+        assert any("finished" in s for s in control[2]), control
+        assert state["ink_mm2"] < ink + 5.0  # the stroke was not finished after Stop
+        assert state["outcome"] == "halted"
+    finally:
+        page.close()

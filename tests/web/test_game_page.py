@@ -14,6 +14,7 @@ screenshots`` (``TTT_SM_SCREENSHOTS=docs/img``) writes it into docs/img.
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -209,8 +210,11 @@ def test_stop_in_the_middle_of_a_stroke_lifts_the_pen_and_returns_the_arm(browse
         open_game(page, game_cockpit)
         session.call(lambda d: d.add_breakpoint("enter Control.field_pen_down"))
         page.get_by_role("button", name="Run", exact=True).click()
-        page.wait_for_function("document.querySelector('[data-role=mode]').dataset.mode === 'paused'",
-                               timeout=LONG)
+        deadline = time.monotonic() + LONG / 1e3
+        while not (session.mode == "paused" and session.call(lambda d: d.breakpoints[0].hits) >= 1):
+            assert time.monotonic() < deadline, "the breakpoint on the field's first pen-down was not hit"
+            time.sleep(0.05)
+        page.wait_for_function("!document.querySelector('[data-cmd=run]').disabled", timeout=30_000)
 
         def into_the_stroke(d: Debugger) -> tuple[bool, float]:
             d.delete(None)

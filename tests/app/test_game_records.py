@@ -5,7 +5,8 @@ SIGTERM at a random moment (after a random number of the record's lines);
 every line of the record must parse, the last must say how the game ended,
 and replaying the record's seed to that line's chart tick must reach the
 same state (docs/reliability.md, "Records that survive").  The default run
-interrupts a few games; the soak run (`make soak`) fifty.
+interrupts three games; the soak run (`make soak`) fifty, two at a time (a
+game's replay in this process overlaps the next game's run).
 """
 
 from __future__ import annotations
@@ -16,7 +17,10 @@ import signal
 import subprocess
 import sys
 import time
+from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -108,69 +112,105 @@ def test_every_game_is_bounded_in_simulated_time():
         session.close()
 
 
-def _interrupt_games(tmp_path: Path, seeds: list[int]) -> dict[str, int]:
-    """Run each game in a subprocess, signal it after a random number of record lines, check its record."""
-    counts = {"SIGINT": 0, "SIGTERM": 0, "finished": 0, "records": 0, "replayed": 0}
-    for seed in seeds:
-        rng = random.Random(seed)
-        out = tmp_path / f"game{seed}"
-        sig = rng.choice([signal.SIGINT, signal.SIGTERM])
-        camera = "serial" if seed % 2 else "direct"
-        proc = subprocess.Popen([str(TTT), "play", "--opponent", "simulated", "--seed", str(seed), "--camera", camera,
-                                 "--person", rng.choice(["random", "greedy"]), "--out", str(out)],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
-        record = out / "game.jsonl"
-        after_lines = rng.randint(1, 150)  # game events and transitions: a whole game writes about 170
-        give_up = time.monotonic() + 300
-        try:
-            while proc.poll() is None and time.monotonic() < give_up:
-                try:
-                    with record.open("rb") as f:
-                        if sum(1 for _ in f) >= after_lines:
-                            break
-                except FileNotFoundError:
-                    pass
-                time.sleep(0.02)
-            time.sleep(rng.uniform(0.0, 1.0))
-            proc.send_signal(sig)
-            status = proc.wait(timeout=120)
-            err = proc.stderr.read() if proc.stderr else ""
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-        assert "Traceback" not in err, err
+def _interrupt_game(tmp_path: Path, seed: int) -> dict[str, Any]:
+    """Run one game in a subprocess, signal it after a random number of record lines; what its record shows.
+
+    Returns ``ending`` (``finished``, ``SIGINT``, ``SIGTERM``) and ``problems``:
+    every way the record or the run fell short (a lost record is one of them).
+    """
+    rng = random.Random(seed)
+    out = tmp_path / f"game{seed}"
+    sig = rng.choice([signal.SIGINT, signal.SIGTERM])
+    camera = "serial" if seed % 2 else "direct"
+    proc = subprocess.Popen([str(TTT), "play", "--opponent", "simulated", "--seed", str(seed), "--camera", camera,
+                             "--person", rng.choice(["random", "greedy"]), "--out", str(out)],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            cwd=tmp_path)
+    record = out / "game.jsonl"
+    after_lines = rng.randint(1, 150)  # game events and transitions: a whole game writes about 170
+    give_up = time.monotonic() + 600
+    try:
+        while proc.poll() is None and time.monotonic() < give_up:
+            try:
+                with record.open("rb") as f:
+                    if sum(1 for _ in f) >= after_lines:
+                        break
+            except FileNotFoundError:
+                pass
+            time.sleep(0.02)
+        time.sleep(rng.uniform(0.0, 1.0))
+        proc.send_signal(sig)
+        _, err = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    status = proc.returncode
+    problems: list[str] = []
+    result: dict[str, Any] = {"seed": seed, "ending": "lost", "problems": problems, "lines": 0}
+    if "Traceback" in err:
+        problems.append(f"a traceback: {err[-2000:]}")
+    try:
         lines = read_record(record)  # every line parses
-        counts["records"] += 1
-        last = lines[-1]
-        assert last["event"] in ENDINGS, last
-        assert lines[0]["event"] == "game" and lines[0]["seed"] == seed
-        if last["event"] == "finished":  # the game ended before the signal came
-            assert status == 0
-            counts["finished"] += 1
-        else:
-            assert last["event"] == "interrupted" and last["signal"] == sig.name and last["boundary"] is True, last
-            assert status == 128 + sig, (status, err)
-            assert f"interrupted ({sig.name})" in err.strip().splitlines()[-1]
-            assert last["waiting_for"] and last["pictures"]
-            assert all(Path(p).is_file() for p in last["pictures"].values())
-            counts[sig.name] += 1
-        check = replay_record(record, P)
-        assert check.identical, check.describe()
-        counts["replayed"] += 1
-    return counts
+    except (OSError, ValueError) as exc:
+        problems.append(f"record lost: {exc}")
+        return result
+    result["lines"] = len(lines)
+    if not lines or lines[0].get("event") != "game" or lines[0].get("seed") != seed:
+        problems.append(f"record lost: its first line is not the game's: {lines[:1]}")
+        return result
+    last = lines[-1]
+    if last.get("event") not in ENDINGS:
+        problems.append(f"record lost: its last line says nothing of how the game ended: {last}")
+        return result
+    if last["event"] == "finished":  # the game ended before the signal came
+        result["ending"] = "finished"
+        if status != 0:
+            problems.append(f"finished, but status {status}: {err[-500:]}")
+    else:
+        result["ending"] = sig.name
+        if not (last["event"] == "interrupted" and last["signal"] == sig.name and last["boundary"] is True):
+            problems.append(f"the last line is not this {sig.name}'s: {last}")
+        if status != 128 + sig:
+            problems.append(f"status {status}, not {128 + sig}: {err[-500:]}")
+        if f"interrupted ({sig.name})" not in (err.strip().splitlines() or [""])[-1]:
+            problems.append(f"standard error does not end saying so: {err[-500:]}")
+        if not (last.get("waiting_for") and last.get("pictures")) or not all(
+                Path(p).is_file() for p in last["pictures"].values()):
+            problems.append(f"where it stood or its pictures missing: {last}")
+    check = replay_record(record, P)
+    if not check.identical:
+        problems.append(check.describe())
+    return result
+
+
+def _interrupt_games(tmp_path: Path, seeds: list[int], workers: int = 1) -> tuple[dict[str, int], list[str]]:
+    """Interrupt a game per seed (``workers`` at a time: a game's replay overlaps another game's run).
+
+    Returns the counts (games, how they ended, records lost, lines) and every problem found.
+    """
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        results = list(pool.map(lambda s: _interrupt_game(tmp_path, s), seeds))
+    endings = Counter(str(r["ending"]) for r in results)
+    problems = [f"seed {r['seed']}: {p}" for r in results for p in r["problems"]]
+    counts = {"games": len(results), "SIGINT": endings["SIGINT"], "SIGTERM": endings["SIGTERM"],
+              "finished_first": endings["finished"],
+              "records_lost": sum(any(p.startswith("record lost") for p in r["problems"]) for r in results),
+              "lines": sum(r["lines"] for r in results)}
+    return counts, problems
 
 
 @needs_script
 def test_interrupted_games_keep_a_record_that_replays_to_its_last_tick(tmp_path):
-    counts = _interrupt_games(tmp_path, [11, 12, 13])
-    assert counts["records"] == counts["replayed"] == 3
-    assert counts["SIGINT"] + counts["SIGTERM"] >= 2
+    counts, problems = _interrupt_games(tmp_path, [11, 12, 13])
+    assert not problems, "\n\n".join(problems)
+    assert counts["records_lost"] == 0 and counts["SIGINT"] + counts["SIGTERM"] >= 2
 
 
 @pytest.mark.soak
 @needs_script
 def test_fifty_interrupted_games_lose_no_record(tmp_path):
-    counts = _interrupt_games(tmp_path, list(range(100, 150)))
+    counts, problems = _interrupt_games(tmp_path, list(range(100, 150)), workers=2)
     print(f"interrupted games: {counts}")
-    assert counts["records"] == counts["replayed"] == 50
-    assert counts["SIGINT"] + counts["SIGTERM"] >= 45
+    assert not problems, "\n\n".join(problems)
+    assert counts["games"] == 50 and counts["records_lost"] == 0 and counts["SIGINT"] + counts["SIGTERM"] >= 45

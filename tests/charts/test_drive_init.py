@@ -130,3 +130,11 @@ def test_passing_and_gave_up_are_outputs_that_follow_pass_pos_and_failed():
     dead.set_input("DriveInit1", "index", True, force=True)
     assert dead.run_until(lambda: dead.init_stage.failed, 30)
     assert dead.init_stage.charts[0].gave_up and "failed" in dead.active("DriveInit1")
+
+
+def test_init_runs_are_bounded_in_simulated_time_and_say_where_they_are():
+    heard: list[str] = []
+    report = init_report(P, 2, seed=3, timeout_s=1.0, status=heard.append)
+    # one simulated second is too short to find the indexes: both runs stop there and count as failures
+    assert report["successes"] == 0 and report["max_time_s"] == 1.0 and len(report["failed_power_on_deg"]) == 2
+    assert heard == [f"init: power-on pose {k} of 2, 0 initialised so far" for k in (1, 2)]

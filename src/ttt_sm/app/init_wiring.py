@@ -237,15 +237,20 @@ def settled_pose(params: ArmParams, q_start: np.ndarray | None, seconds: float, 
     return sim.truth.q
 
 
+#: Longest one initialisation may run, in simulated seconds, unless told otherwise (one takes 6-12 s).
+DEFAULT_INIT_TIMEOUT_S = 40.0
+
+
 def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None,
-             settle_s: float = 2.0, timeout_s: float = 40.0) -> InitRun:
+             settle_s: float = 2.0, timeout_s: float = DEFAULT_INIT_TIMEOUT_S) -> InitRun:
     """Initialise the twin once.
 
     The arm is placed at `q_start` (default: its rest pose) and left unpowered
     for `settle_s`, so gravity brings the pitch joints down as it would before
     anyone switches the arm on (drive 2 "near zero", section 3.1.2).  Then the
     arm is powered: the encoders start counting from zero there, the
-    controllers hold where the arm stands, and the init charts take over.
+    controllers hold where the arm stands, and the init charts take over, for
+    at most `timeout_s` of simulated time (a run that reaches it is a failure).
     """
     q_power_on = settled_pose(params, q_start, settle_s, seed) if settle_s > 0 else q_start
     sim = ArmSim(params, seed=seed, q0=q_power_on)
@@ -271,11 +276,19 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
     )
 
 
-def init_report(params: ArmParams, starts: int, seed: int = 0) -> dict[str, Any]:
-    """Initialise from `starts` random power-on poses: what `ttt-sm init --json` prints."""
+def init_report(params: ArmParams, starts: int, seed: int = 0, timeout_s: float = DEFAULT_INIT_TIMEOUT_S,
+                status: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Initialise from `starts` random power-on poses: what `ttt-sm init --json` prints.
+
+    Each run is bounded by `timeout_s` of simulated time; `status` hears where the runs are.
+    """
     rng = np.random.default_rng(seed)
     wall0 = time.perf_counter()
-    runs = [run_init(params, seed=seed + k, q_start=random_power_on(params, rng)) for k in range(starts)]
+    runs: list[InitRun] = []
+    for k in range(starts):
+        if status is not None:
+            status(f"init: power-on pose {k + 1} of {starts}, {sum(r.success for r in runs)} initialised so far")
+        runs.append(run_init(params, seed=seed + k, q_start=random_power_on(params, rng), timeout_s=timeout_s))
     times = [r.time_s for r in runs]
     offset_errors = [abs(e) for r in runs if r.success for e in r.offset_error_rad]
     count = min(d.rad_per_count for d in params.drives)

@@ -103,6 +103,9 @@ def cmd_camera_serve(args: argparse.Namespace) -> int:
         return _fail("serve", f"--fault-every must be >= 0, got {args.fault_every}")
     try:
         source = board_source(args.board, seed=args.seed)
+    except ValueError as exc:
+        return _fail("serve", f"--board: {exc}")
+    try:
         cam = CameraEmulator(source, rate_hz=args.rate, link=args.link)
     except (ValueError, SerialLinkError) as exc:
         return _fail("serve", str(exc))
@@ -134,7 +137,7 @@ def cmd_camera_read(args: argparse.Namespace) -> int:
     """Read ``--count`` frames from ``--port`` and print them (5 x 5 grids, or JSON)."""
     if args.count < 1:
         return _fail("read", f"--count must be at least 1, got {args.count}")
-    if not (args.timeout > 0 and args.give_up >= 0):
+    if not (0 < args.timeout < math.inf and 0 <= args.give_up < math.inf):
         return _fail("read", f"--timeout must be > 0 and --give-up >= 0 seconds, got {args.timeout}, {args.give_up}")
     policy = ReconnectPolicy(max_duration_s=args.give_up)
     frames = []

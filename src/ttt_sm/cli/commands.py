@@ -128,6 +128,11 @@ def cmd_draw(args: argparse.Namespace) -> int:
     size = None if args.size is None else args.size / 1000
     try:
         check_request(params, args.kind, args.row, args.column, speed, size)
+    except DrawError as exc:  # the request's own words, with the option they came from
+        text = str(exc)
+        option = {"cell": "--row/--column", "speed": "--speed", "size": "--size"}.get(text.split(" ", 1)[0])
+        raise CliError(f"{option}: {text}" if option else text) from exc
+    try:
         session = DrawSession(params, seed=args.seed, progress=progress(True))
         session.start()
         result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=out)
@@ -149,11 +154,14 @@ def cmd_tune(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from ..bench import run_bench
+    from ..bench import SECTIONS, run_bench
 
     out = out_dir(args.out)
     params = load_arm(args.params)
     only = [s.strip() for s in args.only.split(",")] if args.only else None
+    unknown = [name for name in only or () if name not in SECTIONS]
+    if unknown:
+        raise CliError(f"--only: unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
     try:
         if args.gui_soak is not None and not args.gui_soak > 0:
             raise ValueError(f"--gui-soak: expected a positive number of minutes, got {args.gui_soak}")
@@ -168,6 +176,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def cmd_ik(args: argparse.Namespace) -> int:
     from ..twin.kinematics import IKSolver, fk
 
+    bad = [f"{name} = {value}" for name, value in (("x", args.x), ("y", args.y), ("z", args.z), ("--phi", args.phi))
+           if not np.isfinite(value)]
+    if bad:
+        raise CliError(f"the target must be finite numbers (mm, degrees), got {', '.join(bad)}")
     params = load_arm(args.params)
     target = np.array([args.x / 1000, args.y / 1000, args.z / 1000, np.radians(args.phi)])
     solver = IKSolver(params)
@@ -190,8 +202,13 @@ def cmd_init(args: argparse.Namespace) -> int:
 
     if not 1 <= args.starts <= MAX_STARTS:
         raise CliError(f"--starts must lie in 1..{MAX_STARTS}, got {args.starts}")
+    if not 0 < args.time_limit <= 3600:
+        raise CliError(f"--time-limit must lie in (0, 3600] simulated seconds, got {args.time_limit}")
     params = load_arm(args.params)
-    report = init_report(params, args.starts, seed=args.seed)
+    try:
+        report = init_report(params, args.starts, seed=args.seed, timeout_s=args.time_limit, status=status_line())
+    finally:
+        clear_status()
     text = "\n".join(f"  {k}: {v}" for k, v in report.items())
     emit(report, args.json, f"init from {args.starts} random power-on poses:\n{text}")
     ok = report["successes"] == report["runs"] and not report["limit_violations"] \
@@ -217,7 +234,7 @@ def cmd_charts(args: argparse.Namespace) -> int:
     formats = tuple(f.strip() for f in args.format.split(",")) if args.format else REPO_CHART_FORMATS
     unknown = [f for f in formats if f not in FORMATS]
     if unknown:
-        raise CliError(f"unknown format(s) {', '.join(unknown)}; choose from {', '.join(FORMATS)}")
+        raise CliError(f"--format: unknown format(s) {', '.join(unknown)}; choose from {', '.join(FORMATS)}")
     if args.action == "export":
         out_dir(args.out)
     result = export_command(ALL_CHARTS, args.out, check=args.action == "check", formats=formats,
@@ -280,6 +297,8 @@ def register(sub: Any) -> None:
     sp = add_command(sub, "init", cmd_init, "initialise the drives with the init charts from random power-on poses")
     sp.add_argument("--starts", type=int, default=20,
                     help=f"number of random power-on poses, 1..{MAX_STARTS} (default 20)")
+    sp.add_argument("--time-limit", type=float, default=40.0, metavar="SECONDS",
+                    help="longest one initialisation may run, simulated seconds (default 40; one takes 6-12)")
     sp = add_command(sub, "charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
     sp.add_argument("action", choices=["export", "check"])
     sp.add_argument("--format", default=None,

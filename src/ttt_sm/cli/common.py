@@ -106,6 +106,8 @@ def out_dir(path: str, what: str = "--out") -> Path:
         probe.unlink()
     except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
         reason = getattr(exc, "strerror", None) or str(exc)
+        if isinstance(exc, FileExistsError):
+            reason = "a file is there, not a folder"
         raise CliError(f"{what} {path[:200]}: cannot write there ({reason})") from None
     return folder
 

@@ -16,7 +16,7 @@ import webbrowser
 from pathlib import Path
 from typing import Any
 
-from .common import CliError, seed
+from .common import CliError, out_dir, seed
 
 DEFAULT_PORT = 8765
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
@@ -89,6 +89,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
     folder = Path(args.scenarios) if args.scenarios else Path("tests/scenarios")
     if args.scenarios and not folder.is_dir():
         raise CliError(f"--scenarios: {args.scenarios} is not a folder")
+    if Path(args.trace).is_dir():
+        raise CliError(f"--trace: {args.trace} is a folder; name the file the trace is saved to")
+    out_dir(str(Path(args.trace).parent), f"--trace {args.trace}: its folder")  # written when the cockpit stops
     params = load_arm(getattr(args, "params", None))
     token = secrets.token_urlsafe(24) if needs_token(args.host) else None
     try:

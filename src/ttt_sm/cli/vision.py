@@ -109,7 +109,10 @@ def cmd_vision_detect(args: argparse.Namespace) -> int:
         det = detect(image)
         note = check_orientation(det.grid, args.view, str(args.image))
         if args.robot_marks is not None:
-            check_robot_marks(det.cells, args.view, args.robot_marks.upper(), str(args.image))
+            try:
+                check_robot_marks(det.cells, args.view, args.robot_marks.upper(), str(args.image))
+            except VisionError as exc:
+                raise VisionError(f"--robot-marks: {exc}") from None
             note += "; the robot's marks are where it drew them"
         if out is not None:
             _write_picture(out, overlay(image, det), "--overlay")
@@ -148,8 +151,11 @@ def cmd_vision_render(args: argparse.Namespace) -> int:
     params = load_arm(args.params)
     try:
         out = _picture_path(args.out, "OUT")
-        scene = (scene_from_text(params, args.board, args.robot, args.seed) if args.board is not None
-                 else random_scene(params, args.seed))
+        try:
+            scene = (scene_from_text(params, args.board, args.robot, args.seed) if args.board is not None
+                     else random_scene(params, args.seed))
+        except ValueError as exc:
+            raise VisionError(f"--board: {exc}") from None
         rng = np.random.default_rng(args.seed + 1)
         lighting = None
         if args.dim is not None:

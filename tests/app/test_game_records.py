@@ -122,8 +122,9 @@ def _interrupt_game(tmp_path: Path, seed: int) -> dict[str, Any]:
     out = tmp_path / f"game{seed}"
     sig = rng.choice([signal.SIGINT, signal.SIGTERM])
     camera = "serial" if seed % 2 else "direct"
+    person = rng.choice(["random", "greedy"])
     proc = subprocess.Popen([str(TTT), "play", "--opponent", "simulated", "--seed", str(seed), "--camera", camera,
-                             "--person", rng.choice(["random", "greedy"]), "--out", str(out)],
+                             "--person", person, "--out", str(out)],
                             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                             cwd=tmp_path)
     record = out / "game.jsonl"
@@ -159,6 +160,8 @@ def _interrupt_game(tmp_path: Path, seed: int) -> dict[str, Any]:
     if not lines or lines[0].get("event") != "game" or lines[0].get("seed") != seed:
         problems.append(f"record lost: its first line is not the game's: {lines[:1]}")
         return result
+    if (lines[0].get("person"), lines[0].get("camera")) != (f"simulated {person}", camera):
+        problems.append(f"the game line does not say who played and how it saw: {lines[0]}")
     last = lines[-1]
     if last.get("event") not in ENDINGS:
         problems.append(f"record lost: its last line says nothing of how the game ended: {last}")

@@ -3,7 +3,7 @@
 PY := .venv/bin/python
 TTT := .venv/bin/ttt-sm
 
-.PHONY: setup play test gui screenshots soak fuzz lint bench tune clean
+.PHONY: setup play test gui screenshots soak fuzz lint bench tune firmware clean
 
 setup:
 	@sh scripts/setup.sh
@@ -36,6 +36,11 @@ bench: setup
 
 tune: setup
 	$(TTT) tune
+
+# The firmware's portable C (firmware/), built with the system compiler as the tests
+# load it, both precisions, every warning an error (flags: ttt_sm.hardware.firmware).
+firmware: setup
+	$(PY) -m ttt_sm.hardware.firmware out/firmware
 
 clean:
 	rm -rf .venv out .pytest_cache

@@ -41,6 +41,64 @@ def _struct(real: Any) -> type[ctypes.Structure]:
     return Cascade
 
 
+class Board(ctypes.Structure):
+    """``ttt_board`` (fw.h): what the board is, told to the PC in the handshake."""
+
+    _fields_ = [
+        ("rad_per_count", ctypes.c_double * 3),
+        ("limit_min_rad", ctypes.c_float * 3),
+        ("limit_max_rad", ctypes.c_float * 3),
+        ("servo_min_rad", ctypes.c_float),
+        ("servo_max_rad", ctypes.c_float),
+        ("servo_safe_rad", ctypes.c_float),
+        ("control_period_us", ctypes.c_uint32),
+        ("watchdog_steps", ctypes.c_uint32),
+        ("status_every", ctypes.c_uint32),
+        ("late_steps", ctypes.c_uint32),
+    ]
+
+
+class SensorsIn(ctypes.Structure):
+    """``ttt_sensors`` (fw.h): what the board read this control step."""
+
+    _fields_ = [
+        ("counts", ctypes.c_int32 * 3),
+        ("index_count", ctypes.c_int32 * 3),
+        ("index_edges", ctypes.c_uint16 * 3),
+        ("index", ctypes.c_uint8),
+        ("current_a", ctypes.c_float * 3),
+    ]
+
+
+#: The watchdog's limit: setpoints missing this long stop the drives (s).
+WATCHDOG_S = 0.050
+#: Setpoints more than this late (s) are rejected.
+LATE_S = 0.002
+
+
+def board_for(params: ArmParams, servo_safe_rad: float, status_every: int | None = None) -> Board:
+    """The board description of an arm built to the parameter file (the emulator's board).
+
+    `servo_safe_rad` is where the pen goes when the watchdog stops the arm
+    (the pen lifted); a STATUS goes out every `status_every` control steps
+    (default: every chart step).
+    """
+    b = Board()
+    dt = params.control.dt
+    for d, p in enumerate(params.drives):
+        b.rad_per_count[d] = p.rad_per_count
+        b.limit_min_rad[d] = p.limit_min_rad
+        b.limit_max_rad[d] = p.limit_max_rad
+    s = params.servo
+    b.servo_min_rad, b.servo_max_rad = s.min_rad, s.max_rad
+    b.servo_safe_rad = servo_safe_rad
+    b.control_period_us = int(round(dt * 1e6))
+    b.watchdog_steps = int(round(WATCHDOG_S / dt))
+    b.status_every = params.control.chart_divider if status_every is None else status_every
+    b.late_steps = int(round(LATE_S / dt))
+    return b
+
+
 class FirmwareLibrary:
     """A loaded firmware shared object (:func:`.firmware.build`) and its function signatures."""
 
@@ -67,6 +125,25 @@ class FirmwareLibrary:
             "ttt_cascade_set_open_duty": (None, [ptr, ctypes.c_int, real]),
             "ttt_cascade_angle": (real, [ptr, ctypes.c_int, ctypes.c_int32]),
         }
+        fw = ctypes.c_void_p
+        u8p = ctypes.POINTER(ctypes.c_uint8)
+        signatures.update({
+            "ttt_fw_size": (ctypes.c_size_t, []),
+            "ttt_fw_init": (None, [fw, ctypes.POINTER(Board)]),
+            "ttt_fw_rx": (None, [fw, u8p, ctypes.c_size_t]),
+            "ttt_fw_tx": (ctypes.c_size_t, [fw, u8p, ctypes.c_size_t]),
+            "ttt_fw_control_step": (None, [fw, ctypes.POINTER(SensorsIn)]),
+            "ttt_fw_cascade": (ptr, [fw]),
+            "ttt_fw_state": (ctypes.c_uint8, [fw]),
+            "ttt_fw_frames_ok": (ctypes.c_uint32, [fw]),
+            "ttt_fw_rejections": (ctypes.c_uint32, [fw, ctypes.c_int]),
+            "ttt_fw_lost": (ctypes.c_uint32, [fw]),
+            "ttt_fw_step": (ctypes.c_uint32, [fw]),
+            "ttt_crc16": (ctypes.c_uint16, [u8p, ctypes.c_size_t]),
+            "ttt_cobs_encode": (ctypes.c_size_t, [u8p, ctypes.c_size_t, u8p]),
+            "ttt_cobs_decode": (ctypes.c_int, [u8p, ctypes.c_size_t, u8p]),
+            "ttt_frame_encode": (ctypes.c_size_t, [ctypes.c_uint8, ctypes.c_uint16, u8p, ctypes.c_size_t, u8p]),
+        })
         for name, (restype, argtypes) in signatures.items():
             fn = getattr(self.lib, name)
             fn.restype = restype
@@ -152,4 +229,67 @@ class NativeCascade:
         return float(self.lib.lib.ttt_cascade_angle(self._ref, check_drive(drive) - 1, int(count)))
 
 
-__all__ = ["FirmwareLibrary", "NativeCascade"]
+class NativeFirmware:
+    """The whole firmware core (``ttt_fw``, fw.h): link, cascade, watchdog, in the C that would be flashed.
+
+    Bytes go in with :meth:`rx`, come out with :meth:`tx`; :meth:`step`
+    runs one control step on the board's sensor readings.  The accessors
+    read the firmware's own counters.
+    """
+
+    def __init__(self, lib: FirmwareLibrary, board: Board) -> None:
+        self.lib = lib
+        self.board = board
+        f = lib.lib
+        self._mem = ctypes.create_string_buffer(int(f.ttt_fw_size()))
+        self.ptr = ctypes.cast(self._mem, ctypes.c_void_p)
+        f.ttt_fw_init(self.ptr, ctypes.byref(board))
+        self.sensors = SensorsIn()
+        self._sensors_ref = ctypes.byref(self.sensors)
+        self._out = (ctypes.c_uint8 * 4096)()
+        self.cascade = f.ttt_fw_cascade(self.ptr).contents
+
+    def rx(self, data: bytes) -> None:
+        """Bytes received from the PC, in any chunking."""
+        buf = (ctypes.c_uint8 * len(data)).from_buffer_copy(data) if data else (ctypes.c_uint8 * 1)()
+        self.lib.lib.ttt_fw_rx(self.ptr, buf, len(data))
+
+    def tx(self) -> bytes:
+        """Everything the firmware has to send now."""
+        out = bytearray()
+        while True:
+            n = self.lib.lib.ttt_fw_tx(self.ptr, self._out, len(self._out))
+            out += bytes(self._out[:n])
+            if n < len(self._out):
+                return bytes(out)
+
+    def step(self) -> None:
+        """One control step on :attr:`sensors` (fill it first); the commands are in :attr:`act`."""
+        self.lib.lib.ttt_fw_control_step(self.ptr, self._sensors_ref)
+
+    @property
+    def act(self) -> np.ndarray:
+        return np.ctypeslib.as_array(self.cascade.act)
+
+    @property
+    def state(self) -> int:
+        return int(self.lib.lib.ttt_fw_state(self.ptr))
+
+    @property
+    def frames_ok(self) -> int:
+        return int(self.lib.lib.ttt_fw_frames_ok(self.ptr))
+
+    @property
+    def lost(self) -> int:
+        return int(self.lib.lib.ttt_fw_lost(self.ptr))
+
+    @property
+    def steps(self) -> int:
+        return int(self.lib.lib.ttt_fw_step(self.ptr))
+
+    def rejections(self) -> dict[int, int]:
+        """The firmware's rejection counters, by reason number (``TTT_REJ_*``)."""
+        return {r: int(self.lib.lib.ttt_fw_rejections(self.ptr, r)) for r in range(12)}
+
+
+__all__ = ["FirmwareLibrary", "NativeCascade", "NativeFirmware", "Board", "SensorsIn", "board_for"]

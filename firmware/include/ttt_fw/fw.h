@@ -1,0 +1,99 @@
+/*
+ * The firmware's core: the link, the cascade and the watchdog, without a
+ * board.  A board layer reads its sensors into a ttt_sensors, calls
+ * ttt_fw_control_step() at the control rate, writes fw->cascade.act to the
+ * H-bridges and the servo, feeds received bytes to ttt_fw_rx() and sends
+ * what ttt_fw_tx() hands out (docs/hardware.md).
+ *
+ * States: IDLE after power-on (bridges off, no servo pulse; gains may be
+ * downloaded), RUNNING after START (the cascade follows the setpoints),
+ * SAFE_STOP when setpoints stopped arriving for board.watchdog_steps
+ * control steps (each powered drive holds where it is, the pen goes to
+ * board.servo_safe_rad) until the next START.
+ */
+#ifndef TTT_FW_FW_H
+#define TTT_FW_FW_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cascade.h"
+#include "link.h"
+
+#define TTT_FW_VERSION_MAJOR 0
+#define TTT_FW_VERSION_MINOR 1
+#define TTT_FW_VERSION_PATCH 0
+
+#define TTT_STATE_IDLE 0
+#define TTT_STATE_RUNNING 1
+#define TTT_STATE_SAFE_STOP 2
+
+/* DRIVE message operations */
+#define TTT_OP_OFF 0       /* bridge off */
+#define TTT_OP_CLOSED 1    /* cascade on, holding where the drive is */
+#define TTT_OP_OPEN 2      /* open loop at duty = value */
+#define TTT_OP_OFFSET 3    /* encoder offset estimate = value (rad) */
+
+#define TTT_GAINS_BLOCKS 4 /* blocks 0..2: cp of drive 1..3 (10 values); block 3: cg (18 values) */
+#define TTT_TX_CAP 1024
+
+/* What the board is: told to the PC in the handshake. */
+typedef struct ttt_board {
+    double rad_per_count[TTT_DRIVES];
+    float limit_min_rad[TTT_DRIVES];
+    float limit_max_rad[TTT_DRIVES];
+    float servo_min_rad, servo_max_rad, servo_safe_rad;
+    uint32_t control_period_us;
+    uint32_t watchdog_steps;  /* setpoints missing this many steps -> SAFE_STOP (50 at 1 kHz: 50 ms) */
+    uint32_t status_every;    /* a STATUS frame every this many control steps */
+    uint32_t late_steps;      /* setpoints this many steps past their step are late */
+} ttt_board;
+
+/* What the board read this control step. */
+typedef struct ttt_sensors {
+    int32_t counts[TTT_DRIVES];
+    int32_t index_count[TTT_DRIVES];
+    uint16_t index_edges[TTT_DRIVES];
+    uint8_t index;            /* bit d: drive d's index switch level */
+    float current_a[TTT_DRIVES];
+} ttt_sensors;
+
+typedef struct ttt_fw {
+    ttt_board board;
+    ttt_cascade cascade;
+    ttt_sensors sensors;      /* the last control step's */
+    ttt_rx rx;
+    ttt_seq rx_seq;
+    uint16_t tx_seq;
+    uint8_t state;
+    uint8_t gains_loaded;     /* bit b: block b received */
+    uint8_t safe_reason;      /* why the last SAFE_STOP: 1 watchdog */
+    uint32_t step;            /* control steps since power-on */
+    uint32_t last_setpoint_step;
+    uint32_t frames_ok;
+    uint32_t rejections[TTT_N_REJ];
+    int last_reject;          /* the last rejection's reason, -1 if none */
+    uint8_t tx[TTT_TX_CAP];
+    size_t tx_len;
+    uint32_t tx_dropped;      /* frames that found the transmit buffer full */
+} ttt_fw;
+
+void ttt_fw_init(ttt_fw *fw, const ttt_board *board);
+/* Received bytes, any chunking: frames are acted on, everything else counted and rejected. */
+void ttt_fw_rx(ttt_fw *fw, const uint8_t *data, size_t n);
+/* Up to cap bytes to send; returns how many were copied to out. */
+size_t ttt_fw_tx(ttt_fw *fw, uint8_t *out, size_t cap);
+/* One control step: the watchdog, the cascade (fw->cascade.act out), a STATUS when due. */
+void ttt_fw_control_step(ttt_fw *fw, const ttt_sensors *in);
+
+
+
+/* For bindings and board layers that do not see the struct's layout. */
+size_t ttt_fw_size(void);
+ttt_cascade *ttt_fw_cascade(ttt_fw *fw);
+uint8_t ttt_fw_state(const ttt_fw *fw);
+uint32_t ttt_fw_frames_ok(const ttt_fw *fw);
+uint32_t ttt_fw_rejections(const ttt_fw *fw, int reason);
+uint32_t ttt_fw_lost(const ttt_fw *fw);
+uint32_t ttt_fw_step(const ttt_fw *fw);
+#endif

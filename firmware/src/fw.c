@@ -1,0 +1,291 @@
+/* The firmware's core: messages, states, watchdog (fw.h). */
+#include "ttt_fw/fw.h"
+
+static int finite(double v)
+{
+    return (v - v) == 0.0; /* NaN - NaN and inf - inf are NaN */
+}
+
+static void send(ttt_fw *fw, uint8_t type, const uint8_t *body, size_t n)
+{
+    uint8_t wire[TTT_MAX_ENCODED + 1];
+    size_t len = ttt_frame_encode(type, fw->tx_seq, body, n, wire), i;
+    if (len == 0 || fw->tx_len + len > sizeof fw->tx) {
+        fw->tx_dropped++;
+        return;
+    }
+    for (i = 0; i < len; i++) fw->tx[fw->tx_len + i] = wire[i];
+    fw->tx_len += len;
+    fw->tx_seq++;
+}
+
+static void reject(ttt_fw *fw, int reason)
+{
+    fw->rejections[reason]++;
+    fw->last_reject = reason;
+}
+
+static void send_handshake(ttt_fw *fw)
+{
+    uint8_t b[70];
+    const ttt_board *bd = &fw->board;
+    int d;
+    b[0] = TTT_PROTOCOL_VERSION;
+    b[1] = TTT_FW_VERSION_MAJOR;
+    b[2] = TTT_FW_VERSION_MINOR;
+    b[3] = TTT_FW_VERSION_PATCH;
+    b[4] = TTT_DRIVES;
+    b[5] = (uint8_t)sizeof(ttt_real);
+    ttt_put_u32(b + 6, bd->control_period_us);
+    for (d = 0; d < TTT_DRIVES; d++) {
+        ttt_put_f64(b + 10 + 16 * d, bd->rad_per_count[d]);
+        ttt_put_f32(b + 18 + 16 * d, bd->limit_min_rad[d]);
+        ttt_put_f32(b + 22 + 16 * d, bd->limit_max_rad[d]);
+    }
+    ttt_put_f32(b + 58, bd->servo_min_rad);
+    ttt_put_f32(b + 62, bd->servo_max_rad);
+    ttt_put_f32(b + 66, bd->servo_safe_rad);
+    send(fw, TTT_MSG_HANDSHAKE, b, sizeof b);
+}
+
+static ttt_real *gains_block(ttt_fw *fw, uint8_t block, int *count)
+{
+    if (block < TTT_DRIVES) {
+        *count = TTT_N_CP;
+        return fw->cascade.cp[block];
+    }
+    *count = TTT_N_CG;
+    return fw->cascade.cg;
+}
+
+static void send_gains(ttt_fw *fw, uint8_t block)
+{
+    uint8_t b[1 + 8 * TTT_N_CG];
+    int count, k;
+    const ttt_real *v = gains_block(fw, block, &count);
+    b[0] = block;
+    for (k = 0; k < count; k++) ttt_put_f64(b + 1 + 8 * k, (double)v[k]);
+    send(fw, TTT_MSG_GAINS_READBACK, b, 1 + 8 * (size_t)count);
+}
+
+static void send_heartbeat_reply(ttt_fw *fw, uint32_t token)
+{
+    uint8_t b[16 + 4 * TTT_N_REJ];
+    int r;
+    ttt_put_u32(b, token);
+    ttt_put_u32(b + 4, fw->step);
+    ttt_put_u32(b + 8, fw->frames_ok);
+    ttt_put_u32(b + 12, fw->rx_seq.lost);
+    for (r = 0; r < TTT_N_REJ; r++) ttt_put_u32(b + 16 + 4 * r, fw->rejections[r]);
+    send(fw, TTT_MSG_HEARTBEAT_REPLY, b, sizeof b);
+}
+
+static void send_status(ttt_fw *fw)
+{
+    uint8_t b[43];
+    const ttt_sensors *s = &fw->sensors;
+    int d;
+    uint8_t modes = 0;
+    ttt_put_u32(b, fw->step);
+    b[4] = fw->state;
+    b[5] = s->index;
+    for (d = 0; d < TTT_DRIVES; d++) modes = (uint8_t)(modes | ((fw->cascade.cm[d] & 3) << (2 * d)));
+    b[6] = modes;
+    for (d = 0; d < TTT_DRIVES; d++) {
+        float ma = s->current_a[d] * 1000.0f;
+        int32_t i = !finite((double)ma) ? 0 : ma > 32767.0f ? 32767 : ma < -32768.0f ? -32768 : (int32_t)ma;
+        ttt_put_u32(b + 7 + 4 * d, (uint32_t)s->counts[d]);
+        ttt_put_u32(b + 19 + 4 * d, (uint32_t)s->index_count[d]);
+        ttt_put_u16(b + 31 + 2 * d, s->index_edges[d]);
+        ttt_put_u16(b + 37 + 2 * d, (uint16_t)(int16_t)i);
+    }
+    send(fw, TTT_MSG_STATUS, b, sizeof b);
+}
+
+/* Every drive that has power holds the angle it is at; the pen goes to its safe angle. */
+static void hold_here(ttt_fw *fw)
+{
+    int d;
+    for (d = 0; d < TTT_DRIVES; d++) {
+        ttt_real q = ttt_cascade_angle(&fw->cascade, d, fw->sensors.counts[d]);
+        if (fw->cascade.cm[d] != TTT_MODE_OFF) {
+            fw->cascade.cm[d] = TTT_MODE_CLOSED;
+            ttt_cascade_hold(&fw->cascade, d, q);
+        }
+    }
+}
+
+static void start(ttt_fw *fw)
+{
+    int d;
+    for (d = 0; d < TTT_DRIVES; d++) {
+        ttt_real q = ttt_cascade_angle(&fw->cascade, d, fw->sensors.counts[d]);
+        fw->cascade.cm[d] = TTT_MODE_CLOSED;
+        ttt_cascade_hold(&fw->cascade, d, q);
+    }
+    fw->state = TTT_STATE_RUNNING;
+    fw->last_setpoint_step = fw->step;
+}
+
+/* Act on one decoded frame whose sequence number was accepted; returns a rejection reason or -1. */
+static int handle(ttt_fw *fw, uint8_t type, const uint8_t *b, size_t n)
+{
+    int d, k, count;
+    (void)n;
+    switch (type) {
+    case TTT_MSG_HELLO:
+        send_handshake(fw);
+        return -1;
+    case TTT_MSG_GAINS: {
+        ttt_real *dst;
+        double v[TTT_N_CG];
+        if (b[0] >= TTT_GAINS_BLOCKS) return TTT_REJ_VALUE;
+        if (fw->state == TTT_STATE_RUNNING) return TTT_REJ_REFUSED;
+        dst = gains_block(fw, b[0], &count);
+        for (k = 0; k < count; k++) {
+            v[k] = ttt_get_f64(b + 1 + 8 * k);
+            if (!finite(v[k])) return TTT_REJ_VALUE;
+        }
+        for (k = 0; k < count; k++) dst[k] = (ttt_real)v[k];
+        fw->gains_loaded = (uint8_t)(fw->gains_loaded | (1u << b[0]));
+        send_gains(fw, b[0]);
+        return -1;
+    }
+    case TTT_MSG_GAINS_READ:
+        if (b[0] >= TTT_GAINS_BLOCKS) return TTT_REJ_VALUE;
+        send_gains(fw, b[0]);
+        return -1;
+    case TTT_MSG_SETPOINTS: {
+        uint32_t at = ttt_get_u32(b);
+        ttt_real q[4];
+        if (fw->state != TTT_STATE_RUNNING) return TTT_REJ_REFUSED;
+        if ((uint32_t)(fw->step - at) < 0x80000000u && fw->step - at > fw->board.late_steps) return TTT_REJ_LATE;
+        for (k = 0; k < 4; k++) {
+            float v = ttt_get_f32(b + 4 + 4 * k);
+            if (!finite((double)v)) return TTT_REJ_VALUE;
+            q[k] = (ttt_real)v;
+        }
+        ttt_cascade_set_setpoints(&fw->cascade, q, b[20] & 1);
+        fw->last_setpoint_step = fw->step;
+        return -1;
+    }
+    case TTT_MSG_HEARTBEAT:
+        send_heartbeat_reply(fw, ttt_get_u32(b));
+        return -1;
+    case TTT_MSG_DRIVE: {
+        double v = ttt_get_f64(b + 2);
+        ttt_real q;
+        d = b[0];
+        if (d >= TTT_DRIVES || b[1] > TTT_OP_OFFSET || !finite(v)) return TTT_REJ_VALUE;
+        if (fw->state != TTT_STATE_RUNNING) return TTT_REJ_REFUSED;
+        q = ttt_cascade_angle(&fw->cascade, d, fw->sensors.counts[d]);
+        switch (b[1]) {
+        case TTT_OP_OFF: ttt_cascade_set_mode(&fw->cascade, d, TTT_MODE_OFF, q); break;
+        case TTT_OP_CLOSED: ttt_cascade_set_mode(&fw->cascade, d, TTT_MODE_CLOSED, q); break;
+        case TTT_OP_OPEN: ttt_cascade_set_open_duty(&fw->cascade, d, (ttt_real)v); break;
+        default: ttt_cascade_set_offset(&fw->cascade, d, (ttt_real)v); break;
+        }
+        return -1;
+    }
+    case TTT_MSG_START:
+        if (fw->gains_loaded != (1u << TTT_GAINS_BLOCKS) - 1u) return TTT_REJ_REFUSED;
+        start(fw);
+        return -1;
+    default:
+        return TTT_REJ_UNKNOWN_TYPE; /* a firmware -> PC type sent to the firmware */
+    }
+}
+
+void ttt_fw_init(ttt_fw *fw, const ttt_board *board)
+{
+    int r;
+    fw->board = *board;
+    ttt_cascade_init(&fw->cascade);
+    for (r = 0; r < TTT_DRIVES; r++) {
+        fw->cascade.cm[r] = TTT_MODE_OFF;
+        fw->sensors.counts[r] = 0;
+        fw->sensors.index_count[r] = 0;
+        fw->sensors.index_edges[r] = 0;
+        fw->sensors.current_a[r] = 0.0f;
+    }
+    fw->sensors.index = 0;
+    fw->cascade.cgs[TTT_CGS_SV_SET] = (ttt_real)board->servo_safe_rad;
+    ttt_rx_init(&fw->rx);
+    ttt_seq_reset(&fw->rx_seq);
+    fw->tx_seq = 0;
+    fw->state = TTT_STATE_IDLE;
+    fw->gains_loaded = 0;
+    fw->safe_reason = 0;
+    fw->step = 0;
+    fw->last_setpoint_step = 0;
+    fw->frames_ok = 0;
+    for (r = 0; r < TTT_N_REJ; r++) fw->rejections[r] = 0;
+    fw->last_reject = -1;
+    fw->tx_len = 0;
+    fw->tx_dropped = 0;
+}
+
+void ttt_fw_rx(ttt_fw *fw, const uint8_t *data, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; i++) {
+        int got = ttt_rx_byte(&fw->rx, data[i]);
+        int reason;
+        if (got == TTT_RX_REJECTED) {
+            reject(fw, fw->rx.reason);
+            continue;
+        }
+        if (got != TTT_RX_FRAME) continue;
+        if (fw->rx.type >= 0x80) { /* a firmware -> PC type: not for us, its number not taken */
+            reject(fw, TTT_REJ_UNKNOWN_TYPE);
+            continue;
+        }
+        if (fw->rx.type == TTT_MSG_HELLO) ttt_seq_reset(&fw->rx_seq); /* a new session */
+        reason = ttt_seq_accept(&fw->rx_seq, fw->rx.seq);
+        if (reason == 0) reason = handle(fw, fw->rx.type, fw->rx.body, fw->rx.body_len);
+        if (reason >= 0) {
+            reject(fw, reason);
+        } else {
+            fw->frames_ok++;
+        }
+    }
+}
+
+size_t ttt_fw_tx(ttt_fw *fw, uint8_t *out, size_t cap)
+{
+    size_t n = fw->tx_len < cap ? fw->tx_len : cap, i;
+    for (i = 0; i < n; i++) out[i] = fw->tx[i];
+    for (i = n; i < fw->tx_len; i++) fw->tx[i - n] = fw->tx[i];
+    fw->tx_len -= n;
+    return n;
+}
+
+void ttt_fw_control_step(ttt_fw *fw, const ttt_sensors *in)
+{
+    int k;
+    fw->sensors = *in;
+    if (fw->state == TTT_STATE_RUNNING && fw->step - fw->last_setpoint_step >= fw->board.watchdog_steps) {
+        fw->state = TTT_STATE_SAFE_STOP;
+        fw->safe_reason = 1;
+        hold_here(fw);
+        fw->cascade.cgs[TTT_CGS_SV_SET] = (ttt_real)fw->board.servo_safe_rad;
+    }
+    if (fw->state == TTT_STATE_IDLE) {
+        for (k = 0; k < TTT_N_ACT; k++) fw->cascade.act[k] = TTT_R(0.0); /* bridges off, no servo pulse */
+    } else {
+        ttt_cascade_step(&fw->cascade, in->counts);
+    }
+    fw->step++;
+    if (fw->board.status_every != 0 && fw->step % fw->board.status_every == 0) send_status(fw);
+}
+
+size_t ttt_fw_size(void) { return sizeof(ttt_fw); }
+ttt_cascade *ttt_fw_cascade(ttt_fw *fw) { return &fw->cascade; }
+uint8_t ttt_fw_state(const ttt_fw *fw) { return fw->state; }
+uint32_t ttt_fw_frames_ok(const ttt_fw *fw) { return fw->frames_ok; }
+uint32_t ttt_fw_rejections(const ttt_fw *fw, int reason)
+{
+    return reason >= 0 && reason < TTT_N_REJ ? fw->rejections[reason] : 0u;
+}
+uint32_t ttt_fw_lost(const ttt_fw *fw) { return fw->rx_seq.lost; }
+uint32_t ttt_fw_step(const ttt_fw *fw) { return fw->step; }

@@ -125,6 +125,7 @@ static void start(ttt_fw *fw)
     }
     fw->state = TTT_STATE_RUNNING;
     fw->last_setpoint_step = fw->step;
+    send_status(fw); /* the PC learns at once that the drives run, and from which step */
 }
 
 /* Act on one decoded frame whose sequence number was accepted; returns a rejection reason or -1. */
@@ -167,6 +168,7 @@ static int handle(ttt_fw *fw, uint8_t type, const uint8_t *b, size_t n)
         }
         ttt_cascade_set_setpoints(&fw->cascade, q, b[20] & 1);
         fw->last_setpoint_step = fw->step;
+        fw->setpoints_ok++;
         return -1;
     }
     case TTT_MSG_HEARTBEAT:
@@ -218,6 +220,7 @@ void ttt_fw_init(ttt_fw *fw, const ttt_board *board)
     fw->safe_reason = 0;
     fw->step = 0;
     fw->last_setpoint_step = 0;
+    fw->setpoints_ok = 0;
     fw->frames_ok = 0;
     for (r = 0; r < TTT_N_REJ; r++) fw->rejections[r] = 0;
     fw->last_reject = -1;
@@ -289,3 +292,5 @@ uint32_t ttt_fw_rejections(const ttt_fw *fw, int reason)
 }
 uint32_t ttt_fw_lost(const ttt_fw *fw) { return fw->rx_seq.lost; }
 uint32_t ttt_fw_step(const ttt_fw *fw) { return fw->step; }
+uint32_t ttt_fw_last_setpoint_step(const ttt_fw *fw) { return fw->last_setpoint_step; }
+uint32_t ttt_fw_setpoints_ok(const ttt_fw *fw) { return fw->setpoints_ok; }

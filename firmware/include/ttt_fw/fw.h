@@ -70,6 +70,7 @@ typedef struct ttt_fw {
     uint8_t safe_reason;      /* why the last SAFE_STOP: 1 watchdog */
     uint32_t step;            /* control steps since power-on */
     uint32_t last_setpoint_step;
+    uint32_t setpoints_ok;    /* SETPOINTS frames acted on */
     uint32_t frames_ok;
     uint32_t rejections[TTT_N_REJ];
     int last_reject;          /* the last rejection's reason, -1 if none */
@@ -96,4 +97,6 @@ uint32_t ttt_fw_frames_ok(const ttt_fw *fw);
 uint32_t ttt_fw_rejections(const ttt_fw *fw, int reason);
 uint32_t ttt_fw_lost(const ttt_fw *fw);
 uint32_t ttt_fw_step(const ttt_fw *fw);
+uint32_t ttt_fw_last_setpoint_step(const ttt_fw *fw);
+uint32_t ttt_fw_setpoints_ok(const ttt_fw *fw);
 #endif

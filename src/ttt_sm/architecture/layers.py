@@ -70,7 +70,7 @@ CONTRACT: tuple[Component, ...] = (
     Component("sched", 2, ("ttt_sm.sched",), "clocks and the control-step scheduler, over the arm",
               only=("params", "arm", "twin")),
     Component("hardware", 2, ("ttt_sm.hardware",),
-              "the real arm: the firmware's C built and loaded here, its controller against the twin's",
+              "the real arm: the firmware's C built and loaded here, the link, the emulator, the serial Arm",
               only=("params", "arm", "twin")),
     Component("vision staging", 2, ("ttt_sm.vision.scenes", "ttt_sm.vision.bench", "ttt_sm.vision.pictures"),
               "photos of boards drawn on the twin's whiteboard: the vision bench and docs pictures",

@@ -15,7 +15,7 @@ strict JSON output); each other module adds its subcommands with a
 ``ttt-sm --help`` shows them:
 
 - :mod:`.commands`: play, demo, draw, tune, bench, ik, init, charts, params;
-- :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.vision`, :mod:`.ai`,
+- :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.arm`, :mod:`.vision`, :mod:`.ai`,
   :mod:`.docs`: the command of that name.
 
 The subcommand modules import only :mod:`.common` from this package, never
@@ -31,11 +31,11 @@ import sys
 from collections.abc import Sequence
 
 from ..params import shown_path
-from . import ai, camera, commands, debug, docs, gui, scenario, vision
+from . import ai, arm, camera, commands, debug, docs, gui, scenario, vision
 from .common import join_negative_values
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
-SUBCOMMANDS = (commands, scenario, debug, gui, camera, vision, ai, docs)
+SUBCOMMANDS = (commands, scenario, debug, gui, camera, arm, vision, ai, docs)
 
 
 def build_parser() -> argparse.ArgumentParser:

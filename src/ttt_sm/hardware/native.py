@@ -139,6 +139,8 @@ class FirmwareLibrary:
             "ttt_fw_rejections": (ctypes.c_uint32, [fw, ctypes.c_int]),
             "ttt_fw_lost": (ctypes.c_uint32, [fw]),
             "ttt_fw_step": (ctypes.c_uint32, [fw]),
+            "ttt_fw_last_setpoint_step": (ctypes.c_uint32, [fw]),
+            "ttt_fw_setpoints_ok": (ctypes.c_uint32, [fw]),
             "ttt_crc16": (ctypes.c_uint16, [u8p, ctypes.c_size_t]),
             "ttt_cobs_encode": (ctypes.c_size_t, [u8p, ctypes.c_size_t, u8p]),
             "ttt_cobs_decode": (ctypes.c_int, [u8p, ctypes.c_size_t, u8p]),
@@ -286,6 +288,16 @@ class NativeFirmware:
     @property
     def steps(self) -> int:
         return int(self.lib.lib.ttt_fw_step(self.ptr))
+
+    @property
+    def last_setpoint_step(self) -> int:
+        """The control step at which the last setpoints were accepted."""
+        return int(self.lib.lib.ttt_fw_last_setpoint_step(self.ptr))
+
+    @property
+    def setpoints_ok(self) -> int:
+        """SETPOINTS frames the firmware acted on."""
+        return int(self.lib.lib.ttt_fw_setpoints_ok(self.ptr))
 
     def rejections(self) -> dict[int, int]:
         """The firmware's rejection counters, by reason number (``TTT_REJ_*``)."""

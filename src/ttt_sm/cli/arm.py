@@ -1,0 +1,88 @@
+"""``ttt-sm arm serve``: the arm's firmware, emulated on a pseudo-terminal.
+
+The C firmware (``firmware/``, built with the system compiler) runs on the
+twin's plant behind a pty reachable through a stable symlink
+(docs/hardware.md).  ``--pace realtime`` steps it on the wall clock like a
+board; ``--pace gated`` lets the PC's setpoints set the pace.  Errors are
+one line on standard error and exit status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+from .common import print_json, seed
+
+DEFAULT_LINK = str(Path(tempfile.gettempdir()) / "ttt-sm-arm")
+"""Where ``serve`` puts its stable link by default."""
+
+
+def register(sub: Any) -> argparse.ArgumentParser:
+    """Add the ``arm`` command to the subcommands of ``ttt-sm``."""
+    help_ = "the real arm's side: emulate its firmware (the C that is flashed) on a pseudo-terminal"
+    sp: argparse.ArgumentParser = sub.add_parser("arm", help=help_, description=help_)
+    actions = sp.add_subparsers(dest="arm_command", required=True)
+    serve = actions.add_parser(
+        "serve", help="run the firmware on the twin's plant behind a pseudo-terminal until Ctrl-C",
+        description="Emulate the arm: the C firmware coupled to the twin's plant, on a pseudo-terminal reachable"
+                    " through a stable symlink (see docs/hardware.md).")
+    serve.add_argument("--link", default=DEFAULT_LINK, help=f"stable symlink to the pty (default {DEFAULT_LINK})")
+    serve.add_argument("--pace", choices=("gated", "realtime"), default="realtime",
+                       help="realtime: control steps on the wall clock, as a board; gated: the PC's setpoints"
+                            " set the pace (default realtime)")
+    serve.add_argument("--precision", choices=("float", "double"), default="float",
+                       help="the firmware's number type (default float, as the reference board)")
+    serve.add_argument("--seed", type=seed, default=0, help="seed of the plant's current noise (default 0)")
+    serve.add_argument("--duration", type=float, default=None, help="stop after this many seconds (default: Ctrl-C)")
+    serve.add_argument("--json", action="store_true", help="print the emulator's counts as one JSON document")
+    serve.set_defaults(func=cmd_arm_serve)
+    return sp
+
+
+def _fail(message: str) -> int:
+    print(f"ttt-sm arm serve: error: {message}", file=sys.stderr)
+    return 2
+
+
+def cmd_arm_serve(args: argparse.Namespace) -> int:
+    """Run the emulator until Ctrl-C or ``--duration``; print what went over the link."""
+    from ..hardware.emulator import ArmEmulator, ArmEmulatorError
+    from ..hardware.firmware import FirmwareError
+    from ..twin.workspace import load_arm
+
+    if args.duration is not None and not (args.duration >= 0 and math.isfinite(args.duration)):
+        return _fail(f"--duration must be a finite number >= 0 of seconds, got {args.duration}")
+    params = load_arm(args.params)
+    try:
+        emu = ArmEmulator(params, pace=args.pace, link=args.link, precision=args.precision, seed=args.seed)
+    except (ArmEmulatorError, FirmwareError) as exc:
+        return _fail(str(exc))
+    try:
+        with emu:
+            print(f"arm: the {args.precision} firmware on the twin's plant ({args.pace}) on {emu.port};"
+                  + ("" if args.duration is not None else " Ctrl-C stops"), file=sys.stderr, flush=True)
+            end = math.inf if args.duration is None else time.monotonic() + args.duration
+            while time.monotonic() < end:
+                time.sleep(min(0.05, max(0.0, end - time.monotonic())))
+    except KeyboardInterrupt:
+        pass
+    fw = emu.firmware
+    stats = {"steps": fw.steps, "state": ("idle", "running", "safe_stop")[fw.state], "frames_ok": fw.frames_ok,
+             "setpoints_ok": fw.setpoints_ok, "lost": fw.lost,
+             "rejections": {name: n for name, n in zip(_REASONS, fw.rejections().values(), strict=True) if n},
+             "bytes_in": emu.bytes_in, "bytes_out": emu.bytes_out, "bytes_dropped": emu.bytes_dropped}
+    if args.json:
+        print_json({"link": args.link, "pace": args.pace, "precision": args.precision, "stats": stats})
+    else:
+        print("arm: stopped; " + ", ".join(f"{k} {v}" for k, v in stats.items()), file=sys.stderr)
+    return 0
+
+
+_REASONS = ("cobs", "crc", "short", "overlong", "unknown_type", "partial", "length", "duplicate", "out_of_order",
+            "late", "refused", "value")

@@ -1,0 +1,248 @@
+"""The arm's firmware, emulated: the C firmware on the twin's plant, behind a real pseudo-terminal.
+
+:class:`ArmEmulator` is what ``ttt-sm arm serve`` runs.  The firmware is the
+C that would be flashed (``firmware/``, built with the system compiler,
+:mod:`.firmware`), loaded with ctypes (:class:`.native.NativeFirmware`); in
+place of a board, each control step reads the twin's plant
+(:class:`ttt_sm.twin.plant.Plant`: encoder counts, index switches,
+currents) into the firmware's sensors and applies the firmware's commands
+(H-bridge duties and flags, the servo's PWM) to the plant.  Bytes go over
+the master side of a pseudo-terminal; the PC opens the slave (``port``, a
+stable symlink, as the camera emulator does: docs/seriallink.md) with
+pyserial like any serial port.
+
+Two clocks (``pace``):
+
+* ``"realtime"``: the control steps follow the wall clock at the control
+  rate, as on a board; setpoints that stop arriving trip the watchdog.
+* ``"gated"``: the PC's setpoints are the clock: each accepted
+  ``SETPOINTS`` frame lets the firmware run one chart step (``status_every``
+  control steps) past the step it was meant for, then it waits.  A loaded
+  machine cannot make frames late, and a whole game runs as fast as the
+  two processes can talk.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import select
+import shutil
+import tempfile
+import threading
+import time
+import tty
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from ..params import ArmParams
+from ..twin import _cascade as C
+from ..twin import _plant as PL
+from ..twin.plant import REST_POSE, Plant, check_pose
+from .firmware import Precision, build
+from .native import FirmwareLibrary, NativeFirmware, board_for
+
+Pace = Literal["realtime", "gated"]
+PACES: tuple[Pace, ...] = ("realtime", "gated")
+
+_LOG = logging.getLogger(__name__)
+
+
+class ArmEmulatorError(RuntimeError):
+    """The emulator cannot do what was asked (a link path that is not ours, a bad option)."""
+
+
+class FirmwareOnPlant:
+    """The C firmware coupled to the twin's plant, stepped by hand (no port, no thread)."""
+
+    def __init__(self, params: ArmParams, lib: FirmwareLibrary, *, seed: int = 0,
+                 q0: tuple[float, float, float, float] | None = None, servo_safe_rad: float | None = None) -> None:
+        q_start = check_pose(params, q0 if q0 is not None else REST_POSE)
+        self.params = params
+        self.plant = Plant(params, q_start, np.random.default_rng(seed))
+        safe = float(q_start[3]) if servo_safe_rad is None else servo_safe_rad
+        self.firmware = NativeFirmware(lib, board_for(params, safe))
+        self._act = np.zeros(C.N_ACT)
+        self._ints = self.plant.ints
+        self._ps = self.plant.ps
+
+    def step(self) -> None:
+        """One control step: the plant's sensors into the firmware, its commands onto the plant."""
+        s, ints = self.firmware.sensors, self._ints
+        for d in range(3):
+            s.counts[d] = int(ints[d, PL.PI_COUNTS])
+            s.index_count[d] = int(ints[d, PL.PI_INDEX_COUNT])
+            s.index_edges[d] = int(ints[d, PL.PI_INDEX_EDGES]) & 0xFFFF
+            s.current_a[d] = float(self._ps[d, PL.PS_I_MEAS])
+        s.index = sum(1 << d for d in range(3) if ints[d, PL.PI_INDEX] == 1)
+        self.firmware.step()
+        self._act[:] = self.firmware.act
+        self.plant.step(self._act)
+
+
+class ArmEmulator:
+    """The firmware on the twin's plant, on a pseudo-terminal, in a background thread.
+
+    Parameters
+    ----------
+    params
+        The parameter file (the plant, and the board the handshake tells).
+    pace
+        ``"realtime"`` or ``"gated"`` (module docstring).
+    link
+        Path of the stable symlink to the pty; default ``arm`` in a fresh
+        temporary folder, removed by :meth:`stop`.  An existing path must be
+        a symlink.
+    precision
+        The firmware's number type: ``"float"`` (the reference board) or ``"double"``.
+    seed, q0
+        The plant's noise seed and its pose at power-on.
+    """
+
+    def __init__(self, params: ArmParams, *, pace: Pace = "gated", link: str | os.PathLike[str] | None = None,
+                 precision: Precision = "float", seed: int = 0,
+                 q0: tuple[float, float, float, float] | None = None, cache: Path | None = None,
+                 logger: logging.Logger | None = None) -> None:
+        if pace not in PACES:
+            raise ArmEmulatorError(f"pace must be one of {', '.join(PACES)}, got {pace!r}")
+        self.params = params
+        self.pace = pace
+        self.dt = params.control.dt
+        self._lib = FirmwareLibrary(build(precision, cache), precision)
+        self.bench = FirmwareOnPlant(params, self._lib, seed=seed, q0=q0)
+        self.firmware = self.bench.firmware
+        #: The physics (simulation only): ground truth for tests.
+        self.plant = self.bench.plant
+        self._own_dir: Path | None = None
+        if link is None:
+            self._own_dir = Path(tempfile.mkdtemp(prefix="ttt-arm-"))
+            link = self._own_dir / "arm"
+        self._link = Path(link)
+        if not self._link.parent.is_dir():
+            raise ArmEmulatorError(f"the folder of the link {self._link} does not exist; create it or choose"
+                                   " another --link")
+        if self._link.exists() and not self._link.is_symlink():
+            raise ArmEmulatorError(f"{self._link} exists and is not a symlink; the emulator only replaces its own"
+                                   " link: choose another --link")
+        self._log = logger or _LOG
+        self._lock = threading.RLock()
+        self._master: int | None = None
+        self._slave: int | None = None
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._out = bytearray()
+        self.bytes_in = 0
+        self.bytes_out = 0
+        self.bytes_dropped = 0
+        self._gate = 0  # setpoints frames seen by the gated clock
+        self._until = 0  # ... which let it run to this step
+
+    @property
+    def port(self) -> str:
+        """The stable path the PC opens (a symlink to the pty)."""
+        return str(self._link)
+
+    def start(self) -> ArmEmulator:
+        """Make the pty and its link, and run the firmware in a background thread."""
+        if self._thread is not None:
+            return self
+        master, slave = os.openpty()
+        tty.setraw(slave)  # bytes pass as on a UART: no echo, no line discipline
+        os.set_blocking(master, False)
+        self._master, self._slave = master, slave
+        tmp = self._link.with_name(f".{self._link.name}.{os.getpid()}.tmp")
+        tmp.unlink(missing_ok=True)
+        os.symlink(os.ttyname(slave), tmp)
+        os.replace(tmp, self._link)
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._run, name=f"arm-emulator {self._link}", daemon=True)
+        self._thread.start()
+        self._log.info("arm emulator (%s, %s firmware): %s -> %s", self.pace, self._lib.precision, self._link,
+                       os.ttyname(slave))
+        return self
+
+    def stop(self, timeout_s: float = 5.0) -> None:
+        """Stop the thread, close the pty, remove the link (and its folder if the emulator made it)."""
+        self._stop.set()
+        thread, self._thread = self._thread, None
+        if thread is not None:
+            thread.join(timeout_s)
+        with self._lock:
+            self._link.unlink(missing_ok=True)
+            for fd in (self._master, self._slave):
+                if fd is not None:
+                    os.close(fd)
+            self._master = self._slave = None
+        if self._own_dir is not None:
+            shutil.rmtree(self._own_dir, ignore_errors=True)
+            self._own_dir = None
+
+    def hang(self, timeout_s: float = 5.0) -> None:
+        """Stop the firmware but leave the port open, as a board that hangs: bytes go in, nothing comes out."""
+        self._stop.set()
+        thread, self._thread = self._thread, None
+        if thread is not None:
+            thread.join(timeout_s)
+
+    def __enter__(self) -> ArmEmulator:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    # -- the thread ----------------------------------------------------------------
+
+    def _run(self) -> None:
+        t0 = time.monotonic()
+        fw = self.firmware
+        while not self._stop.is_set():
+            fd = self._master
+            if fd is None:
+                return
+            readable, _, _ = select.select([fd], [], [], 0.0005)
+            if readable:
+                self._receive(fd)
+            if self.pace == "realtime":
+                due = int((time.monotonic() - t0) / self.dt)
+                while fw.steps < due and not self._stop.is_set():
+                    self.bench.step()
+                    self._send(fd)
+            else:
+                if fw.setpoints_ok != self._gate:  # new setpoints: one more chart step past their step
+                    self._gate = fw.setpoints_ok
+                    self._until = fw.last_setpoint_step + fw.board.status_every
+                while fw.state == 1 and fw.steps < self._until:
+                    self.bench.step()
+                self._send(fd)
+
+    def _receive(self, fd: int) -> None:
+        try:
+            data = os.read(fd, 4096)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:  # the PC side closed: nothing to read until it reopens
+            time.sleep(0.001)
+            return
+        self.bytes_in += len(data)
+        self.firmware.rx(data)
+
+    def _send(self, fd: int) -> None:
+        self._out += self.firmware.tx()
+        if not self._out:
+            return
+        try:
+            n = os.write(fd, self._out)
+        except (BlockingIOError, InterruptedError):
+            n = 0
+        except OSError:
+            n = 0
+        self.bytes_out += n
+        del self._out[:n]
+        if len(self._out) > 65536:  # nobody reads: a UART drops what does not go out
+            self.bytes_dropped += len(self._out)
+            self._out.clear()
+
+
+__all__ = ["ArmEmulator", "ArmEmulatorError", "FirmwareOnPlant", "PACES"]

@@ -1,0 +1,254 @@
+"""The ``serial`` arm backend: the :class:`~ttt_sm.arm.Arm` protocol over the link to the firmware.
+
+:class:`SerialArm` opens a serial port with pyserial (a board's
+``/dev/ttyACM0``, or ``ttt-sm arm serve``'s pseudo-terminal), says
+``HELLO`` and checks the ``HANDSHAKE`` (protocol version, three drives, the
+encoder resolutions of the parameter file), downloads the cascade's gains
+(designed with python-control on the PC, ``twin.tuning.design_gains``) and
+checks their read-back, and sends ``START``.  Then the scheduler drives it
+like the twin: ``set_setpoints`` once per chart step, ``step(n)`` sends them
+(one ``SETPOINTS`` frame per chart step) and waits for the firmware's
+``STATUS`` of the step it asked for; the sensors are that status's.
+
+The link is declared lost (:class:`LinkLost`) when no valid status arrives
+within :data:`LINK_TIMEOUT_S` of wall-clock time while waiting for one.
+Rejected frames are counted and logged by its
+:class:`~ttt_sm.hardware.link.Receiver`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from typing import TypeVar
+
+import numpy as np
+import serial
+
+from ..arm import Sensors
+from ..params import ArmParams
+from ..twin import _cascade as C
+from ..twin.cascade import CascadeController
+from ..twin.control import Gains, check_drive
+from ..twin.tuning import design_gains
+from . import link as L
+
+LINK_TIMEOUT_S = 0.050
+"""No valid status for this long while one is due: the link is lost."""
+HANDSHAKE_TIMEOUT_S = 2.0
+BAUD = 921_600
+
+
+M = TypeVar("M", bound=L.Message)
+
+
+class SerialArmError(RuntimeError):
+    """The firmware is not the one expected (handshake, gains read-back), or refused a command."""
+
+
+class LinkLost(SerialArmError):
+    """No valid frame from the firmware within the link's timeout."""
+
+
+class SerialArm:
+    """An :class:`~ttt_sm.arm.Arm` whose cascade runs in the firmware at the other end of `port`.
+
+    Parameters
+    ----------
+    port
+        A pyserial URL or device path (``ttt-sm arm serve``'s link, ``/dev/ttyACM0``).
+    params
+        The parameter file: the encoder resolutions the handshake must match,
+        the control rate, the chart divider.
+    gains
+        The cascade's gains; None designs them (``design_gains(params)``).
+    servo_angle
+        The servo's setpoint until the first ``set_setpoints`` (rad).
+    link_timeout_s
+        Wall-clock seconds without a valid status before :class:`LinkLost`.
+    """
+
+    def __init__(self, port: str, params: ArmParams, gains: Gains | None = None, servo_angle: float = 0.0,
+                 link_timeout_s: float = LINK_TIMEOUT_S, baudrate: int = BAUD) -> None:
+        self.params = params
+        self.dt = params.control.dt
+        self.divider = params.control.chart_divider
+        self.gains = design_gains(params) if gains is None else gains
+        self.link_timeout_s = link_timeout_s
+        self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
+        self._offsets = [0.0, 0.0, 0.0]
+        self._q: list[float] = [0.0, 0.0, 0.0, float(servo_angle)]
+        self._fr_sw = False
+        self.rx = L.Receiver(name="pc")
+        self.tx = L.Sender()
+        self.bytes_sent = 0
+        self.bytes_received = 0
+        self._status: L.Status | None = None
+        self._replies: list[L.Message] = []
+        try:
+            self._ser = serial.serial_for_url(port, baudrate=baudrate, timeout=0)
+        except (OSError, serial.SerialException) as e:
+            raise SerialArmError(f"cannot open the arm's port {port}: {e}") from e
+        try:
+            self.handshake = self._open()
+        except BaseException:
+            self._ser.close()
+            raise
+
+    # ---- opening the link ---------------------------------------------------------
+
+    def _open(self) -> L.Handshake:
+        self._send(L.Hello())
+        hs = self._wait_for(L.Handshake, HANDSHAKE_TIMEOUT_S)
+        if hs.protocol != L.PROTOCOL_VERSION:
+            raise SerialArmError(f"the firmware speaks protocol {hs.protocol}, this PC {L.PROTOCOL_VERSION}")
+        if hs.drives != 3:
+            raise SerialArmError(f"the firmware drives {hs.drives} motors, the arm has 3")
+        for d, (theirs, ours) in enumerate(zip(hs.rad_per_count, self._rpc, strict=True)):
+            if not math.isclose(theirs, ours, rel_tol=1e-9):
+                raise SerialArmError(f"drive {d + 1}: the firmware's encoder gives {theirs:.6g} rad per count, "
+                                     f"the parameter file {ours:.6g}")
+        if abs(hs.control_period_us - self.dt * 1e6) > 0.5:
+            raise SerialArmError(f"the firmware steps every {hs.control_period_us} us, the parameter file every "
+                                 f"{self.dt * 1e6:g} us")
+        pc = CascadeController(self.params, self.gains, servo_angle=self._q[3])
+        rows = [pc.cp[d, :C.N_CP] for d in range(3)] + [pc.cg[:C.N_CG]]
+        real = np.float32 if hs.real_size == 4 else np.float64
+        for block, row in enumerate(rows):
+            self._send(L.Gains(block, tuple(float(v) for v in row)))
+            back = self._wait_for(L.GainsReadback, HANDSHAKE_TIMEOUT_S)
+            want = row.astype(real).astype(np.float64)
+            if back.block != block or not np.array_equal(np.array(back.values_), want):
+                raise SerialArmError(f"gains block {block}: read back {back.values_}, sent {tuple(want)}")
+        self._send(L.Start())
+        self._status = self._wait_for(L.Status, HANDSHAKE_TIMEOUT_S, after_start=True)
+        return hs
+
+    def close(self) -> None:
+        self._ser.close()
+
+    def __enter__(self) -> SerialArm:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # ---- the wire -------------------------------------------------------------------
+
+    def _send(self, message: L.Message) -> None:
+        data = self.tx.frame(message)
+        try:
+            self._ser.write(data)
+        except (OSError, serial.SerialException) as e:
+            raise LinkLost(f"cannot write to the arm's port: {e}") from e
+        self.bytes_sent += len(data)
+
+    def _poll(self) -> None:
+        try:
+            data = self._ser.read(self._ser.in_waiting or 1)
+        except (OSError, serial.SerialException) as e:
+            raise LinkLost(f"cannot read from the arm's port: {e}") from e
+        if data:
+            self.bytes_received += len(data)
+            for m in self.rx.feed(data):
+                if isinstance(m, L.Status):
+                    if self._status is None or m.step > self._status.step or m.state != self._status.state:
+                        self._status = m
+                else:
+                    self._replies.append(m)
+
+    def _wait_for(self, kind: type[M], timeout_s: float, after_start: bool = False) -> M:
+        give_up = time.monotonic() + timeout_s
+        while True:
+            for i, m in enumerate(self._replies):
+                if isinstance(m, kind):
+                    del self._replies[i]
+                    return m
+            status = self._status
+            if kind is L.Status and status is not None and (not after_start or status.state == 1):
+                return status  # type: ignore[return-value]  # kind is Status
+            if time.monotonic() > give_up:
+                raise LinkLost(f"no {kind.__name__} from the firmware within {timeout_s * 1000:.0f} ms "
+                               f"({self.rx.rejected} frames rejected)")
+            self._poll()
+
+    def _wait_step(self, target: int) -> None:
+        give_up = time.monotonic() + self.link_timeout_s
+        while self._status is None or self._status.step < target:
+            before = self._status
+            self._poll()
+            if self._status is not before:
+                give_up = time.monotonic() + self.link_timeout_s
+            if self._status is not None and self._status.state != 1:
+                raise LinkLost(f"the firmware is in {self._status.state_name} at step {self._status.step}")
+            if time.monotonic() > give_up:
+                raise LinkLost(f"no status from the firmware for {self.link_timeout_s * 1000:.0f} ms "
+                               f"(waiting for step {target}; {self.rx.rejected} frames rejected)")
+
+    # ---- the Arm protocol ---------------------------------------------------------------
+
+    @property
+    def t(self) -> float:
+        return 0.0 if self._status is None else self._status.step * self.dt
+
+    @property
+    def steps(self) -> int:
+        return 0 if self._status is None else self._status.step
+
+    def step(self, n: int = 1) -> None:
+        """Stream the setpoints and wait until the firmware has run `n` more control steps (in chart steps)."""
+        target = self.steps + n
+        while self.steps < target:
+            self._send(L.Setpoints(self.steps, (self._q[0], self._q[1], self._q[2], self._q[3]), self._fr_sw))
+            self._wait_step(min(target, self.steps + self.divider))
+
+    def set_setpoints(self, q_des: Sequence[float], fr_sw: bool = False) -> None:
+        q = [float(v) for v in q_des[:4]]
+        if len(q) != 4 or not all(math.isfinite(v) for v in q):
+            raise SerialArmError(f"setpoints must be 4 finite angles (rad), got {list(q_des)!r}")
+        self._q = q
+        self._fr_sw = bool(fr_sw)
+
+    @property
+    def servo_setpoint(self) -> float:
+        return self._q[3]
+
+    def sensors(self) -> Sensors:
+        s = self._status
+        assert s is not None  # the handshake waited for one
+        return Sensors(counts=s.counts, index=tuple(bool(s.index >> d & 1) for d in range(3)),  # type: ignore[arg-type]
+                       index_count=s.index_count, index_edges=s.index_edges,
+                       current_a=tuple(i / 1000.0 for i in s.current_ma), t=self.t)  # type: ignore[arg-type]
+
+    def encoder_angles(self) -> tuple[float, float, float]:
+        c = (0, 0, 0) if self._status is None else self._status.counts
+        o, r = self._offsets, self._rpc
+        return c[0] * r[0] + o[0], c[1] * r[1] + o[1], c[2] * r[2] + o[2]
+
+    def offset_estimates(self) -> tuple[float, float, float]:
+        return self._offsets[0], self._offsets[1], self._offsets[2]
+
+    def set_offset_estimate(self, drive: int, offset_rad: float) -> None:
+        d = check_drive(drive) - 1
+        shift = float(offset_rad) - self._offsets[d]
+        self._offsets[d] = float(offset_rad)
+        self._q[d] += shift  # the firmware moves its setpoint with the offset: keep ours with it
+        self._send(L.Drive(d, L.Op.OFFSET, float(offset_rad)))
+
+    def enabled(self) -> tuple[bool, bool, bool]:
+        m = 0 if self._status is None else self._status.modes
+        return tuple(((m >> (2 * d)) & 3) == C.MODE_CLOSED for d in range(3))  # type: ignore[return-value]
+
+    def set_enabled(self, drive: int, enabled: bool) -> None:
+        d = check_drive(drive) - 1
+        self._send(L.Drive(d, L.Op.CLOSED if enabled else L.Op.OFF, 0.0))
+
+    @property
+    def link_stats(self) -> dict[str, int]:
+        """Bytes each way, frames taken, rejected and lost (sequence gaps) on the PC's side."""
+        return {"bytes_sent": self.bytes_sent, "bytes_received": self.bytes_received,
+                "frames_ok": self.rx.frames_ok, "rejected": self.rx.rejected, "lost": self.rx.seq.lost}
+
+
+__all__ = ["SerialArm", "SerialArmError", "LinkLost", "LINK_TIMEOUT_S"]

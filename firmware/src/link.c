@@ -9,7 +9,8 @@ uint16_t ttt_crc16(const uint8_t *data, size_t n)
     for (i = 0; i < n; i++) {
         crc = (uint16_t)(crc ^ (uint16_t)(data[i] << 8));
         for (b = 0; b < 8; b++) {
-            crc = (crc & 0x8000u) ? (uint16_t)((crc << 1) ^ 0x1021u) : (uint16_t)(crc << 1);
+            uint16_t shifted = (uint16_t)((unsigned)crc << 1);
+            crc = (crc & 0x8000u) != 0u ? (uint16_t)(shifted ^ 0x1021u) : shifted;
         }
     }
     return crc;

@@ -121,6 +121,9 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     numbers(serve, "--rate", BAD_POSITIVE)
     numbers(serve, "--duration", ("abc", "nan", "-1"))
     numbers(serve, "--fault-every", ("abc", "1.5", "", "-1"))
+    arm = ["arm", "serve", "--duration", "0"]
+    cases.append(([*arm, "--link", f"{p['file_as_folder']}/arm"], p["file_as_folder"]))
+    numbers(arm, "--duration", ("abc", "nan", "-1"))
     read = ["camera", "read", "--give-up", "0.2", "--timeout", "0.5"]
     for key in ("missing", "folder", "garbage"):
         cases.append(([*read, "--port", p[key]], p[key]))

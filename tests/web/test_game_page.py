@@ -95,6 +95,11 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
     try:
         open_game(page, game_cockpit)
         assert page.get_by_role("status").filter(has_text="Wait for the model to be compiled.").count() == 1
+        # Every message Text box2 shows, in order: at full speed the result is on show for a moment only.
+        page.evaluate("() => { const box = document.querySelector('[data-role=\"text-box2\"]'); window.box2 = [];"
+                      " new MutationObserver(() => { const t = box.textContent.trim();"
+                      " if (window.box2[window.box2.length - 1] !== t) window.box2.push(t); })"
+                      ".observe(box, { childList: true, characterData: true, subtree: true }); }")
         run_to_first_turn(page)
         symbol = page.get_by_role("button", name="Symbol", exact=True)
         # Before the first move the symbol may change, and Text box1 says so.
@@ -151,10 +156,10 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
                 assert shot.stat().st_size > 20_000
         state = game_state(game_cockpit)
         result = {state["robot"]: 1, state["person"]: 2, "draw": 3}[state["outcome"]]
-        wait_text(page, "text-box2", RESULT_MESSAGES[result])
-        wait_text(page, "text-box2", MSG_ERASING)
-        wait_text(page, "text-box2", MSG_TURNING_OFF)
         page.wait_for_function("document.querySelector('[data-cmd=stop]').disabled", timeout=LONG)
+        wait_text(page, "text-box2", MSG_TURNING_OFF)
+        # The result, then erasing, then turning off: the thesis' order, as the Game chart output them.
+        assert page.evaluate("window.box2")[-3:] == [RESULT_MESSAGES[result], MSG_ERASING, MSG_TURNING_OFF]
         state = game_state(game_cockpit)
         person = [m for m in state["moves"] if m["by"] == "person"]
         assert len(person) == person_moves

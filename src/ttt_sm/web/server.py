@@ -8,6 +8,7 @@ protocol tests run without a browser or a socket).
 
 Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
 (the Tic-tac-toe page, :mod:`.game`; its camera picture ``/api/game/photo.png``),
+``/api/arm/ink.png`` (the whiteboard's ink under the arm's top view, :mod:`.arm_view`),
 ``/static/...`` (the pages' scripts and styles, from the package: nothing from
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
 SVG, :mod:`.diagrams`), ``/api/trace.jsonl`` (the trace so far), ``/ws``.
@@ -43,6 +44,7 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from ..runtime.errors import GraphvizMissingError
+from .arm_view import ink_png
 from .diagrams import DiagramError, Diagrams
 from .game import photo_png
 from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
@@ -144,6 +146,11 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
             return PlainTextResponse("no photo yet: the camera looks after each move\n", status_code=404)
         return Response(png, media_type="image/png", headers={"Cache-Control": "no-store"})
 
+    async def arm_ink(request: Request) -> Response:
+        # drawn in the simulation thread, between two control steps: never a half-inked stroke
+        png = await asyncio.to_thread(session.call, lambda d: ink_png(d.robot))
+        return Response(png, media_type="image/png", headers={"Cache-Control": "no-store"})
+
     async def diagram(request: Request) -> Response:
         chart = request.path_params["chart"]
         key = request.query_params.get("view", "overview")
@@ -238,6 +245,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         Route("/charts", charts),
         Route("/game", game),
         Route("/api/game/photo.png", game_photo),
+        Route("/api/arm/ink.png", arm_ink),
         Route("/api/diagram/{chart}", diagram),
         Route("/api/trace.jsonl", trace),
         WebSocketRoute("/ws", ws),

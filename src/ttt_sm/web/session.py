@@ -53,6 +53,7 @@ from ..debug.views import fmt_value, signal_text
 from ..runtime.jsonable import dumps, jsonable
 from ..runtime.structure import TICK_EVENT_NAME, TICK_EVENT_PREFIX
 from ..sched.clock import PacedClock
+from .arm_view import arm_scene, arm_view
 from .catalogue import describe_session
 from .coverage import CoverageError, colouring, load_scenarios, run_for_coverage, scenario_from_text
 from .game import GAME_COMMANDS, game_view
@@ -140,6 +141,7 @@ class Session:
         self.chart_classes = {name: type(c) for name, c in robot.charts.items()}
         self.scenarios = dict(scenarios or {})
         self.info["scenarios"] = list(self.scenarios)
+        self.info["arm"] = arm_scene(self.params)
         self.trace_path = trace_path
         self.clock = PacedClock(self.params.control.dt, speed)
         self.speed = speed
@@ -554,6 +556,7 @@ class Session:
             "forced": [f"{c}.{n}" for c, n in dbg.forced],
             "stop": self._stop,
             "game": game_view(dbg),
+            "arm": arm_view(robot),
         }
 
     def _frame(self, full: bool, state: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -595,7 +598,7 @@ class Session:
         frame["taken"] = {name: {i: c for i, c in counts.items() if sent.get("taken", {}).get(name, {}).get(i) != c}
                           for name, counts in state["taken"].items()}
         frame["taken"] = {name: counts for name, counts in frame["taken"].items() if counts}
-        for key in ("breakpoints", "actions", "forced", "stop", "game"):
+        for key in ("breakpoints", "actions", "forced", "stop", "game", "arm"):
             if sent.get(key, _MISSING) != state[key]:
                 frame[key] = state[key]
         return frame

@@ -166,6 +166,15 @@ class BoardContact:
         return self._tip_dev
 
     @property
+    def ink_version(self) -> tuple[int, int, int]:
+        """Changes whenever the ink may have changed (a view draws it again then).
+
+        Strokes kept so far, points of the pen's running stroke, pixels wiped
+        since the reset: nothing inks or wipes without changing one of them.
+        """
+        return self._log.added, len(self._run_x), self.wiped_pixels
+
+    @property
     def contact(self) -> Contact:
         """What touches the board now, and the overpress counters."""
         drag = math.hypot(self._cx - self._tip_x, self._cy - self._tip_y) if self._pen_on else 0.0

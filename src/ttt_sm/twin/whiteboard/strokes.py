@@ -70,6 +70,8 @@ class StrokeLog:
 
     def __init__(self, raster: InkRaster) -> None:
         self._raster = raster
+        #: Strokes kept since the log was made (a clear does not undo the count): a view's change key.
+        self.added = 0
         self.clear()
 
     def clear(self) -> None:
@@ -81,6 +83,7 @@ class StrokeLog:
     def add(self, stroke: StrokeData) -> None:
         """Keep a finished stroke."""
         self._strokes.append(stroke)
+        self.added += 1
         self._cache = None
 
     def changed(self) -> None:

@@ -6,12 +6,13 @@
 // asks the simulated hand to draw there; the board shows what the game has read
 // through the camera, never what the page guessed.
 
+import { ArmViews } from "/static/arm.js";
 import { SessionLink } from "/static/session.js";
 
 const $ = (sel) => document.querySelector(sel);
 const role = (name) => $(`[data-role="${name}"]`);
 
-const state = { game: null, mode: "connecting", photos: -1 };
+const state = { game: null, mode: "connecting", photos: -1, arm: null };
 
 function cellButtons() {
   const board = role("board");
@@ -128,12 +129,18 @@ function drawFrame(f) {
   }
   if (f.t !== undefined) role("sim-time").textContent = f.t.toFixed(1);
   if ("game" in f) drawGame(f.game);
+  if (state.arm) {
+    if (f.full) state.arm.resync();
+    if ("arm" in f) state.arm.draw(f.arm);
+  }
   if (f.stop && f.stop.kind === "game") say(f.stop.text, true);
   if (f.error) say(f.error, true);
 }
 
 function onMessage(m) {
-  if (m.type === "frame") {
+  if (m.type === "session") {
+    state.arm = new ArmViews(role("arm"), m.info.arm);
+  } else if (m.type === "frame") {
     drawFrame(m);
     link.ack(m.seq);
   } else if (m.type === "reply") {

@@ -87,6 +87,7 @@ def test_the_debugged_game_is_the_game_play_plays(first_turn, params):
     dbg.run(60.0)  # on to the robot's second turn, as in the test before the replay
     driven = dbg.game
     played = GameSession(params, seed=0, camera="direct", record_trace=False)
+    played.record_start(25)  # the record's first line, as play() and drive() write it
     for wait in played.flow():
         played._run(wait)
         if len(played.moves) == len(driven.moves):

@@ -21,6 +21,7 @@ from typing import Any
 
 import pytest
 
+from ttt_sm.app.game_record import read_record
 from ttt_sm.charts.game import MSG_ERASING, MSG_TURNING_OFF, MSG_YOUR_TURN, RESULT_MESSAGES
 from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params
@@ -36,7 +37,7 @@ LONG = 240_000
 @pytest.fixture
 def game_cockpit(tmp_path: Path) -> Iterator[Cockpit]:
     """A game with the person at the page, paused at power-on, as fast as it goes when run."""
-    dbg = Debugger.build(load_params(), seed=0, game=True, person="page")
+    dbg = Debugger.build(load_params(), seed=0, game=True, person="page", record_root=tmp_path / "gui")
     session = Session(dbg, speed=None, running=False, trace_path=tmp_path / "trace.jsonl")
     server, thread, url = serve(session)
     try:
@@ -100,7 +101,16 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
                       " new MutationObserver(() => { const t = box.textContent.trim();"
                       " if (window.box2[window.box2.length - 1] !== t) window.box2.push(t); })"
                       ".observe(box, { childList: true, characterData: true, subtree: true }); }")
+        # And every tool the arm's views showed in use and on the board (the erase is seen live).
+        page.evaluate("() => { const arm = document.querySelector('[data-role=\"arm\"]'); window.tools = new Set();"
+                      " new MutationObserver(() => window.tools.add(`${arm.dataset.tool}/${arm.dataset.touching}`))"
+                      ".observe(arm, { attributes: true }); }")
         run_to_first_turn(page)
+        # The engine: the thesis' (section 3.6.2), chosen before the first move.
+        page.get_by_role("combobox", name="Engine").select_option("thesis")
+        page.wait_for_function("document.querySelector('[data-role=reply]').textContent.includes('thesis')",
+                               timeout=30_000)
+        assert game_cockpit.session.call(lambda d: d.game.engine_name) == "thesis"
         symbol = page.get_by_role("button", name="Symbol", exact=True)
         # Before the first move the symbol may change, and Text box1 says so.
         assert text_of(page, "text-box1").startswith("You can change the manipulator's symbol: it plays O")
@@ -163,11 +173,30 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
         state = game_state(game_cockpit)
         person = [m for m in state["moves"] if m["by"] == "person"]
         assert len(person) == person_moves
+        assert page.locator('[data-role="engine"]').is_disabled()  # locked since the first move
+        # The erase was shown as it happened: the sponge in use, and on the board.
+        tools = page.evaluate("Array.from(window.tools)")
+        assert "sponge/sponge" in tools and "pen/pen" in tools, tools
+        # The record, as `ttt-sm play` writes it, in the gui's folder; the page says where.
+        record = tmp_path / "gui" / "game-1" / "game.jsonl"
+        page.get_by_role("status", name="the game's record").filter(has_text=f"{record} (ended: finished)").wait_for(
+            timeout=LONG)
+        lines = read_record(record)
+        assert lines[0]["event"] == "game" and lines[-1]["event"] == "finished"
+        assert lines[-1]["outcome"] == state["outcome"]
+        assert [e["engine"] for e in lines if e["event"] == "engine"] == ["thesis"]
+        assert sum(e["event"] == "person_drew" for e in lines) == person_moves
         # Every cell the person clicked was read through the camera, and read right.
         assert all(m["detected"] == [m["row"], m["column"]] for m in person)
         assert state["correct"] == person_moves and state["wrong"] == 0
         assert len(set(photos_seen)) == len(photos_seen)  # a new photo after every move
         assert state["ended"] and state["ink_mm2"] == 0.0  # erased, turned off
+        # A new game: a new robot from power-on, the engine kept; Run starts it.
+        page.get_by_role("button", name="New game", exact=True).click()
+        wait_text(page, "text-box2", "Wait for the model to be compiled.", timeout=60_000)
+        wait_board(page, "." * 25)
+        assert game_cockpit.session.call(lambda d: (d.robot.t, d.game.engine_name, d.game.moves)) == (0.0, "thesis", [])
+        assert text_of(page, "record").startswith(f"The game's record: {tmp_path / 'gui' / 'game-2' / 'game.jsonl'}")
     finally:
         page.close()
 

@@ -269,6 +269,7 @@ class GameDriver:
             self.wait = next(flow)
         except StopIteration:
             self._flow, self.wait, self.done = None, None, True
+            self.session._end("finished", outcome=self.session.outcome, boundary=True)
             return
         except GameError as exc:
             self._stop(exc)
@@ -279,6 +280,7 @@ class GameDriver:
         assert self._flow is not None
         self._flow.close()
         self._flow, self.error = None, error
+        self.session._end("error", message=str(error), boundary=True)
 
 
 class GameStage:
@@ -533,8 +535,35 @@ class GameSession:
         if self.symbol_locked and symbol != self.robot_symbol:
             raise GameError(f"the manipulator plays {self.robot_symbol}: the symbol cannot change after the"
                             " first move")
+        if symbol != self.robot_symbol:
+            self._event("symbol", robot_symbol=symbol)
         self.robot_symbol = symbol
         self.person_symbol = "X" if symbol == "O" else "O"
+
+    def set_engine(self, name: str) -> None:
+        """The game algorithm the manipulator plays with ("strong" or "thesis"), before the first move only."""
+        if self.symbol_locked and name != self.engine_name:
+            raise GameError(f"the manipulator plays with the {self.engine_name} engine: the engine cannot change"
+                            " after the first move")
+        self.engine = engine_for(name)
+        if name != self.engine_name:
+            self._event("engine", engine=name)
+        self.engine_name = name
+
+    def person_input(self, name: str, **data: Any) -> None:
+        """One input of the person at a GUI, by name: ``cell`` (row, column), ``play``, ``symbol`` (symbol),
+        ``engine`` (engine).  A debugger records each with its control step and applies it again there
+        when it replays (the person's clicks are inputs from outside the simulation)."""
+        if name == "cell":
+            self.person_draws((int(data["row"]), int(data["column"])))
+        elif name == "play":
+            self.press_play()
+        elif name == "symbol":
+            self.set_robot_symbol(str(data["symbol"]))
+        elif name == "engine":
+            self.set_engine(str(data["engine"]))
+        else:
+            raise ValueError(f"unknown input of the person {name!r}; inputs: cell, play, symbol, engine")
 
     def person_draws(self, cell: Cell) -> None:
         """The simulated hand draws the person's symbol in ``cell`` on the whiteboard (the camera must see it)."""
@@ -571,9 +600,7 @@ class GameSession:
         # What exists now (the twin, the charts, the engine, the modules) lives for the
         # whole game: keep it out of the collector's full passes (one of ~90 ms a game).
         gc.freeze()
-        self._event("game", seed=self.robot.seed, robot_symbol=self.robot_symbol, engine=self.engine_name,
-                    person=getattr(self.person, "name", type(self.person).__name__), camera=self.camera.mode,
-                    params_sha256=params_digest(self.params), time_limit_s=self.time_limit_s, max_moves=max_moves)
+        self.record_start(max_moves)
         try:
             wall0 = time.perf_counter()
             for wait in self.flow(max_moves):
@@ -593,6 +620,12 @@ class GameSession:
             gc.unfreeze()
         self._end("finished", outcome=report["outcome"], boundary=True)
         return report
+
+    def record_start(self, max_moves: int) -> None:
+        """The record's first line: what a replay of the record needs."""
+        self._event("game", seed=self.robot.seed, robot_symbol=self.robot_symbol, engine=self.engine_name,
+                    person=getattr(self.person, "name", type(self.person).__name__), camera=self.camera.mode,
+                    params_sha256=params_digest(self.params), time_limit_s=self.time_limit_s, max_moves=max_moves)
 
     def _end(self, how: str, **data: Any) -> None:
         """The record's last event (where the game stood, and its state), and the board picture of the moment."""
@@ -633,6 +666,7 @@ class GameSession:
         For a debugger or a GUI that steps the robot itself; see :class:`GameDriver`.
         """
         if self.driver is None:
+            self.record_start(max_moves)
             self.driver = GameDriver(self, max_moves)
         return self.driver
 

@@ -43,6 +43,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
     sp.add_argument("--open", action="store_true", help="open the cockpit in a web browser")
     sp.add_argument("--scenarios", metavar="DIR", default=None,
                     help="scenario files the page may run for coverage (default: tests/scenarios when it exists)")
+    sp.add_argument("--out", metavar="DIR", default="out/gui",
+                    help="with --game: where each game's record (game-N/game.jsonl, as ttt-sm play writes it) and"
+                         " board pictures go (default out/gui)")
     sp.add_argument("--trace", metavar="FILE", default="out/gui/trace.jsonl",
                     help="where the trace is saved when the cockpit stops (default out/gui/trace.jsonl)")
     return sp
@@ -92,6 +95,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
     if Path(args.trace).is_dir():
         raise CliError(f"--trace: {args.trace} is a folder; name the file the trace is saved to")
     out_dir(str(Path(args.trace).parent), f"--trace {args.trace}: its folder")  # written when the cockpit stops
+    record_root = out_dir(args.out, "--out") if args.game else None
     params = load_arm(getattr(args, "params", None))
     token = secrets.token_urlsafe(24) if needs_token(args.host) else None
     try:
@@ -102,7 +106,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
         raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
     port = sock.getsockname()[1]
     print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
-    dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person)
+    dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person, record_root=record_root)
     session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
                       trace_path=Path(args.trace))
     shown = f"[{args.host}]" if ":" in args.host else args.host
@@ -112,6 +116,8 @@ def cmd_gui(args: argparse.Namespace) -> int:
     print(f"ttt-sm gui: the chart cockpit is at {url}", flush=True)
     if args.game and args.person == "page":
         print(f"ttt-sm gui: play at {url.replace('/charts', '/game', 1)}", flush=True)
+    if record_root is not None:
+        print(f"ttt-sm gui: each game's record goes to {record_root}/game-N/game.jsonl", flush=True)
     if token:
         print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
               flush=True)

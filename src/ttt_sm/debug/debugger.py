@@ -40,7 +40,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from ..app.game import GameSession
+from ..app.game import GameError, GameSession
 from ..app.robot import Robot, RobotError
 from ..params import ArmParams
 from ..runtime import Data, TickChart, UnknownEventError
@@ -108,17 +108,19 @@ class Debugger:
     @classmethod
     def build(cls, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
               settle_s: float = 0.0, *, game: bool = False, person: str = "simulated",
-              max_run_s: float = DEFAULT_MAX_RUN_S) -> Debugger:
+              max_run_s: float = DEFAULT_MAX_RUN_S, record_root: Path | None = None) -> Debugger:
         """A debugger on a new robot, with its recipe for :meth:`replay`.
 
         ``game``: the robot plays a game (:class:`~.replay.GameRecipe`: the Game
         and AlgorithmActivator charts, a simulated person, the camera read
         in-process, the strong engine; the robot draws O).  ``person``: who plays
         against it, ``"simulated"`` or ``"page"`` (a person at the ``/game`` page).
+        ``record_root``: with ``game``, the game's record is written to
+        ``record_root/game-1/game.jsonl`` as it is played.
         """
         pose = None if q_start is None else tuple(float(v) for v in q_start)
-        recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person) if game else \
-            RobotRecipe(params, seed, pose, settle_s)
+        recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person, record_root=record_root) \
+            if game else RobotRecipe(params, seed, pose, settle_s)
         return cls(recipe.build(), recipe, max_run_s=max_run_s)
 
     def _attach(self, robot: Robot) -> None:
@@ -424,7 +426,43 @@ class Debugger:
         self._apply(action, self.robot)
         self._record(action)
 
+    def game_input(self, name: str, **data: Any) -> None:
+        """An input of the person at a GUI (``cell`` row= column=, ``play``, ``symbol`` symbol=, ``engine``
+        engine=; :meth:`GameSession.person_input`), recorded with its control step like a posted event,
+        so a replay repeats the person's clicks where they happened.  A refused one (not the person's
+        turn, a locked symbol) raises :class:`DebugError` and is not recorded."""
+        action = Action(self.robot.steps, "game", "Game", name, data=dict(data))
+        self._apply(action, self.robot)
+        self._record(action)
+
+    def start_over(self, recipe: Recipe) -> None:
+        """A new run from power-on on the robot ``recipe`` builds (a new game): the inputs recorded,
+        the replay fingerprints and how far the session has been are those of the new run only;
+        breakpoints are kept."""
+        old = game_of(self.robot)
+        if old is not None:
+            old.close()  # its record ends (as interrupted, unless the game ended)
+        self.recipe = recipe
+        self.actions = []
+        self.forced = {}
+        self._fingerprints = {}
+        self._attach(recipe.build())
+        self._furthest_steps = self.robot.steps
+        self._remember()
+        for bp in self.breakpoints:
+            if bp.condition is not None:
+                bp.last_value = bp.condition.evaluate(self._names)
+
     def _apply(self, action: Action, robot: Robot) -> None:
+        if action.kind == "game":
+            game = game_of(robot)
+            if game is None:
+                raise DebugError("this robot plays no game: build it with the game (ttt-sm gui --game)")
+            try:
+                game.person_input(action.name, **action.data)
+            except GameError as exc:
+                raise DebugError(str(exc)) from None
+            return
         try:
             if action.kind in ("set", "force"):
                 robot.set_input(action.chart, action.name, action.value, force=action.kind == "force")
@@ -542,6 +580,9 @@ class Debugger:
         kept = [a for a in self.actions if a.steps <= target]
         dropped = len(self.actions) - len(kept)
         self.forced = {}
+        old = game_of(self.robot)
+        if old is not None and old.record.attached:
+            old.record.close()  # the rebuilt game writes its record anew, to the same file
         self._attach(self.recipe.build())
         robot = self.robot
         queue = deque(kept)

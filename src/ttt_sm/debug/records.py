@@ -16,9 +16,9 @@ class Action:
     """Something the user did to the robot, at control step ``steps``, for replay."""
 
     steps: int
-    kind: Literal["set", "force", "release", "post"]
+    kind: Literal["set", "force", "release", "post", "game"]
     chart: str
-    name: str  # input name, or event name for "post"
+    name: str  # input name, event name for "post", the person's input for "game" (cell, play, symbol, engine)
     value: Any = None
     data: dict[str, Any] = field(default_factory=dict)
 
@@ -27,6 +27,9 @@ class Action:
         if self.kind == "post":
             args = "".join(f" {k}={v}" for k, v in self.data.items())
             return f"{where}: post {self.chart} {self.name}{args}"
+        if self.kind == "game":
+            args = "".join(f" {k}={v}" for k, v in self.data.items())
+            return f"{where}: the person's {self.name}{args}"
         if self.kind == "release":
             return f"{where}: release {self.chart}.{self.name}"
         return f"{where}: {self.kind} {self.chart}.{self.name} {self.value!r}"

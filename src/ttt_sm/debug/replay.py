@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping
 from dataclasses import asdict, dataclass
+from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Protocol
 
@@ -70,7 +71,11 @@ class GameRecipe:
     thread behind a pseudo-terminal, would only add wall time to each reading.
     The simulated person is seeded with the seed, as in ``ttt-sm play``;
     ``person="page"``: a person at a GUI plays instead (:class:`RemotePerson`,
-    the ``/game`` page of ``ttt-sm gui``), whose clicks a replay does not repeat.
+    the ``/game`` page of ``ttt-sm gui``), whose clicks the debugger records as
+    inputs (:meth:`~.debugger.Debugger.game_input`) and a replay repeats.
+    ``record_root``: the game's record (``game.jsonl``, with the board
+    pictures, as ``ttt-sm play`` writes them) goes to ``record_root/game-<number>``
+    as it is played (None: kept in memory only).
     """
 
     params: ArmParams
@@ -80,14 +85,22 @@ class GameRecipe:
     robot_symbol: str = "O"
     engine: str = "strong"
     person: str = "simulated"
+    record_root: Path | None = None
+    number: int = 1
+
+    @property
+    def out_dir(self) -> Path | None:
+        """Where this game's record and board pictures are written (None: nowhere)."""
+        return None if self.record_root is None else self.record_root / f"game-{self.number}"
 
     def build(self) -> Robot:
         if self.person not in ("simulated", "page"):
             raise ValueError(f"the person is 'simulated' or 'page', got {self.person!r}")
         person = RemotePerson() if self.person == "page" else None
+        out_dir = self.out_dir
         session = GameSession(self.params, seed=self.seed, robot_symbol=self.robot_symbol, engine=self.engine,
-                              person=person,
-                              camera="direct", record_trace=False, q_start=self.q_start, settle_s=self.settle_s)
+                              person=person, camera="direct", record_trace=out_dir is not None,
+                              q_start=self.q_start, settle_s=self.settle_s, out_dir=out_dir)
         session.drive()
         return session.robot
 

@@ -20,11 +20,12 @@ page asks for the picture again when that number changes.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import cv2
 
-from ..app.game import GameError, GameSession, RemotePerson
+from ..app.game import GameSession, RemotePerson
 from ..charts.game import (
     MSG_COMPILING,
     MSG_DRAWING,
@@ -35,6 +36,7 @@ from ..charts.game import (
     RESULT_MESSAGES,
 )
 from ..debug.debugger import Debugger
+from ..debug.replay import GameRecipe
 
 #: Person messages a frame carries at most (the newest).
 MESSAGES_SHOWN = 8
@@ -42,6 +44,10 @@ MESSAGES_SHOWN = 8
 #: Text box2's messages (the Game chart's): the page shows them there, not among what the game told.
 CHART_MESSAGES = frozenset((MSG_COMPILING, MSG_INITIALISING, MSG_YOUR_TURN, MSG_DRAWING, MSG_ERASING,
                             MSG_TURNING_OFF, *RESULT_MESSAGES.values()))
+
+#: The engines the page offers, by the name the game knows them by.
+ENGINES = {"strong": "strong engine (an opening book and an exact search: it never loses)",
+           "thesis": "thesis' engine (section 3.6.2: three-ply minimax)"}
 
 TEXT_BOX1_FREE = "You can change the manipulator's symbol: it plays {robot}, you play {person}."
 TEXT_BOX1_LOCKED = "The manipulator plays {robot}, you play {person}: the symbol cannot change after the first move."
@@ -86,6 +92,10 @@ def game_view(debugger: Debugger) -> dict[str, Any] | None:
         "told": told,
         "told_total": told_total,  # all told, Text box2's messages too
         "engine": game.engine_name,
+        "engine_locked": game.symbol_locked,
+        "record": None if game.record.path is None else str(game.record.path),
+        "record_ended": game.record.ended,
+        "can_start_over": bool(game.game.ended or (driver is not None and driver.error is not None)),
     }
 
 
@@ -111,45 +121,32 @@ def _game(debugger: Debugger, command: str) -> GameSession:
     return game
 
 
-def _said(command: str, go: Any) -> dict[str, Any]:
-    try:
-        text = go()
-    except GameError as exc:
-        raise ValueError(f"{command}: {exc}") from None
-    return {"text": text}
-
-
 def cmd_game_symbol(debugger: Debugger, symbol: str) -> dict[str, Any]:
     """Symbol: the manipulator plays ``symbol`` (before the first move only)."""
     game = _game(debugger, "game_symbol")
+    debugger.game_input("symbol", symbol=symbol)
+    return {"text": f"the manipulator plays {game.robot_symbol}, you play {game.person_symbol}"}
 
-    def go() -> str:
-        game.set_robot_symbol(symbol)
-        return f"the manipulator plays {game.robot_symbol}, you play {game.person_symbol}"
 
-    return _said("game_symbol", go)
+def cmd_game_engine(debugger: Debugger, engine: str) -> dict[str, Any]:
+    """The engine: the manipulator's game algorithm, strong or the thesis' (before the first move only)."""
+    _game(debugger, "game_engine")
+    debugger.game_input("engine", engine=engine)
+    return {"text": f"the manipulator plays with the {ENGINES[engine]}"}
 
 
 def cmd_game_cell(debugger: Debugger, row: int, column: int) -> dict[str, Any]:
     """A click on a cell: the simulated hand draws the person's symbol there."""
     game = _game(debugger, "game_cell")
-
-    def go() -> str:
-        game.person_draws((row, column))
-        return f"you drew {game.person_symbol} in row {row}, column {column}; click Play when you are done"
-
-    return _said("game_cell", go)
+    debugger.game_input("cell", row=row, column=column)
+    return {"text": f"you drew {game.person_symbol} in row {row}, column {column}; click Play when you are done"}
 
 
 def cmd_game_play(debugger: Debugger) -> dict[str, Any]:
     """Play: the manipulator's move (the AlgorithmActivator's trigger, pulled by the game's flow)."""
     game = _game(debugger, "game_play")
-
-    def go() -> str:
-        game.press_play()
-        return "Play: the camera looks at the board" if game.awaiting == "draw" else "Play: the manipulator moves"
-
-    return _said("game_play", go)
+    debugger.game_input("play")
+    return {"text": "Play: the camera looks at the board" if game.awaiting == "draw" else "Play: the manipulator moves"}
 
 
 def cmd_game_stop(debugger: Debugger) -> dict[str, Any]:
@@ -161,9 +158,29 @@ def cmd_game_stop(debugger: Debugger) -> dict[str, Any]:
     return {"text": "Stop: the manipulator returns to its start pose avoiding the board, then stops"}
 
 
-#: The page's commands (beside the session's ``run``), by protocol type.
+def start_new_game(debugger: Debugger) -> dict[str, Any]:
+    """A new game: a new robot from power-on (the thesis' Run_sim again), with the symbol and engine chosen.
+
+    Only once this game is over (its result and the arm turned off, or Stop)
+    or cannot go on; the new game's record goes beside the last one
+    (``game-<n+1>``).  The caller (the session) starts its views over.
+    """
+    game = _game(debugger, "game_new")
+    recipe = debugger.recipe
+    if not isinstance(recipe, GameRecipe):
+        raise ValueError("game_new: this session's robot was not built for a game")
+    driver = game.driver
+    if not (game.game.ended or (driver is not None and driver.error is not None)):
+        raise ValueError("game_new: this game is still on: click Stop first (or play it to its end)")
+    debugger.start_over(replace(recipe, robot_symbol=game.robot_symbol, engine=game.engine_name,
+                                number=recipe.number + 1))
+    return {"text": f"a new game (game {recipe.number + 1}): the robot is powered on; click Run"}
+
+
+#: The page's commands (beside the session's ``run`` and ``game_new``), by protocol type.
 GAME_COMMANDS: dict[str, Callable[..., dict[str, Any]]] = {
     "game_symbol": cmd_game_symbol,
+    "game_engine": cmd_game_engine,
     "game_cell": cmd_game_cell,
     "game_play": cmd_game_play,
     "game_stop": cmd_game_stop,

@@ -45,6 +45,9 @@ The commands, with their fields (``?``: optional, default in brackets):
 ``game_cell``        ``row``, ``column`` (1..5): the person draws there
 ``game_play``        the Tic-tac-toe page's Play
 ``game_stop``        its Stop: the arm returns to its start pose, then stops
+``game_engine``      ``engine``: ``"strong"`` or ``"thesis"``, the manipulator's
+                     game algorithm (before the first move only)
+``game_new``         a new game: a new robot from power-on, paused (Run starts it)
 ===================  ==========================================================
 
 Every command may carry ``id`` (a number or a short text), echoed in its reply.
@@ -204,6 +207,12 @@ def symbol(cmd: str, name: str, value: Any) -> str:
     return str(value)
 
 
+def engine(cmd: str, name: str, value: Any) -> str:
+    if value not in ("strong", "thesis"):
+        raise ProtocolError(f"{cmd}: {name!r} must be \"strong\" or \"thesis\", got {_describe(value)}")
+    return str(value)
+
+
 @dataclass(frozen=True)
 class Field:
     check: Check
@@ -242,6 +251,8 @@ COMMANDS: Mapping[str, Mapping[str, Field]] = {
     "game_cell": {"row": Field(integer(1, 5)), "column": Field(integer(1, 5))},
     "game_play": {},
     "game_stop": {},
+    "game_engine": {"engine": Field(engine)},
+    "game_new": {},
 }
 
 

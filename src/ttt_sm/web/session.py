@@ -56,7 +56,7 @@ from ..sched.clock import PacedClock
 from .arm_view import arm_scene, arm_view
 from .catalogue import describe_session
 from .coverage import CoverageError, colouring, load_scenarios, run_for_coverage, scenario_from_text
-from .game import GAME_COMMANDS, game_view
+from .game import GAME_COMMANDS, game_view, start_new_game
 from .protocol import Command
 
 log = logging.getLogger(__name__)
@@ -230,6 +230,9 @@ class Session:
             self._thread.join(timeout_s)
         self._worker.shutdown(wait=False, cancel_futures=True)
         gc.unfreeze()
+        game = self.debugger.game
+        if game is not None:
+            game.close()  # its record ends (as interrupted, unless the game ended)
         if self.trace_path is not None:
             return self.debugger.save_trace(self.trace_path)
         return None
@@ -449,6 +452,23 @@ class Session:
         self._stop = {"kind": "replay", "text": result.describe(), "tick": result.tick, "hits": []}
         self._resync = True
         return {"text": result.describe(), "identical": result.identical}
+
+    def _cmd_game_new(self, cid: int) -> dict[str, Any]:
+        gc.unfreeze()  # the robot the new game replaces may be collected
+        try:
+            result = start_new_game(self.debugger)
+        finally:
+            _freeze_heap()
+        for counts in self._taken.values():
+            counts.clear()
+        self._pending.clear()
+        self._pending_total = 0
+        self._pending_stamps = []
+        self._install_clock()
+        self.mode = "paused"
+        self._stop = None
+        self._resync = True
+        return result
 
     def _cmd_timeline(self, cid: int, chart: str, seconds: float) -> None:
         window = self.debugger.timeline(chart, seconds)

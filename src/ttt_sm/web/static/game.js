@@ -92,6 +92,13 @@ function drawGame(g) {
     b.title = by === "drawn" ? "drawn; the camera reads it when you click Play" : "";
   }
   $('[data-cmd="play"]').disabled = !(g.plays_here && g.awaiting);
+  const engine = role("engine");
+  engine.value = g.engine;
+  engine.disabled = g.engine_locked || !g.plays_here;
+  $('[data-cmd="new"]').disabled = !(g.plays_here && g.can_start_over);
+  role("record").textContent = g.record
+    ? `The game's record: ${g.record}` + (g.record_ended ? ` (ended: ${g.record_ended})` : " (written as the game goes)")
+    : "This game's record is kept in memory only.";
   $('[data-cmd="stop"]').disabled = !g.plays_here || g.ended;
   if (g.photos !== state.photos) {
     state.photos = g.photos;
@@ -147,6 +154,7 @@ function onMessage(m) {
     say(m.text || "", false);
   } else if (m.type === "error") {
     say(m.error, true);
+    if (m.command === "game_engine" && state.game) role("engine").value = state.game.engine;
   }
 }
 
@@ -162,4 +170,6 @@ $('[data-cmd="symbol"]').addEventListener("click", () => {
 });
 $('[data-cmd="play"]').addEventListener("click", () => link.send({ type: "game_play" }));
 $('[data-cmd="stop"]').addEventListener("click", () => link.send({ type: "game_stop" }));
+role("engine").addEventListener("change", (e) => link.send({ type: "game_engine", engine: e.target.value }));
+$('[data-cmd="new"]').addEventListener("click", () => link.send({ type: "game_new" }));
 link.connect();

@@ -46,6 +46,10 @@ def register(sub: Any) -> argparse.ArgumentParser:
     sp.add_argument("--out", metavar="DIR", default="out/gui",
                     help="with --game: where each game's record (game-N/game.jsonl, as ttt-sm play writes it) and"
                          " board pictures go (default out/gui)")
+    sp.add_argument("--camera", metavar="CAMERA", default=None,
+                    help="a camera outside the simulation, shown in the /game page: an OpenCV capture device"
+                         " index (0), a folder of pictures (shown in name order) or the serial smart camera"
+                         " (serial:PORT)")
     sp.add_argument("--trace", metavar="FILE", default="out/gui/trace.jsonl",
                     help="where the trace is saved when the cockpit stops (default out/gui/trace.jsonl)")
     return sp
@@ -82,6 +86,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
 
     from ..debug.debugger import Debugger
     from ..twin.workspace import load_arm
+    from ..web.camera_feed import CameraFeedError, open_feed
     from ..web.coverage import scenario_dir_files
     from ..web.server import create_app
     from ..web.session import Session
@@ -105,10 +110,17 @@ def cmd_gui(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
     port = sock.getsockname()[1]
+    feed = None
+    if args.camera is not None:
+        try:
+            feed = open_feed(args.camera)
+        except CameraFeedError as exc:
+            sock.close()
+            raise CliError(str(exc)) from None
     print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
     dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person, record_root=record_root)
     session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
-                      trace_path=Path(args.trace))
+                      trace_path=Path(args.trace), camera_feed=feed)
     shown = f"[{args.host}]" if ":" in args.host else args.host
     hosts = [f"{h}:{port}" for h in ("127.0.0.1", "localhost", "[::1]", shown)]
     app = create_app(session, token=token, hosts=hosts)
@@ -118,6 +130,8 @@ def cmd_gui(args: argparse.Namespace) -> int:
         print(f"ttt-sm gui: play at {url.replace('/charts', '/game', 1)}", flush=True)
     if record_root is not None:
         print(f"ttt-sm gui: each game's record goes to {record_root}/game-N/game.jsonl", flush=True)
+    if feed is not None:
+        print(f"ttt-sm gui: the {feed.kind} camera {feed.name} is shown in the /game page", flush=True)
     if token:
         print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
               flush=True)

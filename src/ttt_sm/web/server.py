@@ -9,6 +9,7 @@ protocol tests run without a browser or a socket).
 Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
 (the Tic-tac-toe page, :mod:`.game`; its camera picture ``/api/game/photo.png``),
 ``/api/arm/ink.png`` (the whiteboard's ink under the arm's top view, :mod:`.arm_view`),
+``/api/camera/frame.png`` (the newest picture of ``--camera``, :mod:`.camera_feed`),
 ``/static/...`` (the pages' scripts and styles, from the package: nothing from
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
 SVG, :mod:`.diagrams`), ``/api/trace.jsonl`` (the trace so far), ``/ws``.
@@ -45,6 +46,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from ..runtime.errors import GraphvizMissingError
 from .arm_view import ink_png
+from .camera_feed import feed_png
 from .diagrams import DiagramError, Diagrams
 from .game import photo_png
 from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
@@ -151,6 +153,13 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         png = await asyncio.to_thread(session.call, lambda d: ink_png(d.robot))
         return Response(png, media_type="image/png", headers={"Cache-Control": "no-store"})
 
+    async def camera_frame(request: Request) -> Response:
+        png = await asyncio.to_thread(feed_png, session.camera_feed)
+        if png is None:
+            return PlainTextResponse("no picture: no --camera, none grabbed yet, or a camera that sends"
+                                     " percentages only\n", status_code=404)
+        return Response(png, media_type="image/png", headers={"Cache-Control": "no-store"})
+
     async def diagram(request: Request) -> Response:
         chart = request.path_params["chart"]
         key = request.query_params.get("view", "overview")
@@ -246,6 +255,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         Route("/game", game),
         Route("/api/game/photo.png", game_photo),
         Route("/api/arm/ink.png", arm_ink),
+        Route("/api/camera/frame.png", camera_frame),
         Route("/api/diagram/{chart}", diagram),
         Route("/api/trace.jsonl", trace),
         WebSocketRoute("/ws", ws),

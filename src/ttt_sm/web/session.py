@@ -54,6 +54,7 @@ from ..runtime.jsonable import dumps, jsonable
 from ..runtime.structure import TICK_EVENT_NAME, TICK_EVENT_PREFIX
 from ..sched.clock import PacedClock
 from .arm_view import arm_scene, arm_view
+from .camera_feed import CameraFeed, feed_view
 from .catalogue import describe_session
 from .coverage import CoverageError, colouring, load_scenarios, run_for_coverage, scenario_from_text
 from .game import GAME_COMMANDS, game_view, start_new_game
@@ -129,12 +130,17 @@ class Session:
         Scenario files the pages may run for coverage.
     trace_path : Path, optional
         Where :meth:`stop` writes the trace (JSON Lines).
+    camera_feed : CameraFeed, optional
+        A camera outside the simulation (``ttt-sm gui --camera``), started and
+        stopped with the session; the frames carry what it shows.
     """
 
     def __init__(self, debugger: Debugger, *, speed: float | None = 1.0, running: bool = True,
                  frame_hz: float = FRAME_HZ, scenarios: Mapping[str, Path] | None = None,
-                 trace_path: Path | None = None) -> None:
+                 trace_path: Path | None = None, camera_feed: CameraFeed | None = None) -> None:
         self.debugger = debugger
+        self.camera_feed = camera_feed
+        self._feed_grabs = 0
         robot = debugger.robot
         self.params = robot.params
         self.info = describe_session(debugger)
@@ -218,6 +224,8 @@ class Session:
         """Start the simulation thread."""
         if self._thread is not None:
             return
+        if self.camera_feed is not None:
+            self.camera_feed.start()
         self._thread = threading.Thread(target=self._main, name="ttt-sm-session", daemon=True)
         self._thread.start()
 
@@ -233,6 +241,8 @@ class Session:
         game = self.debugger.game
         if game is not None:
             game.close()  # its record ends (as interrupted, unless the game ended)
+        if self.camera_feed is not None:
+            self.camera_feed.stop()
         if self.trace_path is not None:
             return self.debugger.save_trace(self.trace_path)
         return None
@@ -297,6 +307,8 @@ class Session:
         timeout = None
         if self._dirty:
             timeout = max(0.0, self._last_frame_at + self.frame_period - time.perf_counter())
+        elif self.camera_feed is not None:
+            timeout = self.frame_period  # paused, the camera outside the simulation goes on: look again
         try:
             item = self._queue.get(timeout=timeout)
         except queue.Empty:
@@ -318,6 +330,9 @@ class Session:
             self._note_stop(reason)
 
     def _flush(self) -> None:
+        if self.camera_feed is not None and self.camera_feed.grabs != self._feed_grabs:
+            self._feed_grabs = self.camera_feed.grabs
+            self._dirty = True
         if self._dirty and time.perf_counter() - self._last_frame_at >= self.frame_period * 0.999:
             self._publish()
 
@@ -577,6 +592,7 @@ class Session:
             "stop": self._stop,
             "game": game_view(dbg),
             "arm": arm_view(robot),
+            "camera": feed_view(self.camera_feed),
         }
 
     def _frame(self, full: bool, state: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -618,7 +634,7 @@ class Session:
         frame["taken"] = {name: {i: c for i, c in counts.items() if sent.get("taken", {}).get(name, {}).get(i) != c}
                           for name, counts in state["taken"].items()}
         frame["taken"] = {name: counts for name, counts in frame["taken"].items() if counts}
-        for key in ("breakpoints", "actions", "forced", "stop", "game", "arm"):
+        for key in ("breakpoints", "actions", "forced", "stop", "game", "arm", "camera"):
             if sent.get(key, _MISSING) != state[key]:
                 frame[key] = state[key]
         return frame

@@ -32,7 +32,12 @@ function cellButtons() {
     }
     board.appendChild(row);
   }
-  const reading = role("reading");
+  makeReading(role("reading"));
+  makeReading(role("feed-reading"));
+}
+
+// A 5x5 table of what a detector read: each cell's ink percentage and symbol.
+function makeReading(reading) {
   for (let r = 1; r <= 5; r++) {
     const row = document.createElement("div");
     row.setAttribute("role", "row");
@@ -47,6 +52,42 @@ function cellButtons() {
     }
     reading.appendChild(row);
   }
+}
+
+function drawReading(reading, percentages, read) {
+  for (const cell of reading.querySelectorAll('[role="cell"]')) {
+    const i = 5 * (cell.dataset.row - 1) + (cell.dataset.column - 1);
+    const pct = percentages[i];
+    const sym = read ? read[i] : "?";
+    cell.innerHTML = "";
+    const b = document.createElement("b");
+    b.textContent = sym === "." ? "" : sym;
+    cell.append(b, `${pct.toFixed(1)} %`);
+    cell.dataset.occupied = sym !== "." ? "true" : "false";
+    cell.dataset.read = sym;
+    cell.title = `row ${cell.dataset.row}, column ${cell.dataset.column}: ${pct.toFixed(1)} % ink, read ${sym === "." ? "empty" : sym}`;
+  }
+}
+
+// The camera outside the simulation (ttt-sm gui --camera): its newest picture and what was read in it.
+function drawCamera(c) {
+  const panel = role("feed-panel");
+  panel.hidden = !c;
+  if (!c) return;
+  role("feed-source").textContent = `— ${c.kind} ${c.name}: ${c.source}`;
+  const status = role("feed-status");
+  status.textContent = c.error || (c.percentages ? `grab ${c.n}: read` : "");
+  status.dataset.error = c.error ? "true" : "false";
+  if (c.percentages) drawReading(role("feed-reading"), c.percentages, c.read);
+  const img = role("feed-photo");
+  if (c.has_image && img.dataset.grab !== String(c.n)) {
+    img.src = `/api/camera/frame.png?n=${c.n}`;
+    img.alt = `the camera's picture: ${c.source}`;
+    img.dataset.grab = c.n;
+    img.dataset.source = c.source;
+    img.hidden = false;
+  }
+  if (!c.has_image) img.hidden = true;
 }
 
 function say(text, error) {
@@ -111,19 +152,7 @@ function drawGame(g) {
       role("photo-count").textContent = `photo ${g.photos}, taken after the last move`;
     }
   }
-  if (g.percentages) {
-    for (const cell of role("reading").querySelectorAll('[role="cell"]')) {
-      const i = 5 * (cell.dataset.row - 1) + (cell.dataset.column - 1);
-      const pct = g.percentages[i];
-      const sym = g.read ? g.read[i] : "?";
-      cell.innerHTML = "";
-      const b = document.createElement("b");
-      b.textContent = sym === "." ? "" : sym;
-      cell.append(b, `${pct.toFixed(1)} %`);
-      cell.dataset.occupied = sym !== "." ? "true" : "false";
-      cell.title = `row ${cell.dataset.row}, column ${cell.dataset.column}: ${pct.toFixed(1)} % ink, read ${sym === "." ? "empty" : sym}`;
-    }
-  }
+  if (g.percentages) drawReading(role("reading"), g.percentages, g.read);
 }
 
 function drawFrame(f) {
@@ -136,6 +165,7 @@ function drawFrame(f) {
   }
   if (f.t !== undefined) role("sim-time").textContent = f.t.toFixed(1);
   if ("game" in f) drawGame(f.game);
+  if ("camera" in f) drawCamera(f.camera);
   if (state.arm) {
     if (f.full) state.arm.resync();
     if ("arm" in f) state.arm.draw(f.arm);

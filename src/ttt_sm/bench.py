@@ -210,6 +210,7 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
             "games": 1 if quick else 3, "quick": quick, "gui_soak_min": gui_soak_min}
     result: dict[str, Any] = {
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
+                    "load_avg_before": [round(x, 2) for x in os.getloadavg()],
                     "numba_jit": os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"},
         "quick": quick,
     }
@@ -221,6 +222,10 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
         # the target: as fast as it goes with a page attached, against the same run's motion
         result["gui_realtime_ratio_to_motion"] = round(
             result["gui_realtime_factor_max"] / result["game_motion_realtime_factor"], 2)
+    if "gui_game_realtime_factor" in result and "game_realtime_factor" in result:
+        # a whole game with the /game page attached, beside the same run's headless games
+        result["gui_game_ratio_to_game"] = round(result["gui_game_realtime_factor"] / result["game_realtime_factor"], 2)
+    result["machine"]["load_avg_after"] = [round(x, 2) for x in os.getloadavg()]
     return result
 
 

@@ -17,6 +17,12 @@ flags as the browser tests) and measures:
 - ``gui_realtime_factor_max``: simulated over wall time, as fast as it goes,
   with the page attached and drawing;
 - ``gui_frame_bytes_median``: the frames the page received;
+- ``gui_game_realtime_factor``: a whole game (a simulated person, seed
+  ``seed``) as fast as it goes, with the Tic-tac-toe page (``/game``) open in
+  Chromium and drawing every frame (the arm, the boards, the photos), and
+  ``gui_game_headless_realtime_factor``: the same game in a session with no
+  page attached (:func:`bench_gui_game`); ``ttt-sm bench`` reports them beside
+  the headless ``game_realtime_factor`` of its ``game`` section;
 - with ``soak_min`` (``ttt-sm bench --only gui --gui-soak MIN``): the server's
   resident memory after 1 minute and after ``soak_min`` minutes at x10.
 
@@ -70,7 +76,7 @@ def _serve(session: Session) -> tuple[Any, threading.Thread, str]:
 
 
 def bench_gui(params: ArmParams, seed: int = 0, x1_s: float = 60.0, max_s: float = 15.0,
-              soak_min: float = 0.0) -> dict[str, Any]:
+              soak_min: float = 0.0, game: bool = True) -> dict[str, Any]:
     """Measure the cockpit in Chromium (see the module's docstring)."""
     try:
         from playwright.sync_api import sync_playwright
@@ -164,6 +170,78 @@ def bench_gui(params: ArmParams, seed: int = 0, x1_s: float = 60.0, max_s: float
     finally:
         server.should_exit = True
         thread.join(30)
+    if game:
+        out.update(bench_gui_game(params, seed, executable))
+    return out
+
+
+def _game_over(d: Debugger) -> bool:
+    game = d.game
+    return game is not None and game.driver is not None and not game.driver.running
+
+
+def _play_whole_game(session: Session, on_start: Any = None, limit_s: float = 900.0) -> tuple[float, float, str]:
+    """Run the session's game as fast as it goes to its end: (simulated s, wall s, outcome)."""
+    t0 = session.call(lambda d: d.robot.t)
+    wall0 = time.perf_counter()
+    session.submit(0, _command("run"))
+    if on_start is not None:
+        on_start()
+    while not session.call(_game_over):
+        if time.perf_counter() - wall0 > limit_s:
+            raise RuntimeError(f"the game did not end within {limit_s:g} s of wall time")
+        time.sleep(0.05)
+    wall = time.perf_counter() - wall0
+    t1, outcome = session.call(lambda d: (d.robot.t, getattr(d.game, "outcome", None)))
+    session.submit(0, _command("pause"))
+    return t1 - t0, wall, str(outcome)
+
+
+def _game_session(params: ArmParams, seed: int) -> Session:
+    dbg = Debugger.build(params, seed=seed, game=True, person="simulated")
+    dbg.run(0.01)  # the numba-compiled loop warmed up, not timed
+    return Session(dbg, speed=None, running=False)
+
+
+def bench_gui_game(params: ArmParams, seed: int = 0, executable: str | None = None) -> dict[str, Any]:
+    """A whole game as fast as it goes, headless and then with the ``/game`` page open in Chromium.
+
+    The same game twice (seed ``seed``, the simulated person, the camera read
+    in-process): first in a session no page watches, then in a new session
+    with Chromium on the Tic-tac-toe page, receiving and drawing every frame.
+    """
+    session = _game_session(params, seed)
+    session.start()
+    try:
+        sim, wall, _ = _play_whole_game(session)
+    finally:
+        session.stop()
+    out: dict[str, Any] = {"gui_game_headless_sim_s": round(sim, 1), "gui_game_headless_wall_s": round(wall, 2),
+                           "gui_game_headless_realtime_factor": round(sim / wall, 1)}
+    from playwright.sync_api import sync_playwright
+
+    session = _game_session(params, seed)
+    server, thread, url = _serve(session)
+    received = []
+
+    def on_ws(ws: Any) -> None:
+        ws.on("framereceived", lambda payload: received.append(len(payload)))
+
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=executable, args=list(CHROMIUM_FLAGS))
+            page = browser.new_page(viewport={"width": 1400, "height": 1300})
+            page.on("websocket", on_ws)
+            page.goto(url + "/game")
+            page.wait_for_selector('svg[data-role="arm-top"] [data-role="tip"]', timeout=60_000)
+            sim, wall, outcome = _play_whole_game(session)
+            browser.close()
+    finally:
+        server.should_exit = True
+        thread.join(30)
+    out.update({"gui_game_sim_s": round(sim, 1), "gui_game_wall_s": round(wall, 2),
+                "gui_game_realtime_factor": round(sim / wall, 1), "gui_game_outcome": outcome,
+                "gui_game_messages_received": len(received)})
     return out
 
 

@@ -162,7 +162,7 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
                 wait_board(page, state["board"])
             if person_moves == 2:
                 shot = Path(os.environ.get("TTT_SM_SCREENSHOTS") or tmp_path) / SHOT
-                page.screenshot(path=str(shot))
+                page.screenshot(path=str(shot), full_page=True)
                 assert shot.stat().st_size > 20_000
         state = game_state(game_cockpit)
         result = {state["robot"]: 1, state["person"]: 2, "draw": 3}[state["outcome"]]

@@ -100,6 +100,12 @@ def cmd_gui(args: argparse.Namespace) -> int:
     if Path(args.trace).is_dir():
         raise CliError(f"--trace: {args.trace} is a folder; name the file the trace is saved to")
     out_dir(str(Path(args.trace).parent), f"--trace {args.trace}: its folder")  # written when the cockpit stops
+    feed = None
+    if args.camera is not None:  # before the port is taken: a camera that is not there is refused first
+        try:
+            feed = open_feed(args.camera)
+        except CameraFeedError as exc:
+            raise CliError(str(exc)) from None
     record_root = out_dir(args.out, "--out") if args.game else None
     params = load_arm(getattr(args, "params", None))
     token = secrets.token_urlsafe(24) if needs_token(args.host) else None
@@ -110,13 +116,6 @@ def cmd_gui(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
     port = sock.getsockname()[1]
-    feed = None
-    if args.camera is not None:
-        try:
-            feed = open_feed(args.camera)
-        except CameraFeedError as exc:
-            sock.close()
-            raise CliError(str(exc)) from None
     print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
     dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person, record_root=record_root)
     session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
@@ -136,8 +135,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
         print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
               flush=True)
     print("ttt-sm gui: Ctrl-C stops it (the trace is saved to " + args.trace + ")", flush=True)
-    if args.open:
-        threading.Timer(1.0, webbrowser.open, args=(url,)).start()
+    if args.open:  # the game's page when you play there, else the chart cockpit
+        shown_url = url.replace("/charts", "/game", 1) if args.game and args.person == "page" else url
+        threading.Timer(1.0, webbrowser.open, args=(shown_url,)).start()
     config = uvicorn.Config(app, log_level="warning", ws_max_size=1 << 20, lifespan="on")
     server = uvicorn.Server(config)
     try:

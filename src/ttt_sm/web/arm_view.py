@@ -12,7 +12,7 @@ computes no kinematics of its own.
 
 What stays the same for the whole session (the board, the field, the link
 lengths) comes once in the session's ``info`` (:func:`arm_scene`).  The
-board's ink is a picture (:func:`ink_png`, ``/api/arm/ink.png``) that the
+board's ink is a picture (:func:`ink_picture`, ``/api/arm/ink.png``) that the
 page asks for again when the frame's ``ink`` key changes.
 
 Ground truth is simulation only: an arm that is no simulation has no
@@ -24,6 +24,7 @@ from __future__ import annotations
 from typing import Any
 
 import cv2
+import numpy as np
 
 from ..app.robot import Robot
 from ..params import ArmParams
@@ -98,9 +99,13 @@ def arm_view(robot: Robot) -> dict[str, Any] | None:
     }
 
 
-def ink_png(robot: Robot) -> bytes:
-    """The whiteboard's ink as PNG, seen from above (x to the right, y up), :data:`INK_PX_PER_MM`."""
-    image = robot.board.render(px_per_mm=INK_PX_PER_MM, view="above")
+def ink_picture(robot: Robot) -> np.ndarray:
+    """The whiteboard's ink seen from above (x to the right, y up), :data:`INK_PX_PER_MM`, BGR."""
+    return robot.board.render(px_per_mm=INK_PX_PER_MM, view="above")
+
+
+def png(image: np.ndarray) -> bytes:
+    """An image as PNG bytes."""
     ok, data = cv2.imencode(".png", image)
     if not ok:
         raise RuntimeError("OpenCV could not encode the whiteboard's picture as PNG")

@@ -45,7 +45,7 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from ..runtime.errors import GraphvizMissingError
-from .arm_view import ink_png
+from .arm_view import ink_picture, png
 from .camera_feed import feed_png
 from .diagrams import DiagramError, Diagrams
 from .game import photo_png
@@ -149,9 +149,10 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         return Response(png, media_type="image/png", headers={"Cache-Control": "no-store"})
 
     async def arm_ink(request: Request) -> Response:
-        # drawn in the simulation thread, between two control steps: never a half-inked stroke
-        png = await asyncio.to_thread(session.call, lambda d: ink_png(d.robot))
-        return Response(png, media_type="image/png", headers={"Cache-Control": "no-store"})
+        # drawn in the simulation thread, between two control steps (never a half-inked stroke), encoded here
+        image = await asyncio.to_thread(session.call, lambda d: ink_picture(d.robot))
+        data = await asyncio.to_thread(png, image)
+        return Response(data, media_type="image/png", headers={"Cache-Control": "no-store"})
 
     async def camera_frame(request: Request) -> Response:
         png = await asyncio.to_thread(feed_png, session.camera_feed)

@@ -135,7 +135,8 @@ def game_lines(dbg: Debugger, last_events: int = 8) -> list[str]:
     for m in game.moves:
         lines.append(f"  move: {m['by']} {m['symbol']} in ({m['row']}, {m['column']}) at t = {m['t']:.3f} s"
                      + (f", seen at {tuple(m['detected'])}" if m.get("detected") else ""))
-    events = [e for e in game.record.events if e["event"] not in ("detected",)][-last_events:]
+    # the record's first line (seed, engine, person, camera) is what the first line above says
+    events = [e for e in game.record.events if e["event"] not in ("detected", "game")][-last_events:]
     for e in events:
         rest = str(e["text"]) if "text" in e else \
             ", ".join(f"{k} {v}" for k, v in e.items() if k not in ("t", "tick", "event", "think_ms"))

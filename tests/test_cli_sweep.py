@@ -109,6 +109,8 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     numbers(["gui"], "--seed", ("abc", "-1"))
     in_files(["gui"], "--scenarios", ("missing", "garbage"))
     in_files(["gui"], "--trace", ("folder", "file_as_folder", "read_only"))
+    in_files(["gui"], "--camera", ("missing", "folder", "garbage"))
+    out_dirs(["gui", "--game"], "--out")
     cases.append((["debug", "--start", "1,2"], "--start"))
     cases.append((["debug", "--start", "a,b,c"], "--start"))
     numbers(["debug"], "--settle", ("abc", "nan", "-1", "inf"))

@@ -6,6 +6,8 @@ read from ``ttt-sm bench --json``, never asserted by a test).
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import pytest
 
 from browser_fixtures import chromium_executable
@@ -14,7 +16,10 @@ from ttt_sm.web.bench import bench_gui_game
 
 
 def test_the_gui_game_bench_plays_the_same_whole_game_headless_and_in_the_page() -> None:
-    result = bench_gui_game(load_params(), seed=0, executable=chromium_executable())
+    # In a thread of its own: the bench starts Playwright's sync API, which refuses a thread where another
+    # test's browser (the session's `browser` fixture) already runs its loop.
+    with ThreadPoolExecutor(1) as pool:
+        result = pool.submit(bench_gui_game, load_params(), 0, chromium_executable()).result(timeout=1800)
     # The same game (one seed, a simulated person) both times: it ends at the same simulated time, to within
     # the bench's look at the session every 0.05 s of wall time.
     assert result["gui_game_sim_s"] > 60.0

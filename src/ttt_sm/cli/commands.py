@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..params import ArmParams
-from .common import CliError, add_command, clear_status, emit, out_dir, progress, status_line
+from .common import CliError, add_command, clear_status, emit, out_dir, print_json, progress, status_line
 
 if TYPE_CHECKING:
     from ..app.game import GameSession
@@ -154,7 +154,10 @@ def cmd_tune(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
+    """The bench: ``--out``/bench.jsonl streamed (a line per section as it ends, then how the run ended);
+    ``--json``: one document at the end, also when interrupted (``"complete": false`` and the ending)."""
     from ..bench import SECTIONS, run_bench
+    from ..runtime.recordfile import RecordFile, ending_of
 
     out = out_dir(args.out)
     params = load_arm(args.params)
@@ -162,14 +165,41 @@ def cmd_bench(args: argparse.Namespace) -> int:
     unknown = [name for name in only or () if name not in SECTIONS]
     if unknown:
         raise CliError(f"--only: unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
+    if args.gui_soak is not None and not args.gui_soak > 0:
+        raise CliError(f"--gui-soak: expected a positive number of minutes, got {args.gui_soak}")
+    names = only or list(SECTIONS)
+    record = RecordFile(out / "bench.jsonl")
+    record.add({"event": "bench", "sections": names, "seed": args.seed, "quick": args.quick,
+                "gui_soak_min": args.gui_soak})
+    done: dict[str, Any] = {}
+    running: list[str] = []
+    finished: list[str] = []
+
+    def on_section(name: str, values: dict[str, Any] | None) -> None:
+        if values is None:
+            running[:] = [name]
+            return
+        running.clear()
+        finished.append(name)
+        done.update(values)
+        record.add({"event": "section", "section": name, "results": values})
+
     try:
-        if args.gui_soak is not None and not args.gui_soak > 0:
-            raise ValueError(f"--gui-soak: expected a positive number of minutes, got {args.gui_soak}")
-        result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
-                           progress=progress(True), gui_soak_min=args.gui_soak or 0.0)
-    except ValueError as exc:
-        raise CliError(str(exc)) from exc
-    emit(result, args.json)
+        try:
+            result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
+                               progress=progress(True), gui_soak_min=args.gui_soak or 0.0, on_section=on_section)
+        except ValueError as exc:
+            raise CliError(str(exc)) from exc
+    except BaseException as exc:  # the record and the --json document say what was measured and where it stopped
+        how, data = ending_of(exc)
+        ended = {"event": how, **data, "section": running[0] if running else None,
+                 "sections_done": finished}
+        record.end(how, **{k: v for k, v in ended.items() if k != "event"})
+        if args.json:
+            print_json({**done, "complete": False, "ended": ended})
+        raise
+    record.end("finished", sections=names)
+    emit({**result, "complete": True}, args.json)
     return 0
 
 

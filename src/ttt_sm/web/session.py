@@ -73,6 +73,9 @@ TRACE_ON_JOIN = 200
 RUN_CHUNK_S = 60.0
 #: Latency samples kept for the p95 figure.
 LATENCY_SAMPLES = 2000
+#: The user's actions (inputs set, events posted) a frame lists, the newest: the page shows the last few,
+#: and a session that runs for hours must not send (and describe) every one in every frame.
+ACTIONS_SHOWN = 50
 
 Send = Callable[[str], None]
 
@@ -560,7 +563,7 @@ class Session:
             "taken": {name: dict(c) for name, c in self._taken.items()},
             "breakpoints": [{"id": bp.id, "spec": bp.spec, "enabled": bp.enabled, "hits": bp.hits,
                              "text": bp.describe()} for bp in dbg.breakpoints],
-            "actions": [a.describe() for a in dbg.actions],
+            "actions": [a.describe() for a in dbg.actions[-ACTIONS_SHOWN:]],
             "forced": [f"{c}.{n}" for c, n in dbg.forced],
             "stop": self._stop,
             "game": game_view(dbg),

@@ -95,6 +95,19 @@ def _quiet_stdout() -> None:
         pass
 
 
+def _ignore_late_signals() -> None:
+    """The ttt-sm process has done its work: a Ctrl-C or SIGTERM while it exits changes nothing.
+
+    Without this, a signal in the last moments (after a command put back the handlers it had, while
+    Python shuts down) killed the process with status -2 or -15 although its work and records were whole.
+    """
+    try:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
+    except ValueError:  # not the main thread: signals are not ours to handle
+        pass
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ttt-sm` console script: run the subcommand, turn every error into one line."""
     command = "?"
@@ -104,6 +117,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else argv))
         command = args.command
         status = int(args.func(args))
+        if argv is None:
+            _ignore_late_signals()
         if sys.stdout is not None:
             sys.stdout.flush()  # a closed pipe shows here, not at exit
         return status
@@ -121,4 +136,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(line, file=sys.stderr)
         return status
     finally:
-        restore()
+        if argv is None:  # the ttt-sm process: it exits now
+            _ignore_late_signals()
+        else:  # called in a program: give it back its handler
+            restore()

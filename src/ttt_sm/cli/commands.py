@@ -54,8 +54,12 @@ def cmd_play(args: argparse.Namespace) -> int:
     record = GameRecord.open(out / "game.jsonl")
     session: GameSession | None = None
 
+    finished = False
+
     def stop(signum: int, _frame: object) -> None:
         why = signal.Signals(signum).name
+        if finished:  # the record already says how the game ended: saving it and the report run to their end
+            return
         if session is None:
             raise GameInterrupted(why)  # nothing runs yet: stop setting up at once
         session.interrupt(why)
@@ -87,6 +91,11 @@ def cmd_play(args: argparse.Namespace) -> int:
             record.close()
             raise
         report = _play_game(session)
+        finished = True
+        report.update(session.save())
+        report["opponent"] = opponent if opponent == "terminal" else f"simulated {args.person}"
+        lines = [f"  {k}: {v}" for k, v in report.items() if k not in ("moves", "camera_link")]
+        emit(report, args.json, "play:\n" + "\n".join(lines))
     except GameInterrupted as exc:
         clear_status()
         t = session.robot.t if session is not None else 0.0
@@ -100,11 +109,6 @@ def cmd_play(args: argparse.Namespace) -> int:
         clear_status()
         if session is not None:
             session.close()
-    assert session is not None
-    report.update(session.save())
-    report["opponent"] = opponent if opponent == "terminal" else f"simulated {args.person}"
-    lines = [f"  {k}: {v}" for k, v in report.items() if k not in ("moves", "camera_link")]
-    emit(report, args.json, "play:\n" + "\n".join(lines))
     return 0
 
 

@@ -7,6 +7,7 @@ import contextlib
 import io
 import math
 import sys
+import tempfile
 
 import pytest
 from hypothesis import assume
@@ -111,7 +112,11 @@ def refused(case: tuple[int, str]) -> None:
 test_an_unusable_number_is_refused_in_one_line, test_an_unusable_number_is_refused_in_one_line_soak = fuzz(
     st.tuples(st.integers(0, len(ARGS) - 1), _NUMBERS), quick=200, soak=3000)(refused)
 
-_PATHS = ["/nonexistent/x", "/dev/null", "/dev/zero", "/proc/nope/x", "/proc/version", "/tmp", "", " ", "-",
+#: Stands for a folder: an empty one the case owns.  A folder is a usable argument to some commands
+#: (``scenario check`` reads the scenario files in it), so a shared one such as /tmp would make the case
+#: depend on what other programs left there.
+_FOLDER = "<an empty folder>"
+_PATHS = ["/nonexistent/x", "/dev/null", "/dev/zero", "/proc/nope/x", "/proc/version", _FOLDER, "", " ", "-",
           "relative/missing", "/etc/hostname", "a" * 5000]
 #: Folders no command can write, even as root: /proc and /sys refuse new files, /dev/null and /proc/version
 #: are files, not folders.
@@ -138,7 +143,9 @@ def path_refused(case: tuple[int, str, int]) -> None:
     before, after, writes = PATH_ARGS[index]
     if writes:
         path = _UNWRITABLE[pick % len(_UNWRITABLE)]
-    rc, err = _run([*before, path, *after])
+    # Run in an empty working folder of the case's own, so a relative path names nothing left by others.
+    with tempfile.TemporaryDirectory() as folder, contextlib.chdir(folder):
+        rc, err = _run([*before, folder if path == _FOLDER else path, *after])
     assert rc in ((2,) if writes else (0, 1, 2)), (before, path, rc, err[-500:])
     if rc == 2:
         one_error_line(err)

@@ -195,11 +195,14 @@ SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
 
 def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, quick: bool = False,
               out: Path = Path("out/bench"), progress: Callable[[str], None] | None = None,
-              gui_soak_min: float = 0.0) -> dict[str, Any]:
+              gui_soak_min: float = 0.0,
+              on_section: Callable[[str, dict[str, Any] | None], None] | None = None) -> dict[str, Any]:
     """Run the chosen sections (all by default) and return one flat result dict.
 
     `quick` shortens the timed runs (for tests of the command, not for the
-    numbers reported on issues).
+    numbers reported on issues).  ``on_section(name, None)`` hears of a
+    section starting, ``on_section(name, values)`` of its results (the
+    command line writes them to ``bench.jsonl`` as they come).
     """
     names = only or list(SECTIONS)
     unknown = [n for n in names if n not in SECTIONS]
@@ -217,7 +220,12 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
     for name in names:
         if progress:
             progress(f"bench: {name} ...")
-        result.update(SECTIONS[name](params, args))
+        if on_section is not None:
+            on_section(name, None)
+        values = SECTIONS[name](params, args)
+        result.update(values)
+        if on_section is not None:
+            on_section(name, values)
     if "gui_realtime_factor_max" in result and "game_motion_realtime_factor" in result:
         # the issue's target: as fast as it goes with a page attached, against the same run's motion
         result["gui_realtime_ratio_to_motion"] = round(

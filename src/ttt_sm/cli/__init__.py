@@ -5,7 +5,9 @@ standard output, progress on standard error).  Errors are one readable line
 on standard error and exit status 2, never a traceback (:func:`main`): a
 project error is its message, an operating-system error on a path names the
 path and what to do, a closed pipe (``ttt-sm params | head``) ends quietly,
-Ctrl-C says "interrupted" (status 130).  Anything else is a bug, reported in
+Ctrl-C says "interrupted" (status 130), SIGTERM likewise (status 143): both
+raise :class:`~.common.Interrupted` where the program is, so every record
+being written ends with its ``interrupted`` line (docs/reliability.md).  Anything else is a bug, reported in
 one line that says so (status 70; ``TTT_SM_TRACEBACK=1`` shows the traceback).
 
 The package: :mod:`.common` holds what every subcommand shares (the
@@ -27,12 +29,13 @@ from __future__ import annotations
 import argparse
 import errno
 import os
+import signal
 import sys
 from collections.abc import Sequence
 
 from ..params import shown_path
 from . import ai, arm, camera, commands, debug, docs, gui, scenario, vision
-from .common import join_negative_values
+from .common import join_negative_values, terminate_interrupts
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
 SUBCOMMANDS = (commands, scenario, debug, gui, camera, arm, vision, ai, docs)
@@ -92,26 +95,48 @@ def _quiet_stdout() -> None:
         pass
 
 
+def _ignore_late_signals() -> None:
+    """The ttt-sm process has done its work: a Ctrl-C or SIGTERM while it exits changes nothing.
+
+    Without this, a signal in the last moments (after a command put back the handlers it had, while
+    Python shuts down) killed the process with status -2 or -15 although its work and records were whole.
+    """
+    try:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
+    except ValueError:  # not the main thread: signals are not ours to handle
+        pass
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ttt-sm` console script: run the subcommand, turn every error into one line."""
     command = "?"
+    restore = terminate_interrupts()
     try:
         parser = build_parser()
         args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else argv))
         command = args.command
         status = int(args.func(args))
+        if argv is None:
+            _ignore_late_signals()
         if sys.stdout is not None:
             sys.stdout.flush()  # a closed pipe shows here, not at exit
         return status
     except BrokenPipeError:
         _quiet_stdout()
         return 141  # as if killed by SIGPIPE (128 + 13), what `head` expects of a writer
-    except KeyboardInterrupt:
-        print(f"ttt-sm {command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        name = str(getattr(exc, "signal", "SIGINT"))
+        print(f"ttt-sm {command}: interrupted" + (f" ({name})" if name != "SIGINT" else ""), file=sys.stderr)
+        return 128 + (signal.SIGTERM if name == "SIGTERM" else signal.SIGINT)
     except Exception as exc:
         if os.environ.get("TTT_SM_TRACEBACK"):
             raise
         line, status = error_line(command, exc)
         print(line, file=sys.stderr)
         return status
+    finally:
+        if argv is None:  # the ttt-sm process: it exits now
+            _ignore_late_signals()
+        else:  # called in a program: give it back its handler
+            restore()

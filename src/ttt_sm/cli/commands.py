@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..params import ArmParams
-from .common import CliError, add_command, clear_status, emit, out_dir, progress, status_line
+from .common import CliError, add_command, clear_status, emit, out_dir, print_json, progress, status_line
 
 if TYPE_CHECKING:
     from ..app.game import GameSession
@@ -54,8 +54,12 @@ def cmd_play(args: argparse.Namespace) -> int:
     record = GameRecord.open(out / "game.jsonl")
     session: GameSession | None = None
 
+    finished = False
+
     def stop(signum: int, _frame: object) -> None:
         why = signal.Signals(signum).name
+        if finished:  # the record already says how the game ended: saving it and the report run to their end
+            return
         if session is None:
             raise GameInterrupted(why)  # nothing runs yet: stop setting up at once
         session.interrupt(why)
@@ -87,6 +91,11 @@ def cmd_play(args: argparse.Namespace) -> int:
             record.close()
             raise
         report = _play_game(session)
+        finished = True
+        report.update(session.save())
+        report["opponent"] = opponent if opponent == "terminal" else f"simulated {args.person}"
+        lines = [f"  {k}: {v}" for k, v in report.items() if k not in ("moves", "camera_link")]
+        emit(report, args.json, "play:\n" + "\n".join(lines))
     except GameInterrupted as exc:
         clear_status()
         t = session.robot.t if session is not None else 0.0
@@ -100,11 +109,6 @@ def cmd_play(args: argparse.Namespace) -> int:
         clear_status()
         if session is not None:
             session.close()
-    assert session is not None
-    report.update(session.save())
-    report["opponent"] = opponent if opponent == "terminal" else f"simulated {args.person}"
-    lines = [f"  {k}: {v}" for k, v in report.items() if k not in ("moves", "camera_link")]
-    emit(report, args.json, "play:\n" + "\n".join(lines))
     return 0
 
 
@@ -154,7 +158,10 @@ def cmd_tune(args: argparse.Namespace) -> int:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
+    """The bench: ``--out``/bench.jsonl streamed (a line per section as it ends, then how the run ended);
+    ``--json``: one document at the end, also when interrupted (``"complete": false`` and the ending)."""
     from ..bench import SECTIONS, run_bench
+    from ..runtime.recordfile import RecordFile, ending_of
 
     out = out_dir(args.out)
     params = load_arm(args.params)
@@ -162,14 +169,41 @@ def cmd_bench(args: argparse.Namespace) -> int:
     unknown = [name for name in only or () if name not in SECTIONS]
     if unknown:
         raise CliError(f"--only: unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
+    if args.gui_soak is not None and not args.gui_soak > 0:
+        raise CliError(f"--gui-soak: expected a positive number of minutes, got {args.gui_soak}")
+    names = only or list(SECTIONS)
+    record = RecordFile(out / "bench.jsonl")
+    record.add({"event": "bench", "sections": names, "seed": args.seed, "quick": args.quick,
+                "gui_soak_min": args.gui_soak})
+    done: dict[str, Any] = {}
+    running: list[str] = []
+    finished: list[str] = []
+
+    def on_section(name: str, values: dict[str, Any] | None) -> None:
+        if values is None:
+            running[:] = [name]
+            return
+        running.clear()
+        finished.append(name)
+        done.update(values)
+        record.add({"event": "section", "section": name, "results": values})
+
     try:
-        if args.gui_soak is not None and not args.gui_soak > 0:
-            raise ValueError(f"--gui-soak: expected a positive number of minutes, got {args.gui_soak}")
-        result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
-                           progress=progress(True), gui_soak_min=args.gui_soak or 0.0)
-    except ValueError as exc:
-        raise CliError(str(exc)) from exc
-    emit(result, args.json)
+        try:
+            result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
+                               progress=progress(True), gui_soak_min=args.gui_soak or 0.0, on_section=on_section)
+        except ValueError as exc:
+            raise CliError(str(exc)) from exc
+    except BaseException as exc:  # the record and the --json document say what was measured and where it stopped
+        how, data = ending_of(exc)
+        ended = {"event": how, **data, "section": running[0] if running else None,
+                 "sections_done": finished}
+        record.end(how, **{k: v for k, v in ended.items() if k != "event"})
+        if args.json:
+            print_json({**done, "complete": False, "ended": ended})
+        raise
+    record.end("finished", sections=names)
+    emit({**result, "complete": True}, args.json)
     return 0
 
 

@@ -32,6 +32,46 @@ class CliError(Exception):
     """A user error the CLI reports as one line."""
 
 
+class Interrupted(KeyboardInterrupt):
+    """A signal that stops the command (SIGTERM; Ctrl-C is Python's own KeyboardInterrupt).
+
+    Raised where the program is, as Ctrl-C is, so ``finally`` blocks and
+    ``with`` blocks run and every record being written gets its last line
+    (:class:`~ttt_sm.runtime.recordfile.RecordFile`); ``signal`` names it.
+    """
+
+    def __init__(self, signal_name: str = "SIGINT") -> None:
+        super().__init__(signal_name)
+        self.signal = signal_name
+
+
+def terminate_interrupts() -> Callable[[], None]:
+    """Make SIGTERM raise :class:`Interrupted` (in the main thread); returns what restores the handler.
+
+    Without it SIGTERM ends the process at once, in the middle of whatever it
+    wrote, with no line saying so.  Commands that stop in a gentler way
+    (``ttt-sm play`` at the end of a chart step, ``ttt-sm gui`` through its
+    server) put handlers of their own in place while they run.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def raise_interrupted(_signum: int, _frame: object) -> None:
+        raise Interrupted("SIGTERM")
+
+    try:
+        previous = signal.signal(signal.SIGTERM, raise_interrupted)
+    except ValueError:  # not the main interpreter
+        return lambda: None
+
+    def restore() -> None:
+        signal.signal(signal.SIGTERM, previous)
+    return restore
+
+
 def add_command(sub: Any, name: str, func: Command, help_: str) -> argparse.ArgumentParser:
     """Add subcommand ``name`` running ``func``, with ``--json`` and ``--seed``."""
     sp: argparse.ArgumentParser = sub.add_parser(name, help=help_, description=help_)
@@ -110,6 +150,15 @@ def out_dir(path: str, what: str = "--out") -> Path:
             reason = "a file is there, not a folder"
         raise CliError(f"{what} {path[:200]}: cannot write there ({reason})") from None
     return folder
+
+
+def trace_file(path: str, what: str = "--trace") -> Path:
+    """A file a command streams a record to: not a folder, its folder made and known writable, before the run."""
+    file = Path(path)
+    if file.is_dir():
+        raise CliError(f"{what}: {path[:200]} is a folder; name the file the record is written to")
+    out_dir(str(file.parent), f"{what} {path[:200]}: its folder")
+    return file
 
 
 #: Whether a status line is on show (the next progress line first clears it).

@@ -10,10 +10,14 @@ import argparse
 import math
 import sys
 from collections.abc import Iterator
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..params import shown_path
-from .common import CliError, seed
+from .common import CliError, seed, trace_file
+
+if TYPE_CHECKING:
+    from ..debug.debugger import Debugger
+    from ..debug.shell import DebugShell
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
@@ -35,6 +39,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
     sp.add_argument("--commands", metavar="FILE", default=None,
                     help="run the commands in FILE ('-': standard input) and quit;"
                          " standard input is read the same way when it is not a terminal")
+    sp.add_argument("--trace", metavar="FILE", default=None,
+                    help="stream every transition to FILE as it happens (JSON Lines, flushed line by line;"
+                         " its last line says how the session ended); in memory the newest 5000 are kept")
     return sp
 
 
@@ -77,11 +84,13 @@ def cmd_debug(args: argparse.Namespace) -> int:
     """Build the robot, then run the REPL: scripted (file or pipe) or interactive."""
     from ..debug.debugger import DEFAULT_MAX_RUN_S, Debugger
     from ..debug.shell import DebugShell
+    from ..runtime.recordfile import ending_of
     from ..twin.workspace import load_arm
 
     max_run = DEFAULT_MAX_RUN_S if args.max_run is None else args.max_run
     if not (math.isfinite(max_run) and max_run > 0):
         raise CliError(f"--max-run must be a positive number of seconds, got {args.max_run}")
+    trace_path = trace_file(args.trace) if args.trace else None  # refused now if it cannot be written
     params = load_arm(getattr(args, "params", None))
     try:
         q_start = parse_start(args.start) if args.start else None
@@ -91,10 +100,21 @@ def cmd_debug(args: argparse.Namespace) -> int:
             raise ValueError(f"--settle: {args.settle:g} s is beyond {max_run:g} s of simulated time, the longest"
                              " one command runs (raise it with --max-run)")
         dbg = Debugger.build(params, seed=args.seed, q_start=q_start, settle_s=args.settle, max_run_s=max_run,
-                             game=args.game)
+                             game=args.game, trace_path=trace_path)
     except ValueError as exc:  # a bad pose (SimError), a bad option
         raise CliError(str(exc)) from exc
     shell = DebugShell(dbg)
+    try:
+        status = _run_shell(args, dbg, shell, q_start)
+    except BaseException as exc:  # the trace file says how the session ended, and in which command
+        how, data = ending_of(exc)
+        dbg.end_trace(how, **data, command=shell.command)
+        raise
+    dbg.end_trace("finished", errors=shell.errors)
+    return status
+
+
+def _run_shell(args: argparse.Namespace, dbg: Debugger, shell: DebugShell, q_start: tuple[float, ...] | None) -> int:
     start = "rest pose" if q_start is None else \
         "(" + ", ".join(f"{math.degrees(v):.1f}" for v in q_start) + ") deg"
     shell.say(f"ttt-sm debugger: seed {args.seed}, start {start}"

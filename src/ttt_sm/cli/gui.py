@@ -16,7 +16,7 @@ import webbrowser
 from pathlib import Path
 from typing import Any
 
-from .common import CliError, out_dir, seed
+from .common import CliError, out_dir, seed, trace_file
 
 DEFAULT_PORT = 8765
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
@@ -51,7 +51,8 @@ def register(sub: Any) -> argparse.ArgumentParser:
                          " index (0), a folder of pictures (shown in name order) or the serial smart camera"
                          " (serial:PORT)")
     sp.add_argument("--trace", metavar="FILE", default="out/gui/trace.jsonl",
-                    help="where the trace is saved when the cockpit stops (default out/gui/trace.jsonl)")
+                    help="the trace of transitions, written as they happen (JSON Lines, flushed line by line;"
+                         " the last line says how the cockpit stopped; default out/gui/trace.jsonl)")
     return sp
 
 
@@ -80,11 +81,13 @@ def needs_token(host: str) -> bool:
 
 def cmd_gui(args: argparse.Namespace) -> int:
     """Build the robot and its debugger, start the session and serve the pages until Ctrl-C."""
+    import signal
     import socket
 
     import uvicorn
 
     from ..debug.debugger import Debugger
+    from ..runtime.recordfile import ending_of
     from ..twin.workspace import load_arm
     from ..web.camera_feed import CameraFeedError, open_feed
     from ..web.coverage import scenario_dir_files
@@ -97,9 +100,6 @@ def cmd_gui(args: argparse.Namespace) -> int:
     folder = Path(args.scenarios) if args.scenarios else Path("tests/scenarios")
     if args.scenarios and not folder.is_dir():
         raise CliError(f"--scenarios: {args.scenarios} is not a folder")
-    if Path(args.trace).is_dir():
-        raise CliError(f"--trace: {args.trace} is a folder; name the file the trace is saved to")
-    out_dir(str(Path(args.trace).parent), f"--trace {args.trace}: its folder")  # written when the cockpit stops
     feed = None
     if args.camera is not None:  # before the port is taken: a camera that is not there is refused first
         try:
@@ -107,6 +107,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
         except CameraFeedError as exc:
             raise CliError(str(exc)) from None
     record_root = out_dir(args.out, "--out") if args.game else None
+    trace = trace_file(args.trace)  # refused now if it cannot be written, not when the cockpit stops
     params = load_arm(getattr(args, "params", None))
     token = secrets.token_urlsafe(24) if needs_token(args.host) else None
     try:
@@ -117,32 +118,47 @@ def cmd_gui(args: argparse.Namespace) -> int:
         raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
     port = sock.getsockname()[1]
     print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
-    dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person, record_root=record_root)
-    session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
-                      trace_path=Path(args.trace), camera_feed=feed)
-    shown = f"[{args.host}]" if ":" in args.host else args.host
-    hosts = [f"{h}:{port}" for h in ("127.0.0.1", "localhost", "[::1]", shown)]
-    app = create_app(session, token=token, hosts=hosts)
-    url = f"http://{shown}:{port}/charts" + (f"?token={token}" if token else "")
-    print(f"ttt-sm gui: the chart cockpit is at {url}", flush=True)
-    if args.game and args.person == "page":
-        print(f"ttt-sm gui: play at {url.replace('/charts', '/game', 1)}", flush=True)
-    if record_root is not None:
-        print(f"ttt-sm gui: each game's record goes to {record_root}/game-N/game.jsonl", flush=True)
-    if feed is not None:
-        print(f"ttt-sm gui: the {feed.kind} camera {feed.name} is shown in the /game page", flush=True)
-    if token:
-        print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
-              flush=True)
-    print("ttt-sm gui: Ctrl-C stops it (the trace is saved to " + args.trace + ")", flush=True)
-    if args.open:  # the game's page when you play there, else the chart cockpit
-        shown_url = url.replace("/charts", "/game", 1) if args.game and args.person == "page" else url
-        threading.Timer(1.0, webbrowser.open, args=(shown_url,)).start()
-    config = uvicorn.Config(app, log_level="warning", ws_max_size=1 << 20, lifespan="on")
-    server = uvicorn.Server(config)
+    dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person, trace_path=trace,
+                         record_root=record_root)
     try:
-        server.run(sockets=[sock])
-    except KeyboardInterrupt:
-        pass  # uvicorn shut down (the session stopped, the trace saved), then passed the Ctrl-C on
+        session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
+                          camera_feed=feed)
+        shown = f"[{args.host}]" if ":" in args.host else args.host
+        hosts = [f"{h}:{port}" for h in ("127.0.0.1", "localhost", "[::1]", shown)]
+        app = create_app(session, token=token, hosts=hosts)
+        url = f"http://{shown}:{port}/charts" + (f"?token={token}" if token else "")
+        print(f"ttt-sm gui: the chart cockpit is at {url}", flush=True)
+        if args.game and args.person == "page":
+            print(f"ttt-sm gui: play at {url.replace('/charts', '/game', 1)}", flush=True)
+        if record_root is not None:
+            print(f"ttt-sm gui: each game's record goes to {record_root}/game-N/game.jsonl", flush=True)
+        if feed is not None:
+            print(f"ttt-sm gui: the {feed.kind} camera {feed.name} is shown in the /game page", flush=True)
+        if token:
+            print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
+                  flush=True)
+        print("ttt-sm gui: Ctrl-C stops it (the trace is written to " + args.trace + " as it happens)", flush=True)
+        if args.open:  # the game's page when you play there, else the chart cockpit
+            shown_url = url.replace("/charts", "/game", 1) if args.game and args.person == "page" else url
+            threading.Timer(1.0, webbrowser.open, args=(shown_url,)).start()
+        config = uvicorn.Config(app, log_level="warning", ws_max_size=1 << 20, lifespan="on")
+        server = uvicorn.Server(config)
+        handle_exit = server.handle_exit
+
+        def stop_on(sig: int, frame: Any) -> None:  # the trace's last line names the signal that stopped it
+            if session.ending is None:
+                session.ending = ("interrupted", {"signal": signal.Signals(sig).name})
+            handle_exit(sig, frame)
+
+        server.handle_exit = stop_on  # type: ignore[method-assign]  # uvicorn installs it for SIGINT, SIGTERM
+        try:
+            server.run(sockets=[sock])
+        except KeyboardInterrupt:
+            pass  # uvicorn shut down (the session stopped, the trace saved), then passed the Ctrl-C on
+    except BaseException as exc:  # before the server ran, or it broke: the trace's last line says so
+        how, data = ending_of(exc)
+        dbg.end_trace(how, **data)  # nothing if the session ended it already
+        raise
+    dbg.end_trace("finished")  # nothing if the session ended it already
     print("ttt-sm gui: stopped", flush=True)
     return 0

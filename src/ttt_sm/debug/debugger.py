@@ -26,6 +26,12 @@ stops at the robot's turn.
 Besides the trace it keeps a :class:`~.timeline.Timeline` (when each state
 was entered and left) and the charts' data as they were just before the last
 chart tick, for :meth:`Debugger.data_diff`.
+
+Bounded in memory: the trace keeps the newest :data:`TRACE_KEEP` transitions
+(a ring buffer); given a ``trace_path``, the whole trace is streamed to that
+file as it happens, each line flushed (:class:`~ttt_sm.runtime.recordfile.RecordFile`:
+a head line, the transitions, a mark at each replay, and an ending that
+says how the session ended, written by :meth:`Debugger.end_trace`).
 """
 
 from __future__ import annotations
@@ -47,6 +53,7 @@ from ..runtime import Data, TickChart, UnknownEventError
 from ..runtime.errors import GraphvizMissingError
 from ..runtime.export import render_active
 from ..runtime.listeners import Trace
+from ..runtime.recordfile import RecordFile
 from .breakpoints import BreakListener, Breakpoint, ChartIndex, Hit, parse_breakpoint
 from .errors import DebugError
 from .names import RobotNames, datum_decl, parse_input_value
@@ -63,6 +70,8 @@ PROGRESS_EVERY_S = 5.0
 #: it every other old one is dropped, so a session that runs for hours (a GUI calls the
 #: debugger 30 times a second) holds them spread over its whole run in bounded memory.
 MAX_FINGERPRINTS = 512
+#: Transitions the trace keeps in memory (the newest); the trace file, if any, gets them all.
+TRACE_KEEP = 5000
 
 
 class Debugger:
@@ -79,10 +88,17 @@ class Debugger:
     max_run_s : float
         The longest one command may run, seconds of simulated time
         (:data:`DEFAULT_MAX_RUN_S`); longer is refused before a step is taken.
+    trace_path : path, optional
+        Stream the whole trace to this file as it happens (JSON Lines, each
+        line flushed); opened now, so an ``OSError`` says it cannot be written
+        before anything runs.  :meth:`end_trace` writes its last line.
+    trace_keep : int
+        Transitions kept in memory (:data:`TRACE_KEEP`), the newest.
     """
 
     def __init__(self, robot: Robot, recipe: Recipe | None = None, *,
-                 max_run_s: float = DEFAULT_MAX_RUN_S) -> None:
+                 max_run_s: float = DEFAULT_MAX_RUN_S, trace_path: str | Path | None = None,
+                 trace_keep: int = TRACE_KEEP) -> None:
         if recipe is None and robot.steps == 0:
             recipe = RobotRecipe.of(robot)
         if not (isinstance(max_run_s, (int, float)) and math.isfinite(max_run_s) and max_run_s > 0):
@@ -102,30 +118,38 @@ class Debugger:
         self._fingerprints: dict[int, dict[str, Any]] = {}
         self._names = RobotNames(lambda: self.robot)
         self._listeners: list[object] = []
+        self.trace_keep = trace_keep
+        #: The file the whole trace streams to (None: the kept transitions only).
+        self.trace_file: RecordFile | None = None
+        if trace_path is not None:
+            self.trace_file = RecordFile(trace_path)
+            self.trace_file.add(self._trace_head(robot))
         self._attach(robot)
         self._remember()
 
     @classmethod
     def build(cls, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
               settle_s: float = 0.0, *, game: bool = False, person: str = "simulated",
-              max_run_s: float = DEFAULT_MAX_RUN_S, record_root: Path | None = None) -> Debugger:
+              max_run_s: float = DEFAULT_MAX_RUN_S, trace_path: str | Path | None = None,
+              record_root: Path | None = None) -> Debugger:
         """A debugger on a new robot, with its recipe for :meth:`replay`.
 
         ``game``: the robot plays a game (:class:`~.replay.GameRecipe`: the Game
         and AlgorithmActivator charts, a simulated person, the camera read
         in-process, the strong engine; the robot draws O).  ``person``: who plays
         against it, ``"simulated"`` or ``"page"`` (a person at the ``/game`` page).
+        ``trace_path``: stream the whole trace there (see the class).
         ``record_root``: with ``game``, the game's record is written to
         ``record_root/game-1/game.jsonl`` as it is played.
         """
         pose = None if q_start is None else tuple(float(v) for v in q_start)
         recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person, record_root=record_root) \
             if game else RobotRecipe(params, seed, pose, settle_s)
-        return cls(recipe.build(), recipe, max_run_s=max_run_s)
+        return cls(recipe.build(), recipe, max_run_s=max_run_s, trace_path=trace_path)
 
     def _attach(self, robot: Robot) -> None:
         self.robot = robot
-        self.trace = Trace()
+        self.trace = Trace(sink=self.trace_file, limit=self.trace_keep)
         self.state_history = Timeline()
         for chart in robot.charts.values():
             chart.add_listener(self.trace, self.listener, *self._listeners)
@@ -303,7 +327,8 @@ class Debugger:
         divider = self._divider
         listener.hits.clear()
         self._pause.clear()
-        first = len(self.trace.records)
+        trace = self.trace
+        first = trace.count
         ticks_done = 0
         kind: StopKind = end
         when = [bp for bp in self.breakpoints if bp.enabled and bp.kind == "when"]
@@ -316,7 +341,7 @@ class Debugger:
                 ticking = robot.steps % divider == 0
                 pending = [[e for e, _ in c.pending_events] for c in charts] \
                     if ticking and watch_events else None
-                mark = len(self.trace.records)
+                mark = trace.count
                 if ticking:
                     self._keep_before_tick()
                 robot.control_step()
@@ -334,7 +359,7 @@ class Debugger:
                 if ticking and game_error():
                     kind = "game"
                     break
-                if until_transition and len(self.trace.records) > mark:
+                if until_transition and trace.count > mark:
                     kind = "transition"
                     break
                 if ticks is not None and ticks_done >= ticks:
@@ -348,7 +373,7 @@ class Debugger:
         self._remember()
         detail = str(_game_error(robot)) if kind == "game" else ""
         return StopReason(kind, robot.t, robot.steps, robot.chart_ticks, tuple(listener.hits),
-                          tuple(self.trace.records[first:]), detail)
+                          tuple(trace.since(first)), detail)
 
     def _game_error_now(self) -> bool:
         """The game's flow stopped with an error in the chart step just run (reported once)."""
@@ -447,6 +472,8 @@ class Debugger:
         self.forced = {}
         self._fingerprints = {}
         self._attach(recipe.build())
+        if self.trace_file is not None:  # the trace goes on: the transitions after this mark are the new run's
+            self.trace_file.add({"event": "start_over", **self.where_now()})
         self._furthest_steps = self.robot.steps
         self._remember()
         for bp in self.breakpoints:
@@ -488,11 +515,38 @@ class Debugger:
     # -- trace, diagrams ---------------------------------------------------------
 
     def save_trace(self, path: str | Path) -> Path:
-        """Write every transition of the session so far as JSON Lines."""
+        """Write the transitions the trace keeps (the newest :attr:`trace_keep`) as JSON Lines.
+
+        All of them since power-on (or the last replay) while no more have
+        happened; :attr:`trace.dropped <ttt_sm.runtime.listeners.Trace.dropped>`
+        says how many older ones were let go (the trace file has them).
+        """
         try:
             return self.trace.write_jsonl(path)
-        except OSError as exc:
-            raise DebugError(f"trace save: cannot write {str(path)!r}: {exc.strerror or exc}") from None
+        except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+            raise DebugError(f"trace save: cannot write {str(path)!r}: {getattr(exc, 'strerror', None) or exc}"
+                             ) from None
+
+    def _trace_head(self, robot: Robot) -> dict[str, Any]:
+        recipe = self.recipe
+        return {"event": "trace", "charts": list(robot.charts),
+                "seed": getattr(recipe, "seed", None), "q_start": getattr(recipe, "q_start", None),
+                "settle_s": getattr(recipe, "settle_s", None), "game": isinstance(recipe, GameRecipe),
+                "dt_s": robot.params.control.dt, "chart_divider": robot.params.control.chart_divider,
+                "kept_in_memory": self.trace_keep}
+
+    def where_now(self) -> dict[str, Any]:
+        """Where the session stands: chart tick, control steps, simulated time (for a record's lines)."""
+        robot = self.robot
+        return {"tick": robot.chart_ticks, "steps": robot.steps, "t": round(robot.t, 6)}
+
+    def end_trace(self, how: str = "finished", **data: Any) -> Path | None:
+        """End the trace file (if any) with ``how`` (``finished``, ``interrupted``, ``error``) and where
+        the session stood; its path.  Only the first call writes."""
+        if self.trace_file is None:
+            return None
+        self.trace_file.end(how, **data, **self.where_now(), transitions=self.trace.count)
+        return self.trace_file.path
 
     def diagram(self, chart: str, path: str | Path | None = None) -> Path:
         """Write the chart's diagram with its active states highlighted.
@@ -587,6 +641,7 @@ class Debugger:
         robot = self.robot
         queue = deque(kept)
         self.listener.muted = True
+        self.trace.sink = None  # the trace file has these transitions already: a mark stands for them
         try:
             while True:
                 while queue and queue[0].steps == robot.steps:
@@ -598,6 +653,9 @@ class Debugger:
                 robot.control_step()
         finally:
             self.listener.muted = False
+            self.trace.sink = self.trace_file
+            if self.trace_file is not None:
+                self.trace_file.add({"event": "replay", **self.where_now(), "actions": len(kept)})
         self._game_stopped = _game_error(robot) is not None
         self.actions = kept
         now = self.fingerprint()

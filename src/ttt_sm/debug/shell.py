@@ -69,6 +69,8 @@ class DebugShell(cmd.Cmd):
         self.errors = 0
         self.scripted = False
         self._progress_shown = False
+        #: The command running now (None between commands): where an interrupted session stood.
+        self.command: str | None = None
 
     # -- plumbing -----------------------------------------------------------------
 
@@ -88,13 +90,16 @@ class DebugShell(cmd.Cmd):
         line = line.split("#", 1)[0].strip()
         if not line:
             return self.emptyline() if not self.scripted else False
+        self.command = line  # still set if a signal ends the session in it
+        done = False
         try:
-            return bool(super().onecmd(line))
+            done = bool(super().onecmd(line))
         except USER_ERRORS as exc:
             self.error(str(exc))
         except Exception as exc:  # a bug in a chart action: say it, keep the session
             self.error(f"{type(exc).__name__}: {exc}")
-        return False
+        self.command = None
+        return done
 
     def emptyline(self) -> bool:
         if self.lastcmd.split(" ", 1)[0] in _REPEATABLE:
@@ -284,13 +289,17 @@ class DebugShell(cmd.Cmd):
                              else f"show what? one of: {', '.join(_SHOW)}")
 
     def do_trace(self, arg: str) -> None:
-        """trace [N]: the last N transitions (default 10); trace save FILE: all, as JSON Lines."""
+        """trace [N]: the last N transitions (default 10); trace save FILE: all kept, as JSON Lines."""
         words = arg.split()
         if words and words[0] == "save":
             if len(words) != 2:
                 raise DebugError("trace save: expected one file name, e.g. trace save out/trace.jsonl")
             path = self.dbg.save_trace(words[1])
-            self.say(f"{len(self.dbg.trace.records)} transitions written to {path}")
+            trace = self.dbg.trace
+            older = f" (the newest; {trace.dropped} older ones are not kept in memory" + (
+                f", the trace file {self.dbg.trace_file.path} has them all)" if self.dbg.trace_file is not None
+                else ": start the debugger with --trace FILE to keep them all)") if trace.dropped else ""
+            self.say(f"{len(trace.records)} transitions written to {path}{older}")
             return
         self.say(*views.trace_lines(self.dbg.trace.records, _count(arg, "trace", 10)))
 

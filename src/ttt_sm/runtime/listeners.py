@@ -11,10 +11,11 @@ every state of the library's own instance diagrams.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable
+from collections import deque
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, overload
 
 from statemachine import StateChart
 from statemachine.transition import Transition
@@ -59,22 +60,84 @@ class TraceRecord:
         return cls(**json.loads(line))
 
 
+class KeptRecords(Sequence[TraceRecord]):
+    """The newest ``limit`` records of a trace, oldest first: a ring buffer a list compares equal to."""
+
+    def __init__(self, limit: int) -> None:
+        if limit < 1:
+            raise ValueError(f"a trace keeps at least one record, not {limit}")
+        self._items: deque[TraceRecord] = deque(maxlen=limit)
+
+    @property
+    def limit(self) -> int:
+        assert self._items.maxlen is not None
+        return self._items.maxlen
+
+    def append(self, record: TraceRecord) -> None:
+        self._items.append(record)
+
+    def clear(self) -> None:
+        self._items.clear()
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __iter__(self) -> Iterator[TraceRecord]:
+        return iter(self._items)
+
+    @overload
+    def __getitem__(self, index: int) -> TraceRecord: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> list[TraceRecord]: ...
+
+    def __getitem__(self, index: int | slice) -> TraceRecord | list[TraceRecord]:
+        if isinstance(index, slice):
+            return list(self._items)[index]
+        return self._items[index]
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, (list, tuple, KeptRecords)):
+            return list(self._items) == list(other)
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+
 class Trace:
     """Records every transition of the charts it observes; writes JSON Lines.
 
     Parameters
     ----------
     sink : text stream, optional
-        If given, each record is also written to it as one JSON line when it happens,
-        so a long run keeps a trace without holding it in memory (``keep=False``).
+        If given, each record is also written to it as one JSON line when it
+        happens, and flushed, so a long run keeps its whole trace on disk
+        (a :class:`~.recordfile.RecordFile`) without holding it in memory.
     keep : bool
         Keep the records in :attr:`records`.
+    limit : int, optional
+        Keep only the newest ``limit`` records (a ring buffer); :attr:`count`
+        still counts them all.  None: keep every record.
     """
 
-    def __init__(self, sink: IO[str] | None = None, keep: bool = True) -> None:
-        self.records: list[TraceRecord] = []
+    def __init__(self, sink: IO[str] | Any | None = None, keep: bool = True, limit: int | None = None) -> None:
+        self.records: list[TraceRecord] | KeptRecords = [] if limit is None else KeptRecords(limit)
         self.sink = sink
         self.keep = keep
+        #: Every record this trace has seen, kept or not.
+        self.count = 0
+
+    @property
+    def dropped(self) -> int:
+        """Records seen but no longer kept (the ring buffer's oldest)."""
+        return self.count - len(self.records) if self.keep else self.count
+
+    def since(self, count: int) -> list[TraceRecord]:
+        """The records seen after the first ``count`` ones (as :attr:`count` was), those still kept."""
+        new = self.count - count
+        if new <= 0 or not self.keep:
+            return []
+        return list(self.records[-new:]) if new < len(self.records) else list(self.records)
 
     def observe(self, *charts: StateChart) -> Trace:
         """Attach to charts already built."""
@@ -98,10 +161,12 @@ class Trace:
             data=jsonable(snapshot()) if callable(snapshot) else {},
             event_args=jsonable(dict(kwargs)),
         )
+        self.count += 1
         if self.keep:
             self.records.append(record)
         if self.sink is not None:
             self.sink.write(record.to_json() + "\n")
+            self.sink.flush()
 
     def write_jsonl(self, path: str | Path) -> Path:
         """Write the kept records to ``path``, one JSON object per line."""
@@ -114,9 +179,14 @@ class Trace:
 
     @staticmethod
     def read_jsonl(path: str | Path) -> list[TraceRecord]:
-        """Read records written by :meth:`write_jsonl` or a ``sink``."""
+        """Read records written by :meth:`write_jsonl` or a ``sink``.
+
+        Lines with an ``event`` (the record's head, a replay mark, its ending:
+        :mod:`.recordfile`) are not transitions and are passed over.
+        """
         with Path(path).open(encoding="utf-8") as f:
-            return [TraceRecord.from_json(line) for line in f if line.strip()]
+            rows = [json.loads(line) for line in f if line.strip()]
+        return [TraceRecord(**row) for row in rows if "event" not in row]
 
 
 @dataclass(frozen=True)

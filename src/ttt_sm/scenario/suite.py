@@ -1,4 +1,10 @@
-"""Several scenarios run together: one report, with their joint coverage of the charts."""
+"""Several scenarios run together: one report, with their joint coverage of the charts.
+
+The report and the traces can be written as the run goes
+(:class:`~ttt_sm.runtime.recordfile.RecordFile`: each line flushed, the last
+one saying how the run ended), so a run that is interrupted keeps what it did:
+``ttt-sm scenario run --out FILE --trace DIR`` (docs/scenarios.md).
+"""
 
 from __future__ import annotations
 
@@ -10,6 +16,7 @@ from typing import Any
 
 from ..params import ArmParams
 from ..runtime.listeners import Coverage, CoverageReport, Trace
+from ..runtime.recordfile import RecordFile, ending_of
 from .model import Scenario
 from .runner import ScenarioResult, StepProgress, run_scenario
 
@@ -60,25 +67,52 @@ def coverage_dict(report: CoverageReport) -> dict[str, Any]:
 def run_scenarios(scenarios: Iterable[Scenario], params: ArmParams, *, coverage: bool = False,
                   trace_dir: str | Path | None = None,
                   progress: Callable[[ScenarioResult], None] | None = None,
-                  step_progress: StepProgress | None = None) -> RunReport:
+                  step_progress: StepProgress | None = None,
+                  report_file: RecordFile | None = None) -> RunReport:
     """Run scenarios one after another; with ``coverage``, one report for them all.
 
     ``trace_dir`` writes each scenario's transitions as JSON Lines,
-    ``<file stem>.jsonl``, to see what the charts did.  ``progress`` hears of
-    each finished scenario, ``step_progress`` of a long step on its way
-    (see :func:`~.runner.run_scenario`).
+    ``<file stem>.jsonl``, as they happen, then an ending line naming the
+    scenario.  ``report_file`` gets a line per
+    scenario as it finishes, then the coverage and the counts; both end with
+    ``interrupted`` or ``error`` (and where: the scenario, its transitions so
+    far, the chart time of the last) if the run is stopped.  ``progress``
+    hears of each finished scenario, ``step_progress`` of a long step on its
+    way (see :func:`~.runner.run_scenario`).
     """
     wall0 = time.perf_counter()
     cov = Coverage() if coverage else None
-    results = []
+    results: list[ScenarioResult] = []
     for scenario in scenarios:
-        trace = Trace() if trace_dir is not None else None
-        result = run_scenario(scenario, params, coverage=cov, listeners=[trace] if trace else [],
-                              progress=step_progress)
-        if trace is not None and trace_dir is not None:
-            trace.write_jsonl(Path(trace_dir) / f"{Path(scenario.file).stem}.jsonl")
+        trace_file = None
+        if trace_dir is not None:
+            trace_file = RecordFile(Path(trace_dir) / f"{Path(scenario.file).stem}.jsonl")
+        trace = Trace(sink=trace_file, limit=1)  # the last transition: where a stopped run stood
+        try:
+            result = run_scenario(scenario, params, coverage=cov, listeners=[trace], progress=step_progress)
+        except BaseException as exc:
+            how, data = ending_of(exc)
+            last = trace.records[-1] if trace.records else None
+            where = {"scenario": scenario.name, "file": scenario.file, "transitions": trace.count,
+                     "last_transition_time_s": None if last is None else last.time_s}
+            if trace_file is not None:
+                trace_file.end(how, **data, **where)
+            if report_file is not None:
+                report_file.end(how, **data, **where, scenarios_done=len(results))
+            raise
+        if trace_file is not None:
+            trace_file.end("finished", scenario=scenario.name, passed=result.passed, transitions=trace.count,
+                           sim_time_s=result.sim_time_s)
         results.append(result)
+        if report_file is not None:
+            report_file.add({"event": "scenario", **result.to_dict()})
         if progress is not None:
             progress(result)
-    return RunReport(tuple(results), cov.report() if cov is not None else None,
-                     time.perf_counter() - wall0)
+    run = RunReport(tuple(results), cov.report() if cov is not None else None, time.perf_counter() - wall0)
+    if report_file is not None:
+        summary = run.to_dict()
+        if "coverage" in summary:
+            report_file.add({"event": "coverage", "coverage": summary["coverage"]})
+        report_file.end("finished", passed=summary["passed"], counts=summary["counts"],
+                        sim_time_s=summary["sim_time_s"], wall_time_s=summary["wall_time_s"])
+    return run

@@ -174,8 +174,12 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         return Response(svg, media_type="image/svg+xml", headers={"Cache-Control": "no-store"})
 
     async def trace(request: Request) -> Response:
-        records = list(session.debugger.trace.records)
-        body = "".join(r.to_json() + "\n" for r in records)
+        streamed = session.debugger.trace_file
+        if streamed is not None and not streamed.closed:  # the whole trace, as written so far
+            body = await asyncio.to_thread(streamed.path.read_text, encoding="utf-8")
+        else:  # the transitions kept in memory
+            records = list(session.debugger.trace.records)
+            body = "".join(r.to_json() + "\n" for r in records)
         return Response(body, media_type="application/x-ndjson",
                         headers={"Content-Disposition": 'attachment; filename="trace.jsonl"'})
 
@@ -247,7 +251,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
             if manage_session:
                 saved = await asyncio.to_thread(session.stop)
                 if saved is not None:
-                    print(f"ttt-sm gui: trace saved to {saved} ({len(session.debugger.trace.records)}"
+                    print(f"ttt-sm gui: trace saved to {saved} ({session.debugger.trace.count}"
                           " transitions)", flush=True)
 
     routes = [

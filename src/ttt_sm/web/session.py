@@ -22,9 +22,12 @@ taken since the previous frame (at most :data:`MAX_FRAME_TRANSITIONS`, with the
 number left out), breakpoints, the last stop, pacing and latency figures.
 A page that joins gets one ``full`` frame, then the same frames as everyone.
 
-Bounded in memory: the debugger keeps a bounded number of fingerprints, the
-session a bounded number of pending transitions and latency samples; the
-trace is the debugger's (``trace save``; :meth:`Session.stop` writes it).
+Bounded in memory: the debugger keeps a bounded number of fingerprints and
+the newest transitions of its trace (a ring buffer), the session a bounded
+number of pending transitions, frame stamps and latency samples.  The whole
+trace is the debugger's trace file when it streams one (``ttt-sm gui
+--trace``: written as it happens, ended by :meth:`Session.stop` with how the
+cockpit stopped), else :meth:`Session.stop` saves the kept transitions.
 """
 
 from __future__ import annotations
@@ -72,6 +75,9 @@ TRACE_ON_JOIN = 200
 RUN_CHUNK_S = 60.0
 #: Latency samples kept for the p95 figure.
 LATENCY_SAMPLES = 2000
+#: The user's actions (inputs set, events posted) a frame lists, the newest: the page shows the last few,
+#: and a session that runs for hours must not send (and describe) every one in every frame.
+ACTIONS_SHOWN = 50
 
 Send = Callable[[str], None]
 
@@ -129,7 +135,8 @@ class Session:
     scenarios : mapping of name to Path
         Scenario files the pages may run for coverage.
     trace_path : Path, optional
-        Where :meth:`stop` writes the trace (JSON Lines).
+        Where :meth:`stop` writes the trace (JSON Lines) when the debugger
+        does not stream it to a file of its own.
     camera_feed : CameraFeed, optional
         A camera outside the simulation (``ttt-sm gui --camera``), started and
         stopped with the session; the frames carry what it shows.
@@ -183,6 +190,9 @@ class Session:
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ttt-sm-coverage")
         self._thread: threading.Thread | None = None
         self.error: str | None = None
+        #: How the session ends, for the trace file's last line: ``("interrupted", {"signal": "SIGTERM"})``
+        #: when a signal stops the server (``ttt-sm gui`` sets it), else finished (or the error).
+        self.ending: tuple[str, dict[str, Any]] | None = None
         debugger.add_listener(_TransitionTap(self))
         self._install_clock()
 
@@ -230,7 +240,7 @@ class Session:
         self._thread.start()
 
     def stop(self, timeout_s: float = 30.0) -> Path | None:
-        """Stop the simulation thread at the next control step and save the trace; its path."""
+        """Stop the simulation thread at the next control step and end (or save) the trace; its path."""
         self._stopping = True
         self.debugger.pause()
         self._queue.put(None)
@@ -243,6 +253,9 @@ class Session:
             game.close()  # its record ends (as interrupted, unless the game ended)
         if self.camera_feed is not None:
             self.camera_feed.stop()
+        if self.debugger.trace_file is not None:
+            how, data = self.ending or (("error", {"message": self.error}) if self.error else ("finished", {}))
+            return self.debugger.end_trace(how, **data, clients=self.clients)
         if self.trace_path is not None:
             return self.debugger.save_trace(self.trace_path)
         return None
@@ -587,7 +600,7 @@ class Session:
             "taken": {name: dict(c) for name, c in self._taken.items()},
             "breakpoints": [{"id": bp.id, "spec": bp.spec, "enabled": bp.enabled, "hits": bp.hits,
                              "text": bp.describe()} for bp in dbg.breakpoints],
-            "actions": [a.describe() for a in dbg.actions],
+            "actions": [a.describe() for a in dbg.actions[-ACTIONS_SHOWN:]],
             "forced": [f"{c}.{n}" for c, n in dbg.forced],
             "stop": self._stop,
             "game": game_view(dbg),
@@ -623,7 +636,7 @@ class Session:
             frame["trace"] = [{"tick": r.tick, "time_s": r.time_s, "chart": r.chart, "source": r.source,
                                "target": r.target, "trigger": r.trigger}
                               for r in dbg.trace.records[-TRACE_ON_JOIN:]]
-            frame["trace_total"] = len(dbg.trace.records)
+            frame["trace_total"] = dbg.trace.count
             return frame
         sent = self._sent
         for key in ("data",):

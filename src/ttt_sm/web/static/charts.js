@@ -4,7 +4,8 @@
 // every value) is the session's (ttt_sm.web.session); this page keeps what it was
 // last told and draws it.  The diagrams are the server's Graphviz SVG, loaded once
 // per picture; a frame only toggles attributes on them (data-active,
-// data-taken-count, a "flash" class), it never redraws a diagram.
+// data-taken-count, a "flash" class on each transition taken, removed when its
+// animation ends), it never redraws a diagram.
 
 import { SessionLink } from "./session.js";
 
@@ -263,6 +264,9 @@ async function loadDiagram() {
     el.addEventListener("click", onDiagramClick);
     el.addEventListener("contextmenu", onDiagramClick);
     el.addEventListener("keydown", (e) => { if (e.key === "Enter" || e.key === " ") onDiagramClick(e); });
+  }
+  for (const el of $$("[data-transition]", box)) {  // a flash is cleared when its animation has run
+    el.addEventListener("animationend", () => el.classList.remove("flash"));
   }
   for (const el of $$("[data-subchart]", box)) {
     el.addEventListener("dblclick", (e) => {

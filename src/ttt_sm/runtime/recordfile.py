@@ -1,0 +1,121 @@
+"""A record written as it happens: JSON Lines, each line flushed, ended by a line that says how the run ended.
+
+Every record ``ttt_sm`` writes while something runs (the debugger's and the
+cockpit's trace, a scenario run's report and traces, the bench's results)
+goes through :class:`RecordFile`:
+
+- the file is opened before the run starts, so a folder that cannot take it
+  is an ``OSError`` then, not after the work;
+- each line is one JSON object (strict JSON, :mod:`.jsonable`), written and
+  flushed when it happens, so whatever ends the process next (Ctrl-C,
+  SIGTERM, a bug, the power) leaves every line written before it whole;
+- the last line is an *ending*: ``{"event": "finished"}``, ``{"event":
+  "interrupted", "signal": "SIGTERM", ...}`` or ``{"event": "error",
+  "message": ...}``, with where the run stood (docs/reliability.md, "Records
+  that survive").  A record whose last line is not an ending was cut short
+  by something no program can answer (``kill -9``, the power): every line it
+  has still parses.
+
+:func:`read_lines` reads any such record back, and names the line that does
+not parse, if one does not.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import IO, Any
+
+from .jsonable import dumps
+
+#: The events that end a record.
+ENDINGS = ("finished", "interrupted", "error")
+
+
+class RecordFile:
+    """A JSON Lines file written line by line, each line flushed; :meth:`end` writes its last line.
+
+    Also a text sink (``write(text)``, ``flush()``) for a
+    :class:`~.listeners.Trace`, which writes its records to it as they happen.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._file: IO[str] | None = self.path.open("w", encoding="utf-8")
+        self.lines = 0
+        #: The ending written (``"finished"``, ``"interrupted"``, ``"error"``), once :meth:`end` ran.
+        self.ended: str | None = None
+
+    @property
+    def closed(self) -> bool:
+        return self._file is None
+
+    def add(self, line: Mapping[str, Any]) -> None:
+        """Append one JSON object as a line, and flush it (nothing once the record is closed)."""
+        self.write(dumps(line) + "\n")
+
+    def write(self, text: str) -> None:
+        """Append text made of whole JSON lines, and flush it (a :class:`~.listeners.Trace` sink)."""
+        if self._file is None:
+            return
+        self._file.write(text)
+        self._file.flush()
+        self.lines += text.count("\n")
+
+    def flush(self) -> None:
+        if self._file is not None:
+            self._file.flush()
+
+    def end(self, how: str, **data: Any) -> None:
+        """Write the ending line ``{"event": how, ...data}`` and close the file; only the first call writes."""
+        if how not in ENDINGS:
+            raise ValueError(f"a record ends with one of {', '.join(ENDINGS)}, not {how!r}")
+        if self._file is None or self.ended is not None:
+            return
+        self.add({"event": how, **data})
+        self.ended = how
+        self.close()
+
+    def close(self) -> None:
+        """Close the file (without an ending: :meth:`end` writes one)."""
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+    def __enter__(self) -> RecordFile:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, _tb: Any) -> None:
+        """Leaving a ``with`` block ends the record: ``finished``, else how the run was stopped."""
+        if exc is None:
+            self.end("finished")
+        else:
+            how, data = ending_of(exc)
+            self.end(how, **data)
+
+
+def ending_of(exc: BaseException) -> tuple[str, dict[str, Any]]:
+    """How an exception ends a record: ``("interrupted", {"signal": ...})`` or ``("error", {"message": ...})``.
+
+    A :class:`KeyboardInterrupt` is an interruption; its ``signal``
+    attribute (``"SIGTERM"``, set by the command line's handler) names the
+    signal, else it was Ctrl-C (``"SIGINT"``).
+    """
+    if isinstance(exc, KeyboardInterrupt):
+        return "interrupted", {"signal": str(getattr(exc, "signal", "SIGINT"))}
+    text = " ".join(str(exc).split())[:300]
+    return "error", {"message": f"{type(exc).__name__}: {text}" if text else type(exc).__name__}
+
+
+def read_lines(path: str | Path) -> list[dict[str, Any]]:
+    """Every line of a record, parsed; a line that does not parse raises ValueError naming it."""
+    lines = []
+    with Path(path).open(encoding="utf-8") as f:
+        for n, line in enumerate(f, 1):
+            try:
+                lines.append(json.loads(line))
+            except json.JSONDecodeError as exc:
+                raise ValueError(f"{path}:{n}: not a JSON line ({exc.msg})") from None
+    return lines

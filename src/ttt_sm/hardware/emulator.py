@@ -27,17 +27,15 @@ from __future__ import annotations
 import logging
 import os
 import select
-import shutil
-import tempfile
 import threading
 import time
-import tty
 from pathlib import Path
 from typing import Literal
 
 import numpy as np
 
 from ..params import ArmParams
+from ..ptylink import PtyLink, PtyLinkError
 from ..twin import _cascade as C
 from ..twin import _plant as PL
 from ..twin.plant import REST_POSE, Plant, check_pose
@@ -115,21 +113,12 @@ class ArmEmulator:
         self.firmware = self.bench.firmware
         #: The physics (simulation only): ground truth for tests.
         self.plant = self.bench.plant
-        self._own_dir: Path | None = None
-        if link is None:
-            self._own_dir = Path(tempfile.mkdtemp(prefix="ttt-arm-"))
-            link = self._own_dir / "arm"
-        self._link = Path(link)
-        if not self._link.parent.is_dir():
-            raise ArmEmulatorError(f"the folder of the link {self._link} does not exist; create it or choose"
-                                   " another --link")
-        if self._link.exists() and not self._link.is_symlink():
-            raise ArmEmulatorError(f"{self._link} exists and is not a symlink; the emulator only replaces its own"
-                                   " link: choose another --link")
+        try:
+            self._pty = PtyLink(link, "arm")
+        except PtyLinkError as exc:
+            raise ArmEmulatorError(str(exc)) from None
         self._log = logger or _LOG
         self._lock = threading.RLock()
-        self._master: int | None = None
-        self._slave: int | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._out = bytearray()
@@ -142,25 +131,18 @@ class ArmEmulator:
     @property
     def port(self) -> str:
         """The stable path the PC opens (a symlink to the pty)."""
-        return str(self._link)
+        return self._pty.port
 
     def start(self) -> ArmEmulator:
         """Make the pty and its link, and run the firmware in a background thread."""
         if self._thread is not None:
             return self
-        master, slave = os.openpty()
-        tty.setraw(slave)  # bytes pass as on a UART: no echo, no line discipline
-        os.set_blocking(master, False)
-        self._master, self._slave = master, slave
-        tmp = self._link.with_name(f".{self._link.name}.{os.getpid()}.tmp")
-        tmp.unlink(missing_ok=True)
-        os.symlink(os.ttyname(slave), tmp)
-        os.replace(tmp, self._link)
+        device = self._pty.open()
         self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name=f"arm-emulator {self._link}", daemon=True)
+        self._thread = threading.Thread(target=self._run, name=f"arm-emulator {self._pty.link}", daemon=True)
         self._thread.start()
-        self._log.info("arm emulator (%s, %s firmware): %s -> %s", self.pace, self._lib.precision, self._link,
-                       os.ttyname(slave))
+        self._log.info("arm emulator (%s, %s firmware): %s -> %s", self.pace, self._lib.precision, self._pty.link,
+                       device)
         return self
 
     def stop(self, timeout_s: float = 5.0) -> None:
@@ -170,14 +152,7 @@ class ArmEmulator:
         if thread is not None:
             thread.join(timeout_s)
         with self._lock:
-            self._link.unlink(missing_ok=True)
-            for fd in (self._master, self._slave):
-                if fd is not None:
-                    os.close(fd)
-            self._master = self._slave = None
-        if self._own_dir is not None:
-            shutil.rmtree(self._own_dir, ignore_errors=True)
-            self._own_dir = None
+            self._pty.remove()
 
     def hang(self, timeout_s: float = 5.0) -> None:
         """Stop the firmware but leave the port open, as a board that hangs: bytes go in, nothing comes out."""
@@ -198,7 +173,7 @@ class ArmEmulator:
         t0 = time.monotonic()
         fw = self.firmware
         while not self._stop.is_set():
-            fd = self._master
+            fd = self._pty.master
             if fd is None:
                 return
             readable, _, _ = select.select([fd], [], [], 0.0005)

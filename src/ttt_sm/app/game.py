@@ -32,6 +32,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from ..arm import Arm
 from ..charts.game import AlgorithmActivator, Game
 from ..game.bitboard import FULL, bits, cell_index, cell_of, win_cells
 from ..game.rules import is_full, parse_board, winner
@@ -40,6 +41,7 @@ from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
 from ..sched.scheduler import Signals
 from ..twin.board_picture import save_board_picture
+from ..twin.truth import GroundTruth
 from ..vision import MoveError, percent_process
 from .camera_link import CameraLink
 from .game_record import GameRecord, params_digest
@@ -333,13 +335,16 @@ class GameSession:
 
     ``q_start`` and ``settle_s`` are the :class:`Robot`'s: the pose before the
     unpowered arm settles for ``settle_s`` seconds (default: the rest pose).
+    ``arm`` and ``truth``: another arm than the twin (``--arm serial:PORT``,
+    :mod:`.arms`) and the ground truth it offers for the whiteboard.
     """
 
     def __init__(self, params: ArmParams, seed: int = 0, robot_symbol: str = "O", person: Person | None = None,
                  engine: str = "strong", camera: str = "serial", record_trace: bool = True,
                  progress: Callable[[str], None] | None = None, q_start: Sequence[float] | None = None,
                  settle_s: float = 0.0, out_dir: Path | None = None, time_limit_s: float = DEFAULT_TIME_LIMIT_S,
-                 status: Callable[[str], None] | None = None, record: GameRecord | None = None) -> None:
+                 status: Callable[[str], None] | None = None, record: GameRecord | None = None,
+                 arm: Arm | None = None, truth: GroundTruth | None = None) -> None:
         if robot_symbol not in ("X", "O"):
             raise ValueError(f"robot symbol must be X or O, got {robot_symbol!r}")
         if not 0 < time_limit_s < float("inf"):
@@ -349,7 +354,8 @@ class GameSession:
         self.say = progress or (lambda _m: None)
         self.trace = Trace() if record_trace else None
         listeners: list[object] = [self.trace] if self.trace else []
-        self.robot = Robot(params, seed=seed, listeners=listeners, q_start=q_start, settle_s=settle_s)
+        self.robot = Robot(params, seed=seed, listeners=listeners, q_start=q_start, settle_s=settle_s, arm=arm,
+                           truth=truth)
         self.activator = AlgorithmActivator(tick_period_s=params.control.chart_dt, listeners=listeners)
         self.game = Game(tick_period_s=params.control.chart_dt, listeners=listeners)
         self.robot_symbol = robot_symbol

@@ -39,6 +39,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
     serve.add_argument("--precision", choices=("float", "double"), default="float",
                        help="the firmware's number type (default float, as the reference board)")
     serve.add_argument("--seed", type=seed, default=0, help="seed of the plant's current noise (default 0)")
+    serve.add_argument("--no-truth", dest="truth", action="store_false",
+                       help="send only what a board sends: no EMU_TRUTH frames (the plant's true angles, which the"
+                            " PC's simulated whiteboard and precision figures need)")
     serve.add_argument("--duration", type=float, default=None, help="stop after this many seconds (default: Ctrl-C)")
     serve.add_argument("--json", action="store_true", help="print the emulator's counts as one JSON document")
     serve.set_defaults(func=cmd_arm_serve)
@@ -60,7 +63,8 @@ def cmd_arm_serve(args: argparse.Namespace) -> int:
         return _fail(f"--duration must be a finite number >= 0 of seconds, got {args.duration}")
     params = load_arm(args.params)
     try:
-        emu = ArmEmulator(params, pace=args.pace, link=args.link, precision=args.precision, seed=args.seed)
+        emu = ArmEmulator(params, pace=args.pace, link=args.link, precision=args.precision, seed=args.seed,
+                          truth=args.truth)
     except (ArmEmulatorError, FirmwareError) as exc:
         return _fail(str(exc))
     try:

@@ -48,17 +48,19 @@ from typing import Any
 
 from ..app.game import GameSession
 from ..app.robot import Robot, RobotError
+from ..arm import Arm
 from ..params import ArmParams
 from ..runtime import Data, TickChart, UnknownEventError
 from ..runtime.errors import GraphvizMissingError
 from ..runtime.export import render_active
 from ..runtime.listeners import Trace
 from ..runtime.recordfile import RecordFile
+from ..twin.truth import GroundTruth
 from .breakpoints import BreakListener, Breakpoint, ChartIndex, Hit, parse_breakpoint
 from .errors import DebugError
 from .names import RobotNames, datum_decl, parse_input_value
 from .records import Action, DataChange, DataDiff, StopKind, StopReason
-from .replay import GameRecipe, Recipe, ReplayResult, RobotRecipe, differences, fingerprint, game_of
+from .replay import ArmRecipe, GameRecipe, Recipe, ReplayResult, RobotRecipe, differences, fingerprint, game_of
 from .timeline import Timeline, TimelineWindow
 
 #: The longest one command (run, next, step, tick) may run unless raised, seconds of
@@ -130,7 +132,8 @@ class Debugger:
     @classmethod
     def build(cls, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
               settle_s: float = 0.0, *, game: bool = False, person: str = "simulated",
-              max_run_s: float = DEFAULT_MAX_RUN_S, trace_path: str | Path | None = None) -> Debugger:
+              max_run_s: float = DEFAULT_MAX_RUN_S, trace_path: str | Path | None = None,
+              arm: Arm | None = None, truth: GroundTruth | None = None) -> Debugger:
         """A debugger on a new robot, with its recipe for :meth:`replay`.
 
         ``game``: the robot plays a game (:class:`~.replay.GameRecipe`: the Game
@@ -138,7 +141,12 @@ class Debugger:
         in-process, the strong engine; the robot draws O).  ``person``: who plays
         against it, ``"simulated"`` or ``"page"`` (a person at the ``/game`` page).
         ``trace_path``: stream the whole trace there (see the class).
+        ``arm`` (and the ``truth`` it offers): another arm than the twin
+        (``--arm serial:PORT``); the robot is built on it once (no replay).
         """
+        if arm is not None:
+            arm_recipe = ArmRecipe(params, arm, truth, seed, game=game, person=person)
+            return cls(arm_recipe.build(), arm_recipe, max_run_s=max_run_s, trace_path=trace_path)
         pose = None if q_start is None else tuple(float(v) for v in q_start)
         recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person) if game else \
             RobotRecipe(params, seed, pose, settle_s)
@@ -544,6 +552,8 @@ class Debugger:
         return fingerprint(self.robot, self.forced)
 
     def _remember(self) -> None:
+        if self.robot.sim is None:  # no twin, nothing a replay could compare
+            return
         kept = self._fingerprints
         kept[self.robot.steps] = self.fingerprint()
         if len(kept) > MAX_FINGERPRINTS:

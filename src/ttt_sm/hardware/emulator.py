@@ -39,6 +39,7 @@ from ..ptylink import PtyLink, PtyLinkError
 from ..twin import _cascade as C
 from ..twin import _plant as PL
 from ..twin.plant import REST_POSE, Plant, check_pose
+from . import link as L
 from .firmware import Precision, build
 from .native import FirmwareLibrary, NativeFirmware, board_for
 
@@ -66,8 +67,8 @@ class FirmwareOnPlant:
         self._ints = self.plant.ints
         self._ps = self.plant.ps
 
-    def step(self) -> None:
-        """One control step: the plant's sensors into the firmware, its commands onto the plant."""
+    def read_sensors(self) -> None:
+        """The plant's sensors into the firmware's input (no step)."""
         s, ints = self.firmware.sensors, self._ints
         for d in range(3):
             s.counts[d] = int(ints[d, PL.PI_COUNTS])
@@ -75,6 +76,15 @@ class FirmwareOnPlant:
             s.index_edges[d] = int(ints[d, PL.PI_INDEX_EDGES]) & 0xFFFF
             s.current_a[d] = float(self._ps[d, PL.PS_I_MEAS])
         s.index = sum(1 << d for d in range(3) if ints[d, PL.PI_INDEX] == 1)
+
+    def sense(self) -> None:
+        """The firmware takes the plant's sensors without a step (a gated clock, before START)."""
+        self.read_sensors()
+        self.firmware.sense()
+
+    def step(self) -> None:
+        """One control step: the plant's sensors into the firmware, its commands onto the plant."""
+        self.read_sensors()
         self.firmware.step()
         self._act[:] = self.firmware.act
         self.plant.step(self._act)
@@ -97,12 +107,17 @@ class ArmEmulator:
         The firmware's number type: ``"float"`` (the reference board) or ``"double"``.
     seed, q0
         The plant's noise seed and its pose at power-on.
+    truth
+        Send the plant's true angles (``EMU_TRUTH``, simulation only) before
+        each burst of the firmware's frames, so that the PC's simulated
+        whiteboard is inked where the emulated pen really is; off, the wire
+        carries exactly what a board sends.
     """
 
     def __init__(self, params: ArmParams, *, pace: Pace = "gated", link: str | os.PathLike[str] | None = None,
                  precision: Precision = "float", seed: int = 0,
                  q0: tuple[float, float, float, float] | None = None, cache: Path | None = None,
-                 logger: logging.Logger | None = None) -> None:
+                 logger: logging.Logger | None = None, truth: bool = False) -> None:
         if pace not in PACES:
             raise ArmEmulatorError(f"pace must be one of {', '.join(PACES)}, got {pace!r}")
         self.params = params
@@ -110,6 +125,9 @@ class ArmEmulator:
         self.dt = params.control.dt
         self._lib = FirmwareLibrary(build(precision, cache), precision)
         self.bench = FirmwareOnPlant(params, self._lib, seed=seed, q0=q0)
+        # The plant's compiled step is loaded on its first call (a third of a second): on a scratch plant
+        # now, not on the first control step, which a PC would wait for in vain.
+        Plant(params, check_pose(params, REST_POSE), np.random.default_rng(0)).step(np.zeros(C.N_ACT))
         self.firmware = self.bench.firmware
         #: The physics (simulation only): ground truth for tests.
         self.plant = self.bench.plant
@@ -125,6 +143,12 @@ class ArmEmulator:
         self.bytes_in = 0
         self.bytes_out = 0
         self.bytes_dropped = 0
+        self.truth = truth
+        self._truth_tx = L.Sender()
+        self.truth_bytes = 0
+        ints, rpc = self.plant.ints, [d.rad_per_count for d in params.drives]
+        c0 = [float((ints[d, PL.PI_C0] + 0.5) * rpc[d]) for d in range(3)]
+        self._true_offsets = (c0[0], c0[1], c0[2])
         self._gate = 0  # setpoints frames seen by the gated clock
         self._until = 0  # ... which let it run to this step
 
@@ -201,10 +225,20 @@ class ArmEmulator:
             time.sleep(0.001)
             return
         self.bytes_in += len(data)
+        if self.pace == "gated" and self.firmware.state != 1:
+            self.bench.sense()  # no control step runs before START here: the readings a board would have
         self.firmware.rx(data)
 
     def _send(self, fd: int) -> None:
-        self._out += self.firmware.tx()
+        data = self.firmware.tx()
+        if data and self.truth:  # before the firmware's frames: the PC has it when it reads their status
+            ps, pgs = self.plant.ps, self.plant.pgs
+            frame = self._truth_tx.frame(L.EmuTruth(self.firmware.steps, int(self.pace == "gated"), (
+                float(ps[0, PL.PS_Q]), float(ps[1, PL.PS_Q]), float(ps[2, PL.PS_Q]), float(pgs[PL.PGS_SV_Q])),
+                self._true_offsets))
+            self.truth_bytes += len(frame)
+            self._out += frame
+        self._out += data
         if not self._out:
             return
         try:

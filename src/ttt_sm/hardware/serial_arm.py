@@ -19,6 +19,7 @@ Rejected frames are counted and logged by its
 from __future__ import annotations
 
 import math
+import select
 import time
 from collections.abc import Sequence
 from typing import TypeVar
@@ -31,16 +32,58 @@ from ..params import ArmParams
 from ..twin import _cascade as C
 from ..twin.cascade import CascadeController
 from ..twin.control import Gains, check_drive
+from ..twin.kinematics import fk
 from ..twin.tuning import design_gains
 from . import link as L
 
 LINK_TIMEOUT_S = 0.050
 """No valid status for this long while one is due: the link is lost."""
+GATED_TIMEOUT_S = 5.0
+"""The same for a gated emulator (it says so in its ``EMU_TRUTH``): it keeps no deadline, and shares the
+PC's processor, so a loaded machine may hold it up; only a link that is really gone is lost."""
 HANDSHAKE_TIMEOUT_S = 2.0
 BAUD = 921_600
 
 
 M = TypeVar("M", bound=L.Message)
+
+
+class LinkTruth:
+    """Ground truth from an emulator (``EMU_TRUTH`` frames): the emulated plant's true joint angles.
+
+    Simulation only, for what exists in simulation alone (the PC's whiteboard
+    inked by the true pen, a drawing's precision); the charts never see it.
+    It offers what :class:`ttt_sm.twin.truth.ArmTruth` offers those parts:
+    :attr:`q`, :meth:`angles`, :meth:`tool_pose`, :attr:`offsets`.
+    """
+
+    def __init__(self, params: ArmParams, q: tuple[float, float, float, float], offsets: tuple[float, float, float],
+                 step: int) -> None:
+        self.params = params
+        self._q = q
+        self._offsets = offsets
+        #: The firmware step these angles are after.
+        self.step = step
+
+    def update(self, q: tuple[float, float, float, float], step: int) -> None:
+        self._q, self.step = q, step
+
+    @property
+    def q(self) -> np.ndarray:
+        """True joint angles q1..q4 (rad), a copy."""
+        return np.array(self._q)
+
+    def angles(self) -> tuple[float, float, float, float]:
+        return self._q
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """The true encoder offsets (rad): an encoder angle plus these is the joint angle within half a count."""
+        return np.array(self._offsets)
+
+    def tool_pose(self) -> np.ndarray:
+        """The true tool pose x, y, z (m), phi (rad): forward kinematics of :attr:`q`."""
+        return fk(self.q, self.params.geometry)
 
 
 class SerialArmError(RuntimeError):
@@ -85,11 +128,20 @@ class SerialArm:
         self.bytes_sent = 0
         self.bytes_received = 0
         self._status: L.Status | None = None
+        #: The emulator's ground truth (simulation only); None from a board, which sends none.
+        self.truth: LinkTruth | None = None
+        #: Whether the other end is a gated emulator (its ``EMU_TRUTH`` says so): it keeps no deadline.
+        self.gated = False
         self._replies: list[L.Message] = []
         try:
             self._ser = serial.serial_for_url(port, baudrate=baudrate, timeout=0)
         except (OSError, serial.SerialException) as e:
             raise SerialArmError(f"cannot open the arm's port {port}: {e}") from e
+        fileno = getattr(self._ser, "fileno", None)
+        try:
+            self._fd: int | None = fileno() if fileno is not None else None
+        except (OSError, serial.SerialException, AttributeError):
+            self._fd = None
         try:
             self.handshake = self._open()
         except BaseException:
@@ -144,8 +196,11 @@ class SerialArm:
             raise LinkLost(f"cannot write to the arm's port: {e}") from e
         self.bytes_sent += len(data)
 
-    def _poll(self) -> None:
+    def _poll(self, wait_s: float = 0.0) -> None:
+        """Read what has come (waiting up to `wait_s` for a first byte, without spinning) and take its frames."""
         try:
+            if wait_s > 0 and not self._ser.in_waiting and self._fd is not None:
+                select.select([self._fd], [], [], wait_s)
             data = self._ser.read(self._ser.in_waiting or 1)
         except (OSError, serial.SerialException) as e:
             raise LinkLost(f"cannot read from the arm's port: {e}") from e
@@ -155,6 +210,12 @@ class SerialArm:
                 if isinstance(m, L.Status):
                     if self._status is None or m.step > self._status.step or m.state != self._status.state:
                         self._status = m
+                elif isinstance(m, L.EmuTruth):
+                    self.gated = m.gated
+                    if self.truth is None:
+                        self.truth = LinkTruth(self.params, m.q, m.offsets, m.step)
+                    else:
+                        self.truth.update(m.q, m.step)
                 else:
                     self._replies.append(m)
 
@@ -171,19 +232,20 @@ class SerialArm:
             if time.monotonic() > give_up:
                 raise LinkLost(f"no {kind.__name__} from the firmware within {timeout_s * 1000:.0f} ms "
                                f"({self.rx.rejected} frames rejected)")
-            self._poll()
+            self._poll(min(0.005, max(0.0, give_up - time.monotonic())))
 
     def _wait_step(self, target: int) -> None:
-        give_up = time.monotonic() + self.link_timeout_s
+        timeout = max(self.link_timeout_s, GATED_TIMEOUT_S) if self.gated else self.link_timeout_s
+        give_up = time.monotonic() + timeout
         while self._status is None or self._status.step < target:
             before = self._status
-            self._poll()
+            self._poll(min(0.005, timeout))
             if self._status is not before:
-                give_up = time.monotonic() + self.link_timeout_s
+                give_up = time.monotonic() + timeout
             if self._status is not None and self._status.state != 1:
                 raise LinkLost(f"the firmware is in {self._status.state_name} at step {self._status.step}")
             if time.monotonic() > give_up:
-                raise LinkLost(f"no status from the firmware for {self.link_timeout_s * 1000:.0f} ms "
+                raise LinkLost(f"no status from the firmware for {timeout * 1000:.0f} ms "
                                f"(waiting for step {target}; {self.rx.rejected} frames rejected)")
 
     # ---- the Arm protocol ---------------------------------------------------------------
@@ -251,4 +313,4 @@ class SerialArm:
                 "frames_ok": self.rx.frames_ok, "rejected": self.rx.rejected, "lost": self.rx.seq.lost}
 
 
-__all__ = ["SerialArm", "SerialArmError", "LinkLost", "LINK_TIMEOUT_S"]
+__all__ = ["SerialArm", "SerialArmError", "LinkLost", "LinkTruth", "LINK_TIMEOUT_S"]

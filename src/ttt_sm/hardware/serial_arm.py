@@ -128,6 +128,8 @@ class SerialArm:
         self.bytes_sent = 0
         self.bytes_received = 0
         self._status: L.Status | None = None
+        self._steps = 0  # control steps run (the arm's time)
+        self._sent_for = -1  # the control step the last setpoints were sent for
         #: The emulator's ground truth (simulation only); None from a board, which sends none.
         self.truth: LinkTruth | None = None
         #: Whether the other end is a gated emulator (its ``EMU_TRUTH`` says so): it keeps no deadline.
@@ -175,6 +177,7 @@ class SerialArm:
                 raise SerialArmError(f"gains block {block}: read back {back.values_}, sent {tuple(want)}")
         self._send(L.Start())
         self._status = self._wait_for(L.Status, HANDSHAKE_TIMEOUT_S, after_start=True)
+        self._steps = self._status.step
         return hs
 
     def close(self) -> None:
@@ -252,18 +255,34 @@ class SerialArm:
 
     @property
     def t(self) -> float:
-        return 0.0 if self._status is None else self._status.step * self.dt
+        return self._steps * self.dt
 
     @property
     def steps(self) -> int:
-        return 0 if self._status is None else self._status.step
+        """Control steps run: the firmware's, as of its last status, and those stepped since within a chart step."""
+        return self._steps
 
     def step(self, n: int = 1) -> None:
-        """Stream the setpoints and wait until the firmware has run `n` more control steps (in chart steps)."""
-        target = self.steps + n
-        while self.steps < target:
-            self._send(L.Setpoints(self.steps, (self._q[0], self._q[1], self._q[2], self._q[3]), self._fr_sw))
-            self._wait_step(min(target, self.steps + self.divider))
+        """Stream the setpoints and wait until the firmware has run `n` more control steps.
+
+        The setpoints go out at each chart step's first control step; the
+        firmware reports at each chart step's end, so that is where this waits.
+        Stepping one control step at a time (the debugger, a paced clock),
+        the steps within a chart step return at once: the firmware runs them
+        on the setpoints it has.
+        """
+        target = self._steps + n
+        d = self.divider
+        while self._steps < target:
+            if self._steps % d == 0 and self._sent_for != self._steps:
+                self._send(L.Setpoints(self._steps, (self._q[0], self._q[1], self._q[2], self._q[3]), self._fr_sw))
+                self._sent_for = self._steps
+            nxt = min(target, (self._steps // d + 1) * d)
+            if nxt % d == 0:
+                self._wait_step(nxt)
+                assert self._status is not None  # _wait_step returns with one
+                nxt = max(nxt, self._status.step)  # on its own clock, the firmware may be further on
+            self._steps = nxt
 
     def set_setpoints(self, q_des: Sequence[float], fr_sw: bool = False) -> None:
         q = [float(v) for v in q_des[:4]]

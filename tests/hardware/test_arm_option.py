@@ -5,7 +5,9 @@ the C firmware on the twin's plant behind a real pseudo-terminal; the
 command runs here, opens the pty's stable link with pyserial and drives the
 arm through the link only.  The emulator's own report (``--json`` when it
 stops) says what went over the wire: every test checks that the firmware
-ran, took the PC's setpoints and rejected nothing.
+ran, took the PC's setpoints and rejected nothing.  The example of
+docs/hardware.md, "Choosing the arm" (``arm serve`` then ``draw X --arm``),
+is the first test here.
 """
 
 from __future__ import annotations

@@ -84,6 +84,7 @@ CONTRACT: tuple[Component, ...] = (
               "the browser cockpit (ttt-sm gui): a session over the debugger, its protocol, server and pages"),
     Component("bench", 6, ("ttt_sm.bench",), "the speed and quality targets",
               only=("package", "runtime", "params", "arm", "charts", "twin", "game", "seriallink", "vision", "sched",
+                    "hardware",
                     "vision staging", "app", "debug", "scenario", "architecture", "web")),
     Component("architecture", 4, ("ttt_sm.architecture",), "this contract, its checker, docs/architecture.md"),
     Component("cli common", 4, ("ttt_sm.cli.common",), "the CLI's one-line error, options and strict JSON output",

@@ -211,6 +211,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise CliError(f"--only: unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
     if args.gui_soak is not None and not args.gui_soak > 0:
         raise CliError(f"--gui-soak: expected a positive number of minutes, got {args.gui_soak}")
+    if args.link_minutes is not None and not 0 < args.link_minutes <= 1440:
+        raise CliError(f"--link-minutes: expected a number of minutes in (0, 1440], got {args.link_minutes}")
     names = only or list(SECTIONS)
     record = RecordFile(out / "bench.jsonl")
     record.add({"event": "bench", "sections": names, "seed": args.seed, "quick": args.quick,
@@ -231,7 +233,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     try:
         try:
             result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
-                               progress=progress(True), gui_soak_min=args.gui_soak or 0.0, on_section=on_section)
+                               progress=progress(True), gui_soak_min=args.gui_soak or 0.0, on_section=on_section,
+                               link_minutes=args.link_minutes)
         except ValueError as exc:
             raise CliError(str(exc)) from exc
     except BaseException as exc:  # the record and the --json document say what was measured and where it stopped
@@ -370,10 +373,12 @@ def register(sub: Any) -> None:
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
     sp = add_command(sub, "bench", cmd_bench, "measure the speed and quality targets")
     sp.add_argument("--only", default=None,
-                    help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui")
+                    help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui,link")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
     sp.add_argument("--gui-soak", metavar="MIN", type=float, default=None,
                     help="gui section: also run MIN minutes at x10 and report the memory after 1 and after MIN")
+    sp.add_argument("--link-minutes", metavar="MIN", type=float, default=None,
+                    help="link section: stream setpoints to the emulator for MIN minutes (default 10; --quick: 5 s)")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
     sp = add_command(sub, "ik", cmd_ik, "solve inverse kinematics for one tool pose")
     sp.add_argument("x", type=float, help="mm")

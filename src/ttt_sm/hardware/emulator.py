@@ -35,7 +35,7 @@ from typing import Literal
 import numpy as np
 
 from ..params import ArmParams
-from ..ptylink import PtyLink, PtyLinkError
+from ..ptylink import PtyLink, PtyLinkError, realtime_priority
 from ..twin import _cascade as C
 from ..twin import _plant as PL
 from ..twin.plant import REST_POSE, Plant, check_pose
@@ -112,12 +112,17 @@ class ArmEmulator:
         each burst of the firmware's frames, so that the PC's simulated
         whiteboard is inked where the emulated pen really is; off, the wire
         carries exactly what a board sends.
+    realtime
+        Run the firmware's thread at ``SCHED_FIFO`` priority
+        (:func:`ttt_sm.ptylink.realtime_priority`), as a board's control
+        loop runs before anything else; :attr:`priority_note` says why not
+        when the system refuses.
     """
 
     def __init__(self, params: ArmParams, *, pace: Pace = "gated", link: str | os.PathLike[str] | None = None,
                  precision: Precision = "float", seed: int = 0,
                  q0: tuple[float, float, float, float] | None = None, cache: Path | None = None,
-                 logger: logging.Logger | None = None, truth: bool = False) -> None:
+                 logger: logging.Logger | None = None, truth: bool = False, realtime: bool = False) -> None:
         if pace not in PACES:
             raise ArmEmulatorError(f"pace must be one of {', '.join(PACES)}, got {pace!r}")
         self.params = params
@@ -144,6 +149,9 @@ class ArmEmulator:
         self.bytes_out = 0
         self.bytes_dropped = 0
         self.truth = truth
+        self.realtime = realtime
+        #: Why the thread did not get its real-time priority (None: it did, or it was not asked).
+        self.priority_note: str | None = None
         self._truth_tx = L.Sender()
         self.truth_bytes = 0
         ints, rpc = self.plant.ints, [d.rad_per_count for d in params.drives]
@@ -194,6 +202,8 @@ class ArmEmulator:
     # -- the thread ----------------------------------------------------------------
 
     def _run(self) -> None:
+        if self.realtime:
+            self.priority_note = realtime_priority()
         t0 = time.monotonic()
         fw = self.firmware
         while not self._stop.is_set():

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import select
 import threading
 import time
@@ -188,6 +189,10 @@ class SerialArm:
         self.status_step = 0
         self._closing = threading.Event()
         self._keeper: threading.Thread | None = None
+        # The keeper runs at its maker's scheduling priority: one that ran lower could be held off the
+        # processor while holding the interpreter's lock, and hold up a chart loop of higher priority.
+        get_policy = getattr(os, "sched_getscheduler", None)
+        self._policy = (get_policy(0), os.sched_getparam(0)) if get_policy is not None else None
         try:
             self._ser = serial.serial_for_url(port, baudrate=baudrate, timeout=0)
         except (OSError, serial.SerialException) as e:
@@ -317,6 +322,11 @@ class SerialArm:
         It looks every :data:`KEEPER_TICK_S` while the wire is free (the chart
         loop, waiting for a status, watches the link itself).
         """
+        if self._policy is not None and self._policy[0] != os.SCHED_OTHER:
+            try:
+                os.sched_setscheduler(0, *self._policy)
+            except OSError:
+                pass  # the maker's priority is not ours to take: the keeper runs at the normal one
         checked = time.monotonic()
         while not self._closing.wait(KEEPER_TICK_S):
             if not self._io.acquire(blocking=False):

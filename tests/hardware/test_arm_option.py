@@ -176,3 +176,26 @@ def test_a_link_where_no_firmware_answers_is_one_error_line(command, tmp_path, c
     lines = [line for line in err.splitlines() if line.strip() and not line.startswith("ttt-sm play: the robot")]
     assert status == 2 and "Traceback" not in err
     assert lines[-1].startswith(f"ttt-sm {command[0]}: error: --arm serial:{silent}: no Handshake"), err
+
+
+@pytest.mark.soak
+def test_a_whole_game_over_the_emulator_draws_as_precisely_as_the_twin(emulator, tmp_path, capsys):
+    """``ttt-sm play --arm serial:PTY`` against ``arm serve``: the whole game, field to erasing (soak: it takes
+    a few minutes of processor time; the default suite draws one X over the link, above)."""
+    cpu0 = os.times()
+    status, out, err = run(["play", "--arm", emulator.arm, "--opponent", "simulated", "--camera", "direct",
+                            "--json", "--out", str(tmp_path / "link")], capsys)
+    assert status == 0, err
+    link = json.loads(out)
+    report = emulator.stop()
+    cpu = os.times()
+    status, out, err = run(["play", "--opponent", "simulated", "--camera", "direct", "--json",
+                            "--out", str(tmp_path / "twin")], capsys)
+    assert status == 0, err
+    twin = json.loads(out)
+    assert link["winner"] in ("robot", "draw") and link["erased"] and link["detections_wrong"] == 0
+    assert abs(link["drawing_rms_mm"] - twin["drawing_rms_mm"]) <= PRECISION_TOLERANCE_MM, (link, twin)
+    link_clean(report, min_setpoints=int(link["sim_time_s"] / 0.002) - 5)
+    print(f"whole game over the link: {link['sim_time_s']} s simulated, drawing rms {link['drawing_rms_mm']} mm"
+          f" (twin {twin['drawing_rms_mm']} mm), this process {cpu.user - cpu0.user + cpu.system - cpu0.system:.0f} s"
+          f" of processor time, the emulator {cpu.children_user - cpu0.children_user:.0f} s")

@@ -145,19 +145,27 @@ def test_play_over_the_emulator_starts_a_game_on_the_link(emulator, tmp_path, ca
 
 
 def test_gui_over_the_emulator_builds_the_robot_on_the_link(emulator, tmp_path, firmware_cache):
+    trace = tmp_path / "trace.jsonl"
     gui = subprocess.Popen([sys.executable, "-m", "ttt_sm.cli", "gui", "--arm", emulator.arm, "--port", "0",
-                            "--trace", str(tmp_path / "trace.json")],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            "--trace", str(trace)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert gui.stdout is not None
         first = gui.stdout.readline()
         assert "the chart cockpit is at http://" in first, first + gui.communicate(timeout=30)[1]
-        time.sleep(1.0)  # the session runs at x1: half a thousand chart steps over the link
+        # the session runs at x1: wait for the init charts' first transitions, streamed to the trace
+        give_up = time.monotonic() + 120
+        while (not trace.exists() or trace.read_text().count('"chart"') < 2) and time.monotonic() < give_up:
+            time.sleep(0.05)
     finally:
         gui.send_signal(signal.SIGINT)
         out, err = gui.communicate(timeout=60)
     assert gui.returncode == 0 and "Traceback" not in err, err
-    link_clean(emulator.stop(), min_setpoints=50)
+    last = json.loads(trace.read_text().splitlines()[-1])
+    assert last["event"] == "interrupted" and last["tick"] > 0
+    report = emulator.stop()
+    link_clean(report, min_setpoints=1)
+    # every chart step the cockpit ran was one SETPOINTS frame the firmware took
+    assert abs(report["stats"]["setpoints_ok"] - last["tick"]) <= 1, (report, last)
 
 
 @pytest.mark.parametrize("command", [["play", "--opponent", "simulated", "--camera", "direct"], ["demo"],

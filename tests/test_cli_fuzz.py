@@ -157,6 +157,22 @@ test_an_unusable_path_is_refused_in_one_line, test_an_unusable_path_is_refused_i
               st.integers(0, 100)), quick=150, soak=2000)(path_refused)
 
 
+def arm_refused(case: tuple[int, str, bool]) -> None:
+    """``--arm`` with anything but ``sim``: a bad value, or a port that does not open or answer, in one line."""
+    index, text, as_port = case
+    value = f"serial:{text}" if as_port else text
+    assume(value != "sim")
+    before = [["draw", "X"], ["init", "--starts", "1"], ["demo"], ["debug", "--commands", "/dev/null"]][index]
+    rc, err = _run([*before, "--arm", value])
+    assert rc == 2, (before, value, rc, err[-500:])
+    one_error_line(err)
+
+
+test_an_unusable_arm_is_refused_in_one_line, test_an_unusable_arm_is_refused_in_one_line_soak = fuzz(
+    st.tuples(st.integers(0, 3), st.one_of(st.sampled_from(_PATHS), st.text(max_size=20)), st.booleans()),
+    quick=60, soak=600)(arm_refused)
+
+
 @pytest.mark.parametrize("argv, message", [
     (["draw", "X", "--seed", "-1"], "argument --seed: expected a whole number 0 .. 2**63 - 1, got -1"),
     (["vision", "bench", "--photos", "1", "--seed", "-5"], "argument --seed: expected a whole number 0 .. 2**63 - 1"),

@@ -123,6 +123,13 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     numbers(serve, "--rate", BAD_POSITIVE)
     numbers(serve, "--duration", ("abc", "nan", "-1"))
     numbers(serve, "--fault-every", ("abc", "1.5", "", "-1"))
+    for command in (play, ["demo"], ["draw", "X"], ["init", "--starts", "1"], ["debug"], ["gui"]):
+        cases.append(([*command, "--arm", "bogus"], "--arm"))
+        cases.append(([*command, "--arm", "serial:"], "--arm"))
+        cases.append(([*command, "--arm", f"serial:{p['missing']}"], p["missing"]))
+        cases.append(([*command, "--arm", f"serial:{p['folder']}"], p["folder"]))
+    cases.append((["init", "--starts", "3", "--arm", f"serial:{p['missing']}"], "--starts"))
+    cases.append((["debug", "--settle", "1", "--arm", f"serial:{p['missing']}"], "--settle"))
     arm = ["arm", "serve", "--duration", "0"]
     cases.append(([*arm, "--link", f"{p['file_as_folder']}/arm"], p["file_as_folder"]))
     numbers(arm, "--duration", ("abc", "nan", "-1"))

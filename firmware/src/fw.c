@@ -263,6 +263,8 @@ size_t ttt_fw_tx(ttt_fw *fw, uint8_t *out, size_t cap)
     return n;
 }
 
+void ttt_fw_sense(ttt_fw *fw, const ttt_sensors *in) { fw->sensors = *in; }
+
 void ttt_fw_control_step(ttt_fw *fw, const ttt_sensors *in)
 {
     int k;

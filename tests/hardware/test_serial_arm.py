@@ -149,6 +149,7 @@ def test_arm_serve_runs_the_emulator_for_a_pc_and_reports_the_link(tmp_path, cap
         for _ in range(50):
             arm.step(2)
         arm.close()
+        heartbeats = arm.heartbeats_sent  # an idle moment (a loaded machine) is kept watched by heartbeats
     finally:
         server.join(60)
     assert rc == [0] and not link.exists()
@@ -156,7 +157,7 @@ def test_arm_serve_runs_the_emulator_for_a_pc_and_reports_the_link(tmp_path, cap
     assert doc["pace"] == "gated" and doc["precision"] == "float"
     stats = doc["stats"]
     assert stats["steps"] == 100 and stats["setpoints_ok"] == 50 and stats["rejections"] == {}
-    assert stats["frames_ok"] == 1 + 4 + 1 + 50  # hello, four gains blocks, start, the setpoints
+    assert stats["frames_ok"] == 1 + 4 + 1 + 50 + heartbeats  # hello, four gains blocks, start, the setpoints
 
 
 def test_arm_serve_errors_are_one_line(tmp_path, capsys):

@@ -26,7 +26,7 @@ def test_the_link_points_at_a_real_pty_and_follows_replugs(tmp_path):
     cam = CameraEmulator(link=tmp_path / "camera")
     try:
         first = cam.plug()
-        assert first.startswith("/dev/pts/") and os.readlink(cam.port) == first and os.isatty(cam._slave)
+        assert first.startswith("/dev/pts/") and os.readlink(cam.port) == first and os.isatty(cam._pty._slave)
         cam.unplug()
         assert cam.device is None and not os.path.lexists(cam.port)
         assert cam.send_raw(b"lost") is False and cam.stats.bytes_dropped == 4

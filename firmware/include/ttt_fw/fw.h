@@ -86,6 +86,11 @@ void ttt_fw_rx(ttt_fw *fw, const uint8_t *data, size_t n);
 size_t ttt_fw_tx(ttt_fw *fw, uint8_t *out, size_t cap);
 /* One control step: the watchdog, the cascade (fw->cascade.act out), a STATUS when due. */
 void ttt_fw_control_step(ttt_fw *fw, const ttt_sensors *in);
+/* Take the sensor readings without a control step: what the next STATUS
+ * reports and START holds from.  A board steps at the control rate from
+ * power-on, so its readings are always fresh; an emulator whose clock the PC
+ * gates runs no step before START, and calls this instead. */
+void ttt_fw_sense(ttt_fw *fw, const ttt_sensors *in);
 
 
 

@@ -25,11 +25,13 @@ from typing import Any
 
 import numpy as np
 
+from ..arm import Arm
 from ..params import ArmParams
 from ..sched.scheduler import Signals
 from ..sched.trajectory import distance_to_path, simplify_polyline
 from ..twin.board_picture import save_board_picture
 from ..twin.kinematics import fk
+from ..twin.truth import GroundTruth
 from .path_plot import PathData, save_path_plot
 from .robot import Robot
 
@@ -93,7 +95,8 @@ class RecordStage:
 
     def __init__(self, robot: Robot) -> None:
         if robot.truth is None:
-            raise DrawError("measuring a drawing's precision needs the simulated arm's ground truth")
+            raise DrawError("measuring a drawing's precision needs ground truth: the simulated arm's, or an"
+                            " emulator's (ttt-sm arm serve sends it; a board does not)")
         self.robot = robot
         self.truth = robot.truth
         self.on = False
@@ -231,9 +234,10 @@ def check_request(params: ArmParams, kind: str, row: int, column: int, speed: fl
 class DrawSession:
     """A robot, its whiteboard and a recorder, ready to draw on command."""
 
-    def __init__(self, params: ArmParams, seed: int = 0, progress: Callable[[str], None] | None = None) -> None:
+    def __init__(self, params: ArmParams, seed: int = 0, progress: Callable[[str], None] | None = None,
+                 arm: Arm | None = None, truth: GroundTruth | None = None) -> None:
         self.params = params
-        self.robot = Robot(params, seed=seed)
+        self.robot = Robot(params, seed=seed, arm=arm, truth=truth)
         self.recorder = RecordStage(self.robot)
         self.robot.sched.joint_stages.append(self.recorder)
         #: The Control chart's active sub-state over time, for the path plot's bands.

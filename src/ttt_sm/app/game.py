@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import gc
 import hashlib
+import math
 import sys
 import time
 from collections import deque
@@ -32,6 +33,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from ..arm import Arm
 from ..charts.game import AlgorithmActivator, Game
 from ..game.bitboard import FULL, bits, cell_index, cell_of, win_cells
 from ..game.rules import is_full, parse_board, winner
@@ -40,6 +42,7 @@ from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
 from ..sched.scheduler import Signals
 from ..twin.board_picture import save_board_picture
+from ..twin.truth import GroundTruth
 from ..vision import MoveError, percent_process
 from .camera_link import CameraLink
 from .game_record import GameRecord, params_digest
@@ -330,18 +333,62 @@ class GameStage:
             s.robot_turn_now()
 
 
+class PenPathStage:
+    """Joint stage: where the Control chart sends the pen each chart step while it draws (not erasing).
+
+    For the game's drawing precision (:meth:`GameSession.report`): the
+    robot's ink against these desired pen-down paths, as ``ttt-sm draw``
+    measures one drawing (thesis section 3.5).  Simulation only: the ink is
+    the true pen's.
+    """
+
+    #: At most this many pen-down samples are kept (a game draws ~60 s of them: 30 000).
+    MAX_SAMPLES = 250_000
+
+    def __init__(self, robot: Robot) -> None:
+        self.control = robot.control
+        self.surface_z = robot.params.board.surface_z
+        #: Desired pen positions while it is down, one row per chart step; a row at z = inf where it lifts.
+        self.xyz: list[tuple[float, float, float]] = []
+        self._down = False
+        self.board = robot.board
+        #: The robot's ink as it was when the sponge set off (the points of each stroke), kept for the report.
+        self.ink: list[np.ndarray] | None = None
+
+    def robot_ink(self) -> list[np.ndarray]:
+        """The robot's ink strokes: as they were before erasing when the board was erased, else as they are."""
+        if self.ink is not None:
+            return self.ink
+        return [s.points for s in self.board.strokes if s.author == "robot"]
+
+    def tick(self, signals: Signals) -> None:
+        c = self.control
+        if c.erasing and self.ink is None:
+            self.ink = [np.array(s.points) for s in self.board.strokes if s.author == "robot"]
+        if c.busy and not c.erasing and c.Z_out <= self.surface_z:
+            if len(self.xyz) < self.MAX_SAMPLES:
+                self.xyz.append((c.X_out, c.Y_out, c.Z_out))
+            self._down = True
+        elif self._down:
+            self.xyz.append((c.X_out, c.Y_out, math.inf))
+            self._down = False
+
+
 class GameSession:
     """One game on the simulated robot.
 
     ``q_start`` and ``settle_s`` are the :class:`Robot`'s: the pose before the
     unpowered arm settles for ``settle_s`` seconds (default: the rest pose).
+    ``arm`` and ``truth``: another arm than the twin (``--arm serial:PORT``,
+    :mod:`.arms`) and the ground truth it offers for the whiteboard.
     """
 
     def __init__(self, params: ArmParams, seed: int = 0, robot_symbol: str = "O", person: Person | None = None,
                  engine: str = "strong", camera: str = "serial", record_trace: bool = True,
                  progress: Callable[[str], None] | None = None, q_start: Sequence[float] | None = None,
                  settle_s: float = 0.0, out_dir: Path | None = None, time_limit_s: float = DEFAULT_TIME_LIMIT_S,
-                 status: Callable[[str], None] | None = None, record: GameRecord | None = None) -> None:
+                 status: Callable[[str], None] | None = None, record: GameRecord | None = None,
+                 arm: Arm | None = None, truth: GroundTruth | None = None) -> None:
         if robot_symbol not in ("X", "O"):
             raise ValueError(f"robot symbol must be X or O, got {robot_symbol!r}")
         if not 0 < time_limit_s < float("inf"):
@@ -351,7 +398,12 @@ class GameSession:
         self.say = progress or (lambda _m: None)
         self.trace = Trace() if record_trace else None
         listeners: list[object] = [self.trace] if self.trace else []
-        self.robot = Robot(params, seed=seed, listeners=listeners, q_start=q_start, settle_s=settle_s)
+        self.robot = Robot(params, seed=seed, listeners=listeners, q_start=q_start, settle_s=settle_s, arm=arm,
+                           truth=truth)
+        #: The desired pen-down paths, for the game's drawing precision (with ground truth only).
+        self.pen_path = PenPathStage(self.robot) if self.robot.truth is not None else None
+        if self.pen_path is not None:
+            self.robot.sched.joint_stages.append(self.pen_path)
         self.activator = AlgorithmActivator(tick_period_s=params.control.chart_dt, listeners=listeners)
         self.game = Game(tick_period_s=params.control.chart_dt, listeners=listeners)
         self.robot_symbol = robot_symbol
@@ -724,7 +776,24 @@ class GameSession:
             "camera_link": self.camera.stats(),
             "camera_wall_s": round(self.camera.read_wall_s, 3),
             "ignored_play_clicks": self.activator.ignored_triggers,
+            **self._drawing_precision(),
         }
+
+    def _drawing_precision(self) -> dict[str, float | None]:
+        """The robot's ink against the desired pen-down paths of the whole game, mm (None without ground truth)."""
+        from .drawing import _distance_to_runs, _pen_down_runs
+
+        if self.pen_path is None:
+            return {"drawing_rms_mm": None, "drawing_max_mm": None}
+        ink = [p for p in self.pen_path.robot_ink() if len(p)]
+        if not ink or not self.pen_path.xyz:
+            return {"drawing_rms_mm": None, "drawing_max_mm": None}
+        runs = _pen_down_runs(np.asarray(self.pen_path.xyz), self.params.board.surface_z)
+        if not runs:
+            return {"drawing_rms_mm": None, "drawing_max_mm": None}
+        err = _distance_to_runs(np.vstack(ink), runs) * 1e3
+        return {"drawing_rms_mm": round(float(np.sqrt(np.mean(err ** 2))), 4),
+                "drawing_max_mm": round(float(err.max()), 4)}
 
     def checkpoint(self) -> dict[str, Any]:
         """The state of a game at a chart-step boundary, as a record keeps it: readable parts and one digest.

@@ -30,6 +30,7 @@ from ..params import ArmParams
 from ..sched.scheduler import Scheduler, Signals
 from ..twin.kinematics import link_points
 from ..twin.sim import ArmSim
+from ..twin.truth import GroundTruth
 from .wires import BLOCKS, INIT_WIRES
 from .wiring import Wiring, not_wired, wire_stages
 
@@ -186,10 +187,10 @@ class InitMonitor:
     Simulation only: it measures against the twin's ground truth.
     """
 
-    def __init__(self, params: ArmParams, sim: ArmSim, allowance_rad: float) -> None:
+    def __init__(self, params: ArmParams, arm: Arm, truth: GroundTruth, allowance_rad: float) -> None:
         self.params = params
-        self.sim = sim
-        self.truth = sim.truth
+        self.arm = arm
+        self.truth = truth
         allowance = np.array([allowance_rad, 0.0, 0.0])
         self.lo = np.array([d.limit_min_rad for d in params.drives]) - allowance
         self.hi = np.array([d.limit_max_rad for d in params.drives]) + allowance
@@ -199,8 +200,8 @@ class InitMonitor:
 
     def tick(self, signals: Signals) -> None:
         """Check this chart step's setpoints and the true tool position."""
-        sim, truth = self.sim, self.truth
-        q_true_cmd = np.asarray(signals.q_set[:3]) - sim.offset_estimate + truth.offsets
+        truth = self.truth
+        q_true_cmd = np.asarray(signals.q_set[:3]) - np.asarray(self.arm.offset_estimates()) + truth.offsets
         over = np.maximum(q_true_cmd - self.hi, self.lo - q_true_cmd)
         self.max_overtravel_rad = max(self.max_overtravel_rad, float(over.max()))
         if np.any(over > 0):
@@ -254,38 +255,54 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
     """
     q_power_on = settled_pose(params, q_start, settle_s, seed) if settle_s > 0 else q_start
     sim = ArmSim(params, seed=seed, q0=q_power_on)
-    q0_true = sim.truth.q
-    sched = Scheduler(params, sim)
+    return init_once(params, sim, sim.truth, timeout_s)
+
+
+def init_once(params: ArmParams, arm: Arm, truth: GroundTruth, timeout_s: float = DEFAULT_INIT_TIMEOUT_S) -> InitRun:
+    """Run the init charts once on `arm` from where it stands, watched against `truth` (:class:`InitMonitor`).
+
+    The twin (:func:`run_init`), or an emulated arm behind a serial link whose
+    emulator sends its ground truth (``ttt-sm init --arm serial:PORT``).
+    """
+    q0_true = truth.q
+    sched = Scheduler(params, arm)
     charts = make_init_charts(params)
-    stage = DriveInitStage(params, sim, sched, charts)
+    stage = DriveInitStage(params, arm, sched, charts)
     wire_stages(INIT_WIRES, {c.chart_name: c for c in charts}, [stage], BLOCKS)
     # Drive 1 may push its setpoint past a stop by its stall band (and one more step) to find it.
     one_step = charts[0].search_speed * params.control.chart_dt
-    monitor = InitMonitor(params, sim, allowance_rad=charts[0].stall_lag + one_step)
+    monitor = InitMonitor(params, arm, truth, allowance_rad=charts[0].stall_lag + one_step)
     sched.joint_stages = [stage, monitor]
-    t0 = sim.t
+    t0 = arm.t
     sched.run_until(lambda: stage.done or stage.failed, timeout_s)
     return InitRun(
         q_power_on=tuple(float(v) for v in q0_true),  # type: ignore[arg-type]
         success=stage.done,
-        time_s=round(sim.t - t0, 4),
+        time_s=round(arm.t - t0, 4),
         limit_violations=monitor.limit_violations,
         board_zone_ticks=monitor.zone_ticks,
-        offset_error_rad=tuple(float(v) for v in sim.offset_estimate - sim.truth.offsets),  # type: ignore
+        offset_error_rad=tuple(float(v) for v in np.asarray(arm.offset_estimates()) - truth.offsets),  # type: ignore
         max_overtravel_rad=round(monitor.max_overtravel_rad, 5),
     )
 
 
 def init_report(params: ArmParams, starts: int, seed: int = 0, timeout_s: float = DEFAULT_INIT_TIMEOUT_S,
-                status: Callable[[str], None] | None = None) -> dict[str, Any]:
+                status: Callable[[str], None] | None = None, arm: Arm | None = None,
+                truth: GroundTruth | None = None) -> dict[str, Any]:
     """Initialise from `starts` random power-on poses: what `ttt-sm init --json` prints.
 
     Each run is bounded by `timeout_s` of simulated time; `status` hears where the runs are.
+    With `arm` (and its `truth`), one run on that arm from where it stands (`starts` must be 1).
     """
     rng = np.random.default_rng(seed)
     wall0 = time.perf_counter()
     runs: list[InitRun] = []
-    for k in range(starts):
+    if arm is not None:
+        if truth is None or starts != 1:
+            raise ValueError("an arm behind a serial link initialises once, from where it stands, and is watched"
+                             " against its emulator's ground truth" + ("" if truth else ": this one sends none"))
+        runs.append(init_once(params, arm, truth, timeout_s))
+    for k in range(starts if arm is None else 0):
         if status is not None:
             status(f"init: power-on pose {k + 1} of {starts}, {sum(r.success for r in runs)} initialised so far")
         runs.append(run_init(params, seed=seed + k, q_start=random_power_on(params, rng), timeout_s=timeout_s))

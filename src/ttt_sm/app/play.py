@@ -15,8 +15,10 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from ..arm import Arm
 from ..params import ArmParams
 from ..twin.board_picture import save_board_picture
+from ..twin.truth import GroundTruth
 from .drawing import DrawError, DrawSession
 
 #: What the demo draws, in order: (kind, row, column).
@@ -28,11 +30,15 @@ def _what(kind: str, row: int, column: int) -> str:
 
 
 def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
-             progress: Callable[[str], None] | None = None) -> dict[str, Any]:
-    """Initialise, draw the field, an X and an O, erase, finish; return what happened."""
+             progress: Callable[[str], None] | None = None, arm: Arm | None = None,
+             truth: GroundTruth | None = None) -> dict[str, Any]:
+    """Initialise, draw the field, an X and an O, erase, finish; return what happened.
+
+    `arm` and `truth`: another arm than the twin (``--arm serial:PORT``) and the ground truth it offers.
+    """
     say = progress or (lambda _m: None)
     wall0 = time.perf_counter()
-    session = DrawSession(params, seed=seed, progress=say)
+    session = DrawSession(params, seed=seed, progress=say, arm=arm, truth=truth)
     robot = session.robot
     t_ready = session.start()
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -27,7 +27,7 @@ from ..params import ArmParams
 from ..runtime import TickChart
 from ..sched.scheduler import Scheduler, Signals, Stage
 from ..twin.sim import ArmSim
-from ..twin.truth import ArmTruth
+from ..twin.truth import GroundTruth
 from ..twin.whiteboard import Whiteboard
 from ..twin.workspace import check_reach
 from .compensation import GearPlayCompensation
@@ -43,7 +43,7 @@ class BoardStage:
     Simulation only: the simulated whiteboard is inked by the true tool.
     """
 
-    def __init__(self, board: Whiteboard, truth: ArmTruth) -> None:
+    def __init__(self, board: Whiteboard, truth: GroundTruth) -> None:
         self.board = board
         self.truth = truth
 
@@ -75,7 +75,7 @@ class Robot:
     arm : Arm, optional
         The arm to drive; None builds the simulated arm (:class:`ArmSim`) from
         `params`, `seed`, `q_start` and `settle_s`.
-    truth : ArmTruth, optional
+    truth : GroundTruth, optional
         Ground truth for the simulation-only parts (the whiteboard's ink, the
         ``q_true`` and ``tool_true`` signals); by default the simulated arm's
         own.  Without it (an arm that is no simulation) the whiteboard stays
@@ -88,7 +88,7 @@ class Robot:
 
     def __init__(self, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
                  settle_s: float = 0.0, listeners: Sequence[object] = (), arm: Arm | None = None,
-                 truth: ArmTruth | None = None, wires: Sequence[Wire] = ROBOT_WIRES) -> None:
+                 truth: GroundTruth | None = None, wires: Sequence[Wire] = ROBOT_WIRES) -> None:
         check_reach(params)  # a field out of reach would be drawn as nothing, silently
         self.params = params
         self.seed = seed

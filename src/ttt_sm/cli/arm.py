@@ -39,6 +39,12 @@ def register(sub: Any) -> argparse.ArgumentParser:
     serve.add_argument("--precision", choices=("float", "double"), default="float",
                        help="the firmware's number type (default float, as the reference board)")
     serve.add_argument("--seed", type=seed, default=0, help="seed of the plant's current noise (default 0)")
+    serve.add_argument("--no-truth", dest="truth", action="store_false",
+                       help="send only what a board sends: no EMU_TRUTH frames (the plant's true angles, which the"
+                            " PC's simulated whiteboard and precision figures need)")
+    serve.add_argument("--realtime-priority", action="store_true",
+                       help="run the emulator at SCHED_FIFO priority, as a board's loop runs first (Linux, root or"
+                            " CAP_SYS_NICE; said when refused)")
     serve.add_argument("--duration", type=float, default=None, help="stop after this many seconds (default: Ctrl-C)")
     serve.add_argument("--json", action="store_true", help="print the emulator's counts as one JSON document")
     serve.set_defaults(func=cmd_arm_serve)
@@ -60,14 +66,26 @@ def cmd_arm_serve(args: argparse.Namespace) -> int:
         return _fail(f"--duration must be a finite number >= 0 of seconds, got {args.duration}")
     params = load_arm(args.params)
     try:
-        emu = ArmEmulator(params, pace=args.pace, link=args.link, precision=args.precision, seed=args.seed)
+        emu = ArmEmulator(params, pace=args.pace, link=args.link, precision=args.precision, seed=args.seed,
+                          truth=args.truth, realtime=args.realtime_priority)
     except (ArmEmulatorError, FirmwareError) as exc:
         return _fail(str(exc))
+    import gc
+
+    gc.freeze()  # the firmware, the plant and the libraries stay: a collection walks only what the loop makes
     try:
         with emu:
             print(f"arm: the {args.precision} firmware on the twin's plant ({args.pace}) on {emu.port};"
                   + ("" if args.duration is not None else " Ctrl-C stops"), file=sys.stderr, flush=True)
             end = math.inf if args.duration is None else time.monotonic() + args.duration
+            time.sleep(0.05)  # the firmware's thread has asked for its priority
+            if emu.priority_note:
+                print(f"arm: {emu.priority_note}; the firmware runs at the normal priority", file=sys.stderr,
+                      flush=True)
+            elif args.realtime_priority:
+                from ..ptylink import realtime_priority
+
+                realtime_priority()  # this thread too: held off the processor, it could hold the firmware's up
             while time.monotonic() < end:
                 time.sleep(min(0.05, max(0.0, end - time.monotonic())))
     except KeyboardInterrupt:

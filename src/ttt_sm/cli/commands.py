@@ -15,9 +15,20 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..params import ArmParams
-from .common import CliError, add_command, clear_status, emit, out_dir, print_json, progress, status_line
+from .common import (
+    CliError,
+    add_arm_option,
+    add_command,
+    clear_status,
+    emit,
+    out_dir,
+    print_json,
+    progress,
+    status_line,
+)
 
 if TYPE_CHECKING:
+    from ..app.arms import ArmConnection
     from ..app.game import GameSession
     from ..runtime.export import ExtraDiagram
 
@@ -30,12 +41,31 @@ def load_arm(path: str | None) -> ArmParams:
     return load(path)
 
 
+def open_arm(args: argparse.Namespace, params: ArmParams) -> ArmConnection | None:
+    """The arm ``--arm`` names, opened (None: the twin, built by the command); one error line if it cannot be."""
+    from ..app.arms import ArmChoiceError, connect_arm
+
+    try:
+        return connect_arm(getattr(args, "arm", "sim"), params)
+    except ArmChoiceError as exc:
+        raise CliError(str(exc)) from None
+
+
 def cmd_demo(args: argparse.Namespace) -> int:
+    from ..app.drawing import DrawError
     from ..app.play import run_play
 
     out = out_dir(args.out)
     params = load_arm(args.params)
-    result = run_play(params, seed=args.seed, out_dir=out, progress=progress(True))
+    conn = open_arm(args, params)
+    try:
+        result = run_play(params, seed=args.seed, out_dir=out, progress=progress(True),
+                          arm=conn.arm if conn else None, truth=conn.truth if conn else None)
+    except DrawError as exc:
+        raise CliError(str(exc)) from exc
+    finally:
+        if conn is not None:
+            conn.close()
     lines = [f"  {k}: {v}" for k, v in result.items() if k != "drawings"]
     emit(result, args.json, "demo:\n" + "\n".join(lines))
     return 0
@@ -53,6 +83,7 @@ def cmd_play(args: argparse.Namespace) -> int:
     out = out_dir(args.out)
     record = GameRecord.open(out / "game.jsonl")
     session: GameSession | None = None
+    conn: ArmConnection | None = None
 
     finished = False
 
@@ -68,6 +99,7 @@ def cmd_play(args: argparse.Namespace) -> int:
     try:
         try:
             params = load_arm(args.params)
+            conn = open_arm(args, params)
             say = progress(True)
             opponent = args.opponent
             stdin_open = sys.stdin is not None and not sys.stdin.closed
@@ -82,7 +114,8 @@ def cmd_play(args: argparse.Namespace) -> int:
                 f"camera {'behind a serial port' if args.camera == 'serial' else 'read directly'}")
             session = GameSession(params, seed=args.seed, robot_symbol=args.robot_symbol, person=person,
                                   engine=args.engine, camera=args.camera, progress=say, out_dir=out,
-                                  time_limit_s=args.time_limit, status=status_line(), record=record)
+                                  time_limit_s=args.time_limit, status=status_line(), record=record,
+                                  arm=conn.arm if conn else None, truth=conn.truth if conn else None)
         except BaseException as exc:  # before the game: the record says so in its one line
             how = "interrupted" if isinstance(exc, (GameInterrupted, KeyboardInterrupt)) else "error"
             record.add(0.0, how, tick=0, waiting_for="setting up the robot (nothing ran yet)",
@@ -109,6 +142,8 @@ def cmd_play(args: argparse.Namespace) -> int:
         clear_status()
         if session is not None:
             session.close()
+        if conn is not None:
+            conn.close()
     return 0
 
 
@@ -136,12 +171,17 @@ def cmd_draw(args: argparse.Namespace) -> int:
         text = str(exc)
         option = {"cell": "--row/--column", "speed": "--speed", "size": "--size"}.get(text.split(" ", 1)[0])
         raise CliError(f"{option}: {text}" if option else text) from exc
+    conn = open_arm(args, params)
     try:
-        session = DrawSession(params, seed=args.seed, progress=progress(True))
+        session = DrawSession(params, seed=args.seed, progress=progress(True), arm=conn.arm if conn else None,
+                              truth=conn.truth if conn else None)
         session.start()
         result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=out)
     except DrawError as exc:
         raise CliError(str(exc)) from exc
+    finally:
+        if conn is not None:
+            conn.close()
     data = dataclasses.asdict(result)
     emit(data, args.json, "\n".join(f"  {k}: {v}" for k, v in data.items()))
     return 0
@@ -171,6 +211,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
         raise CliError(f"--only: unknown bench section(s) {', '.join(unknown)}; choose from {', '.join(SECTIONS)}")
     if args.gui_soak is not None and not args.gui_soak > 0:
         raise CliError(f"--gui-soak: expected a positive number of minutes, got {args.gui_soak}")
+    if args.link_minutes is not None and not 0 < args.link_minutes <= 1440:
+        raise CliError(f"--link-minutes: expected a number of minutes in (0, 1440], got {args.link_minutes}")
     names = only or list(SECTIONS)
     record = RecordFile(out / "bench.jsonl")
     record.add({"event": "bench", "sections": names, "seed": args.seed, "quick": args.quick,
@@ -191,7 +233,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     try:
         try:
             result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
-                               progress=progress(True), gui_soak_min=args.gui_soak or 0.0, on_section=on_section)
+                               progress=progress(True), gui_soak_min=args.gui_soak or 0.0, on_section=on_section,
+                               link_minutes=args.link_minutes)
         except ValueError as exc:
             raise CliError(str(exc)) from exc
     except BaseException as exc:  # the record and the --json document say what was measured and where it stopped
@@ -239,10 +282,19 @@ def cmd_init(args: argparse.Namespace) -> int:
     if not 0 < args.time_limit <= 3600:
         raise CliError(f"--time-limit must lie in (0, 3600] simulated seconds, got {args.time_limit}")
     params = load_arm(args.params)
+    if args.arm != "sim" and args.starts != 1:
+        raise CliError(f"--starts {args.starts}: an arm behind a serial link initialises once, from where it stands;"
+                       " give --starts 1")
+    conn = open_arm(args, params)
     try:
-        report = init_report(params, args.starts, seed=args.seed, timeout_s=args.time_limit, status=status_line())
+        report = init_report(params, args.starts, seed=args.seed, timeout_s=args.time_limit, status=status_line(),
+                             arm=conn.arm if conn else None, truth=conn.truth if conn else None)
+    except ValueError as exc:
+        raise CliError(f"--arm {args.arm}: {exc}") from exc
     finally:
         clear_status()
+        if conn is not None:
+            conn.close()
     text = "\n".join(f"  {k}: {v}" for k, v in report.items())
     emit(report, args.json, f"init from {args.starts} random power-on poses:\n{text}")
     ok = report["successes"] == report["runs"] and not report["limit_violations"] \
@@ -304,8 +356,10 @@ def register(sub: Any) -> None:
     sp.add_argument("--time-limit", type=float, default=1200.0, metavar="SECONDS",
                     help="longest the game may run in simulated seconds (default 1200; a game takes ~190)")
     sp.add_argument("--out", default="out/play", help="folder for the game record and the board PNGs")
+    add_arm_option(sp)
     sp = add_command(sub, "demo", cmd_demo, "initialise, draw the field, an X and an O, erase, finish (no game)")
     sp.add_argument("--out", default="out/demo", help="folder for the board PNGs (default out/demo)")
+    add_arm_option(sp)
     sp = add_command(sub, "draw", cmd_draw,
                      "draw one thing with the Control chart and measure its precision (thesis 3.5)")
     sp.add_argument("kind", choices=["field", "X", "O", "sine"])
@@ -314,14 +368,17 @@ def register(sub: Any) -> None:
     sp.add_argument("--speed", type=float, default=None, help="drawing speed, mm/s (default 20)")
     sp.add_argument("--size", type=float, default=None, help="symbol size, mm (default 18)")
     sp.add_argument("--out", default="out/draw", help="folder for the board PNG and the path plot")
+    add_arm_option(sp)
     sp = add_command(sub, "tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
     sp = add_command(sub, "bench", cmd_bench, "measure the speed and quality targets")
     sp.add_argument("--only", default=None,
-                    help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui")
+                    help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui,link")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
     sp.add_argument("--gui-soak", metavar="MIN", type=float, default=None,
                     help="gui section: also run MIN minutes at x10 and report the memory after 1 and after MIN")
+    sp.add_argument("--link-minutes", metavar="MIN", type=float, default=None,
+                    help="link section: stream setpoints to the emulator for MIN minutes (default 10; --quick: 5 s)")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
     sp = add_command(sub, "ik", cmd_ik, "solve inverse kinematics for one tool pose")
     sp.add_argument("x", type=float, help="mm")
@@ -333,6 +390,7 @@ def register(sub: Any) -> None:
                     help=f"number of random power-on poses, 1..{MAX_STARTS} (default 20)")
     sp.add_argument("--time-limit", type=float, default=40.0, metavar="SECONDS",
                     help="longest one initialisation may run, simulated seconds (default 40; one takes 6-12)")
+    add_arm_option(sp)
     sp = add_command(sub, "charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
     sp.add_argument("action", choices=["export", "check"])
     sp.add_argument("--format", default=None,

@@ -124,6 +124,22 @@ def join_negative_values(parser: argparse.ArgumentParser, argv: Sequence[str]) -
     return out
 
 
+def arm_choice(text: str) -> str:
+    """The ``type`` of every ``--arm``: ``sim`` or ``serial:PORT`` (the port is opened when the command runs)."""
+    kind, sep, port = text.partition(":")
+    if text == "sim" or (kind == "serial" and sep and port.strip()):
+        return text
+    raise argparse.ArgumentTypeError(f"expected sim or serial:PORT (a serial device or the link of ttt-sm arm"
+                                     f" serve), got {text[:80]!r}")
+
+
+def add_arm_option(sp: argparse.ArgumentParser) -> None:
+    """The ``--arm`` option of the commands that drive the robot (docs/hardware.md, "Choosing the arm")."""
+    sp.add_argument("--arm", type=arm_choice, default="sim", metavar="sim|serial:PORT",
+                    help="sim (default): the twin in this process; serial:PORT: the arm behind a serial link"
+                         " (a board, or ttt-sm arm serve's link)")
+
+
 def seed(text: str) -> int:
     """The ``type`` of every ``--seed``: a whole number 0 .. 2**63 - 1 (numpy's generators take no negative
     seed, and a run is reproducible from it)."""

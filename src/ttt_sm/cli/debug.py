@@ -13,7 +13,8 @@ from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 from ..params import shown_path
-from .common import CliError, seed, trace_file
+from .commands import open_arm
+from .common import CliError, add_arm_option, seed, trace_file
 
 if TYPE_CHECKING:
     from ..debug.debugger import Debugger
@@ -26,6 +27,7 @@ def register(sub: Any) -> argparse.ArgumentParser:
     sp: argparse.ArgumentParser = sub.add_parser("debug", help=help_, description=help_)
     sp.set_defaults(func=cmd_debug)
     sp.add_argument("--seed", type=seed, default=0, help="seed of the simulated arm (default 0)")
+    add_arm_option(sp)
     sp.add_argument("--start", metavar="Q1,Q2,Q3[,Q4]", default=None,
                     help="joint angles before power-on, degrees (default: the twin's rest pose)")
     sp.add_argument("--settle", metavar="SECONDS", type=float, default=0.0,
@@ -99,8 +101,12 @@ def cmd_debug(args: argparse.Namespace) -> int:
         if args.settle > max_run:
             raise ValueError(f"--settle: {args.settle:g} s is beyond {max_run:g} s of simulated time, the longest"
                              " one command runs (raise it with --max-run)")
+        if args.arm != "sim" and (q_start is not None or args.settle):
+            raise ValueError("--start and --settle pose the twin; an arm behind a serial link starts where it stands")
+        conn = open_arm(args, params)
         dbg = Debugger.build(params, seed=args.seed, q_start=q_start, settle_s=args.settle, max_run_s=max_run,
-                             game=args.game, trace_path=trace_path)
+                             game=args.game, trace_path=trace_path, arm=conn.arm if conn else None,
+                             truth=conn.truth if conn else None)
     except ValueError as exc:  # a bad pose (SimError), a bad option
         raise CliError(str(exc)) from exc
     shell = DebugShell(dbg)
@@ -110,6 +116,9 @@ def cmd_debug(args: argparse.Namespace) -> int:
         how, data = ending_of(exc)
         dbg.end_trace(how, **data, command=shell.command)
         raise
+    finally:
+        if conn is not None:
+            conn.close()
     dbg.end_trace("finished", errors=shell.errors)
     return status
 
@@ -117,7 +126,8 @@ def cmd_debug(args: argparse.Namespace) -> int:
 def _run_shell(args: argparse.Namespace, dbg: Debugger, shell: DebugShell, q_start: tuple[float, ...] | None) -> int:
     start = "rest pose" if q_start is None else \
         "(" + ", ".join(f"{math.degrees(v):.1f}" for v in q_start) + ") deg"
-    shell.say(f"ttt-sm debugger: seed {args.seed}, start {start}"
+    shell.say(f"ttt-sm debugger: seed {args.seed}, "
+              + (f"start {start}" if args.arm == "sim" else f"the arm behind {args.arm}")
               + (f", settled {args.settle:g} s" if args.settle else "")
               + (", a game: robot O against a simulated person X, camera read in-process" if args.game else "")
               + f"; charts {', '.join(dbg.chart_names)}. Type help.")

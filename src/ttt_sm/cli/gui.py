@@ -16,7 +16,8 @@ import webbrowser
 from pathlib import Path
 from typing import Any
 
-from .common import CliError, out_dir, seed, trace_file
+from .commands import open_arm
+from .common import CliError, add_arm_option, out_dir, seed, trace_file
 
 DEFAULT_PORT = 8765
 LOOPBACK = ("127.0.0.1", "localhost", "::1")
@@ -31,6 +32,7 @@ def register(sub: Any) -> argparse.ArgumentParser:
                     help="address to listen on (default 127.0.0.1; any other needs the printed token)")
     sp.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default {DEFAULT_PORT}; 0: any free one)")
     sp.add_argument("--seed", type=seed, default=0, help="seed of the simulated arm (default 0)")
+    add_arm_option(sp)
     sp.add_argument("--game", action="store_true",
                     help="a whole game: the Game and AlgorithmActivator charts too; the person plays in the"
                          " /game page")
@@ -118,8 +120,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
         raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
     port = sock.getsockname()[1]
     print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
+    conn = open_arm(args, params)
     dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person, trace_path=trace,
-                         record_root=record_root)
+                         record_root=record_root, arm=conn.arm if conn else None, truth=conn.truth if conn else None)
     try:
         session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
                           camera_feed=feed)
@@ -159,6 +162,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
         how, data = ending_of(exc)
         dbg.end_trace(how, **data)  # nothing if the session ended it already
         raise
+    finally:
+        if conn is not None:
+            conn.close()
     dbg.end_trace("finished")  # nothing if the session ended it already
     print("ttt-sm gui: stopped", flush=True)
     return 0

@@ -48,17 +48,19 @@ from typing import Any
 
 from ..app.game import GameError, GameSession
 from ..app.robot import Robot, RobotError
+from ..arm import Arm
 from ..params import ArmParams
 from ..runtime import Data, TickChart, UnknownEventError
 from ..runtime.errors import GraphvizMissingError
 from ..runtime.export import render_active
 from ..runtime.listeners import Trace
 from ..runtime.recordfile import RecordFile
+from ..twin.truth import GroundTruth
 from .breakpoints import BreakListener, Breakpoint, ChartIndex, Hit, parse_breakpoint
 from .errors import DebugError
 from .names import RobotNames, datum_decl, parse_input_value
 from .records import Action, DataChange, DataDiff, StopKind, StopReason
-from .replay import GameRecipe, Recipe, ReplayResult, RobotRecipe, differences, fingerprint, game_of
+from .replay import ArmRecipe, GameRecipe, Recipe, ReplayResult, RobotRecipe, differences, fingerprint, game_of
 from .timeline import Timeline, TimelineWindow
 
 #: The longest one command (run, next, step, tick) may run unless raised, seconds of
@@ -131,7 +133,8 @@ class Debugger:
     def build(cls, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
               settle_s: float = 0.0, *, game: bool = False, person: str = "simulated",
               max_run_s: float = DEFAULT_MAX_RUN_S, trace_path: str | Path | None = None,
-              record_root: Path | None = None) -> Debugger:
+              record_root: Path | None = None, arm: Arm | None = None,
+              truth: GroundTruth | None = None) -> Debugger:
         """A debugger on a new robot, with its recipe for :meth:`replay`.
 
         ``game``: the robot plays a game (:class:`~.replay.GameRecipe`: the Game
@@ -141,7 +144,12 @@ class Debugger:
         ``trace_path``: stream the whole trace there (see the class).
         ``record_root``: with ``game``, the game's record is written to
         ``record_root/game-1/game.jsonl`` as it is played.
+        ``arm`` (and the ``truth`` it offers): another arm than the twin
+        (``--arm serial:PORT``); the robot is built on it once (no replay).
         """
+        if arm is not None:
+            arm_recipe = ArmRecipe(params, arm, truth, seed, game=game, person=person)
+            return cls(arm_recipe.build(), arm_recipe, max_run_s=max_run_s, trace_path=trace_path)
         pose = None if q_start is None else tuple(float(v) for v in q_start)
         recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person, record_root=record_root) \
             if game else RobotRecipe(params, seed, pose, settle_s)
@@ -585,6 +593,8 @@ class Debugger:
         return fingerprint(self.robot, self.forced)
 
     def _remember(self) -> None:
+        if self.robot.sim is None:  # no twin, nothing a replay could compare
+            return
         kept = self._fingerprints
         kept[self.robot.steps] = self.fingerprint()
         if len(kept) > MAX_FINGERPRINTS:

@@ -17,8 +17,10 @@ from typing import Any, Protocol
 
 from ..app.game import GameSession, RemotePerson
 from ..app.robot import Robot
+from ..arm import Arm
 from ..params import ArmParams
 from ..twin.sim import ArmSim
+from ..twin.truth import GroundTruth
 from .errors import DebugError
 
 #: Quantities of the simulated arm a fingerprint compares (arrays, exact floats): its
@@ -101,6 +103,37 @@ class GameRecipe:
         session = GameSession(self.params, seed=self.seed, robot_symbol=self.robot_symbol, engine=self.engine,
                               person=person, camera="direct", record_trace=out_dir is not None,
                               q_start=self.q_start, settle_s=self.settle_s, out_dir=out_dir)
+        session.drive()
+        return session.robot
+
+
+@dataclass
+class ArmRecipe:
+    """A robot on an arm that is not the twin (``--arm serial:PORT``), alone or in a game.
+
+    It is built once: an arm behind a serial link cannot be powered on again
+    in the same state, so a replay is refused with a line that says so.
+    """
+
+    params: ArmParams
+    arm: Arm
+    truth: GroundTruth | None
+    seed: int = 0
+    game: bool = False
+    person: str = "simulated"
+    built: bool = False
+
+    def build(self) -> Robot:
+        if self.built:
+            raise DebugError("replay needs the twin: an arm behind a serial link cannot be powered on again in the"
+                             " state it started from")
+        self.built = True
+        if not self.game:
+            return Robot(self.params, seed=self.seed, arm=self.arm, truth=self.truth)
+        if self.person not in ("simulated", "page"):
+            raise ValueError(f"the person is 'simulated' or 'page', got {self.person!r}")
+        session = GameSession(self.params, seed=self.seed, person=RemotePerson() if self.person == "page" else None,
+                              camera="direct", record_trace=False, arm=self.arm, truth=self.truth)
         session.drive()
         return session.robot
 

@@ -27,20 +27,19 @@ from __future__ import annotations
 import logging
 import os
 import select
-import shutil
-import tempfile
 import threading
 import time
-import tty
 from pathlib import Path
 from typing import Literal
 
 import numpy as np
 
 from ..params import ArmParams
+from ..ptylink import PtyLink, PtyLinkError, realtime_priority
 from ..twin import _cascade as C
 from ..twin import _plant as PL
 from ..twin.plant import REST_POSE, Plant, check_pose
+from . import link as L
 from .firmware import Precision, build
 from .native import FirmwareLibrary, NativeFirmware, board_for
 
@@ -68,8 +67,8 @@ class FirmwareOnPlant:
         self._ints = self.plant.ints
         self._ps = self.plant.ps
 
-    def step(self) -> None:
-        """One control step: the plant's sensors into the firmware, its commands onto the plant."""
+    def read_sensors(self) -> None:
+        """The plant's sensors into the firmware's input (no step)."""
         s, ints = self.firmware.sensors, self._ints
         for d in range(3):
             s.counts[d] = int(ints[d, PL.PI_COUNTS])
@@ -77,6 +76,15 @@ class FirmwareOnPlant:
             s.index_edges[d] = int(ints[d, PL.PI_INDEX_EDGES]) & 0xFFFF
             s.current_a[d] = float(self._ps[d, PL.PS_I_MEAS])
         s.index = sum(1 << d for d in range(3) if ints[d, PL.PI_INDEX] == 1)
+
+    def sense(self) -> None:
+        """The firmware takes the plant's sensors without a step (a gated clock, before START)."""
+        self.read_sensors()
+        self.firmware.sense()
+
+    def step(self) -> None:
+        """One control step: the plant's sensors into the firmware, its commands onto the plant."""
+        self.read_sensors()
         self.firmware.step()
         self._act[:] = self.firmware.act
         self.plant.step(self._act)
@@ -99,12 +107,22 @@ class ArmEmulator:
         The firmware's number type: ``"float"`` (the reference board) or ``"double"``.
     seed, q0
         The plant's noise seed and its pose at power-on.
+    truth
+        Send the plant's true angles (``EMU_TRUTH``, simulation only) before
+        each burst of the firmware's frames, so that the PC's simulated
+        whiteboard is inked where the emulated pen really is; off, the wire
+        carries exactly what a board sends.
+    realtime
+        Run the firmware's thread at ``SCHED_FIFO`` priority
+        (:func:`ttt_sm.ptylink.realtime_priority`), as a board's control
+        loop runs before anything else; :attr:`priority_note` says why not
+        when the system refuses.
     """
 
     def __init__(self, params: ArmParams, *, pace: Pace = "gated", link: str | os.PathLike[str] | None = None,
                  precision: Precision = "float", seed: int = 0,
                  q0: tuple[float, float, float, float] | None = None, cache: Path | None = None,
-                 logger: logging.Logger | None = None) -> None:
+                 logger: logging.Logger | None = None, truth: bool = False, realtime: bool = False) -> None:
         if pace not in PACES:
             raise ArmEmulatorError(f"pace must be one of {', '.join(PACES)}, got {pace!r}")
         self.params = params
@@ -112,55 +130,51 @@ class ArmEmulator:
         self.dt = params.control.dt
         self._lib = FirmwareLibrary(build(precision, cache), precision)
         self.bench = FirmwareOnPlant(params, self._lib, seed=seed, q0=q0)
+        # The plant's compiled step is loaded on its first call (a third of a second): on a scratch plant
+        # now, not on the first control step, which a PC would wait for in vain.
+        Plant(params, check_pose(params, REST_POSE), np.random.default_rng(0)).step(np.zeros(C.N_ACT))
         self.firmware = self.bench.firmware
         #: The physics (simulation only): ground truth for tests.
         self.plant = self.bench.plant
-        self._own_dir: Path | None = None
-        if link is None:
-            self._own_dir = Path(tempfile.mkdtemp(prefix="ttt-arm-"))
-            link = self._own_dir / "arm"
-        self._link = Path(link)
-        if not self._link.parent.is_dir():
-            raise ArmEmulatorError(f"the folder of the link {self._link} does not exist; create it or choose"
-                                   " another --link")
-        if self._link.exists() and not self._link.is_symlink():
-            raise ArmEmulatorError(f"{self._link} exists and is not a symlink; the emulator only replaces its own"
-                                   " link: choose another --link")
+        try:
+            self._pty = PtyLink(link, "arm")
+        except PtyLinkError as exc:
+            raise ArmEmulatorError(str(exc)) from None
         self._log = logger or _LOG
         self._lock = threading.RLock()
-        self._master: int | None = None
-        self._slave: int | None = None
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._out = bytearray()
         self.bytes_in = 0
         self.bytes_out = 0
         self.bytes_dropped = 0
+        self.truth = truth
+        self.realtime = realtime
+        #: Why the thread did not get its real-time priority (None: it did, or it was not asked).
+        self.priority_note: str | None = None
+        self._truth_tx = L.Sender()
+        self.truth_bytes = 0
+        ints, rpc = self.plant.ints, [d.rad_per_count for d in params.drives]
+        c0 = [float((ints[d, PL.PI_C0] + 0.5) * rpc[d]) for d in range(3)]
+        self._true_offsets = (c0[0], c0[1], c0[2])
         self._gate = 0  # setpoints frames seen by the gated clock
         self._until = 0  # ... which let it run to this step
 
     @property
     def port(self) -> str:
         """The stable path the PC opens (a symlink to the pty)."""
-        return str(self._link)
+        return self._pty.port
 
     def start(self) -> ArmEmulator:
         """Make the pty and its link, and run the firmware in a background thread."""
         if self._thread is not None:
             return self
-        master, slave = os.openpty()
-        tty.setraw(slave)  # bytes pass as on a UART: no echo, no line discipline
-        os.set_blocking(master, False)
-        self._master, self._slave = master, slave
-        tmp = self._link.with_name(f".{self._link.name}.{os.getpid()}.tmp")
-        tmp.unlink(missing_ok=True)
-        os.symlink(os.ttyname(slave), tmp)
-        os.replace(tmp, self._link)
+        device = self._pty.open()
         self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name=f"arm-emulator {self._link}", daemon=True)
+        self._thread = threading.Thread(target=self._run, name=f"arm-emulator {self._pty.link}", daemon=True)
         self._thread.start()
-        self._log.info("arm emulator (%s, %s firmware): %s -> %s", self.pace, self._lib.precision, self._link,
-                       os.ttyname(slave))
+        self._log.info("arm emulator (%s, %s firmware): %s -> %s", self.pace, self._lib.precision, self._pty.link,
+                       device)
         return self
 
     def stop(self, timeout_s: float = 5.0) -> None:
@@ -170,14 +184,7 @@ class ArmEmulator:
         if thread is not None:
             thread.join(timeout_s)
         with self._lock:
-            self._link.unlink(missing_ok=True)
-            for fd in (self._master, self._slave):
-                if fd is not None:
-                    os.close(fd)
-            self._master = self._slave = None
-        if self._own_dir is not None:
-            shutil.rmtree(self._own_dir, ignore_errors=True)
-            self._own_dir = None
+            self._pty.remove()
 
     def hang(self, timeout_s: float = 5.0) -> None:
         """Stop the firmware but leave the port open, as a board that hangs: bytes go in, nothing comes out."""
@@ -195,10 +202,12 @@ class ArmEmulator:
     # -- the thread ----------------------------------------------------------------
 
     def _run(self) -> None:
+        if self.realtime:
+            self.priority_note = realtime_priority()
         t0 = time.monotonic()
         fw = self.firmware
         while not self._stop.is_set():
-            fd = self._master
+            fd = self._pty.master
             if fd is None:
                 return
             readable, _, _ = select.select([fd], [], [], 0.0005)
@@ -226,10 +235,20 @@ class ArmEmulator:
             time.sleep(0.001)
             return
         self.bytes_in += len(data)
+        if self.pace == "gated" and self.firmware.state != 1:
+            self.bench.sense()  # no control step runs before START here: the readings a board would have
         self.firmware.rx(data)
 
     def _send(self, fd: int) -> None:
-        self._out += self.firmware.tx()
+        data = self.firmware.tx()
+        if data and self.truth:  # before the firmware's frames: the PC has it when it reads their status
+            ps, pgs = self.plant.ps, self.plant.pgs
+            frame = self._truth_tx.frame(L.EmuTruth(self.firmware.steps, int(self.pace == "gated"), (
+                float(ps[0, PL.PS_Q]), float(ps[1, PL.PS_Q]), float(ps[2, PL.PS_Q]), float(pgs[PL.PGS_SV_Q])),
+                self._true_offsets))
+            self.truth_bytes += len(frame)
+            self._out += frame
+        self._out += data
         if not self._out:
             return
         try:

@@ -37,13 +37,18 @@ class FirmwareError(RuntimeError):
     """The firmware cannot be found or built: names what is missing or what the compiler said."""
 
 
+#: The firmware's sources beside this module: in a source checkout a link to ``firmware/``, in an
+#: installed wheel a copy (package data).
+PACKAGED_SOURCES = Path(__file__).resolve().parent / "firmware_src"
+
+
 def firmware_root() -> Path:
-    """The firmware's folder: ``$TTT_SM_FIRMWARE`` or ``firmware/`` of the source checkout this package is in."""
+    """The firmware's folder: ``$TTT_SM_FIRMWARE``, else the sources the package carries (:data:`PACKAGED_SOURCES`)."""
     env = os.environ.get(_ENV_SOURCES)
-    root = Path(env) if env else Path(__file__).resolve().parents[3] / "firmware"
+    root = Path(env) if env else PACKAGED_SOURCES
     if not (root / "src").is_dir() or not (root / "include").is_dir():
-        raise FirmwareError(f"no firmware sources at {root} (src/ and include/); the firmware is built from a "
-                            f"source checkout of ttt_sm, or set {_ENV_SOURCES} to its firmware/ folder")
+        raise FirmwareError(f"no firmware sources at {root} (src/ and include/); reinstall ttt_sm, or set"
+                            f" {_ENV_SOURCES} to the firmware/ folder of a source checkout")
     return root
 
 

@@ -53,6 +53,7 @@ class Msg(IntEnum):
     GAINS_READBACK = 0x82
     STATUS = 0x85
     HEARTBEAT_REPLY = 0x86
+    EMU_TRUTH = 0xE0  # the emulator's, never a board's: the plant's true angles (simulation only)
 
 
 class Reason(IntEnum):
@@ -498,8 +499,44 @@ class HeartbeatReply(Message):
         return cls(v[0], v[1], v[2], v[3], tuple(v[4:]))
 
 
+@dataclass(frozen=True)
+class EmuTruth(Message):
+    """The emulator's plant after firmware step `step`: true joint angles q1..q4, true encoder offsets (rad).
+
+    Simulation only: ``ttt-sm arm serve`` sends one before each burst of the
+    firmware's frames so that the PC can ink its simulated whiteboard and
+    measure a drawing's precision; a board never sends it.  Its sequence
+    numbers are its own (the emulator numbers them, not the firmware).
+    `flags` bit 0: the emulator is gated (the PC's setpoints set its pace:
+    it keeps no deadline, so the PC need not hold it to the link's 50 ms).
+    """
+
+    KIND: ClassVar[Msg] = Msg.EMU_TRUTH
+    FORMAT: ClassVar[str] = "<IB4d3d"
+    step: int
+    flags: int
+    q: tuple[float, float, float, float]
+    offsets: tuple[float, float, float]
+
+    def values(self) -> tuple[float | int, ...]:
+        return (self.step, self.flags, *self.q, *self.offsets)
+
+    @classmethod
+    def unpack(cls, body: bytes) -> EmuTruth:
+        v = struct.unpack(cls.FORMAT, body)
+        return cls(v[0], v[1], (v[2], v[3], v[4], v[5]), (v[6], v[7], v[8]))
+
+    @property
+    def gated(self) -> bool:
+        return bool(self.flags & 1)
+
+    def check(self) -> str | None:
+        return None if _finite(self.q + self.offsets) else f"non-finite angles {self.q} {self.offsets}"
+
+
 MESSAGES: dict[int, type[Message]] = {m.KIND: m for m in (
-    Hello, Gains, GainsRead, Setpoints, Heartbeat, Drive, Start, Handshake, GainsReadback, Status, HeartbeatReply)}
+    Hello, Gains, GainsRead, Setpoints, Heartbeat, Drive, Start, Handshake, GainsReadback, Status, HeartbeatReply,
+    EmuTruth)}
 _FIXED_LENGTH = {kind: struct.calcsize(m.FORMAT) for kind, m in MESSAGES.items()
                  if kind not in (Msg.GAINS, Msg.GAINS_READBACK)}
 TO_FIRMWARE = frozenset(k for k in MESSAGES if k < 0x80)
@@ -525,6 +562,8 @@ class Receiver:
     seq: SeqTracker = field(default_factory=SeqTracker)
     rejections: Counter[Reason] = field(default_factory=Counter)
     frames_ok: int = 0
+    emu_seq: SeqTracker = field(default_factory=SeqTracker)
+    """The emulator's own frames (``EMU_TRUTH``) are numbered apart from the firmware's."""
 
     def feed(self, data: bytes) -> list[Message]:
         """The messages in `data` that pass every check, in order."""
@@ -539,9 +578,10 @@ class Receiver:
                 continue
             if item.kind in (Msg.HELLO, Msg.HANDSHAKE):
                 self.seq.reset()
-            refused = self.seq.accept(item.seq)
+            seq = self.emu_seq if item.kind == Msg.EMU_TRUTH else self.seq
+            refused = seq.accept(item.seq)
             if refused is not None:
-                self.reject(Rejection(refused, f"{_name(item.kind)} seq {item.seq} after {self.seq.last}", 0))
+                self.reject(Rejection(refused, f"{_name(item.kind)} seq {item.seq} after {seq.last}", 0))
                 continue
             message = MESSAGES[item.kind].unpack(item.body)
             bad = message.check()
@@ -577,4 +617,5 @@ class Sender:
 __all__ = ["PROTOCOL_VERSION", "Msg", "Reason", "Op", "crc16", "cobs_encode", "cobs_decode", "encode_frame",
            "Frame", "Rejection", "FrameDecoder", "SeqTracker", "Message", "Hello", "Gains", "GainsRead",
            "GainsReadback", "Setpoints", "Heartbeat", "Drive", "Start", "Handshake", "Status", "HeartbeatReply",
+           "EmuTruth",
            "MESSAGES", "TO_FIRMWARE", "TO_PC", "Receiver", "Sender"]

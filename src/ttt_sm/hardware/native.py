@@ -133,6 +133,7 @@ class FirmwareLibrary:
             "ttt_fw_rx": (None, [fw, u8p, ctypes.c_size_t]),
             "ttt_fw_tx": (ctypes.c_size_t, [fw, u8p, ctypes.c_size_t]),
             "ttt_fw_control_step": (None, [fw, ctypes.POINTER(SensorsIn)]),
+            "ttt_fw_sense": (None, [fw, ctypes.POINTER(SensorsIn)]),
             "ttt_fw_cascade": (ptr, [fw]),
             "ttt_fw_state": (ctypes.c_uint8, [fw]),
             "ttt_fw_frames_ok": (ctypes.c_uint32, [fw]),
@@ -264,6 +265,10 @@ class NativeFirmware:
             out += bytes(self._out[:n])
             if n < len(self._out):
                 return bytes(out)
+
+    def sense(self) -> None:
+        """Take :attr:`sensors` (fill it first) without a control step (``ttt_fw_sense``)."""
+        self.lib.lib.ttt_fw_sense(self.ptr, self._sensors_ref)
 
     def step(self) -> None:
         """One control step on :attr:`sensors` (fill it first); the commands are in :attr:`act`."""

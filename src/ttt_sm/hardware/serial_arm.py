@@ -12,15 +12,26 @@ like the twin: ``set_setpoints`` once per chart step, ``step(n)`` sends them
 
 The link is declared lost (:class:`LinkLost`) when no valid status arrives
 within :data:`LINK_TIMEOUT_S` of wall-clock time while waiting for one.
-Rejected frames are counted and logged by its
+While the PC has nothing to send (the charts paused, a debugger at a
+breakpoint), a background thread keeps the link watched: every
+:data:`HEARTBEAT_PERIOD_S` it sends a ``HEARTBEAT`` (the firmware answers
+with a ``HEARTBEAT_REPLY``; on its own clock it also goes on sending its
+``STATUS``), and when no valid frame has come for the link's timeout it
+records a :class:`LinkLoss` (:attr:`SerialArm.lost`, and the
+``on_link_lost`` callback).  Rejected frames are counted and logged by its
 :class:`~ttt_sm.hardware.link.Receiver`.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
+import os
+import select
+import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import TypeVar
 
 import numpy as np
@@ -31,16 +42,84 @@ from ..params import ArmParams
 from ..twin import _cascade as C
 from ..twin.cascade import CascadeController
 from ..twin.control import Gains, check_drive
+from ..twin.kinematics import fk
 from ..twin.tuning import design_gains
 from . import link as L
 
 LINK_TIMEOUT_S = 0.050
 """No valid status for this long while one is due: the link is lost."""
+GATED_TIMEOUT_S = 5.0
+"""The same for a gated emulator (it says so in its ``EMU_TRUTH``): it keeps no deadline, and shares the
+PC's processor, so a loaded machine may hold it up; only a link that is really gone is lost."""
+HEARTBEAT_PERIOD_S = 0.010
+"""With nothing sent for this long, the PC sends a ``HEARTBEAT``: an idle link stays watched both ways."""
+KEEPER_TICK_S = 0.002
+"""How often the idle link's keeper looks at the clock."""
 HANDSHAKE_TIMEOUT_S = 2.0
 BAUD = 921_600
 
 
 M = TypeVar("M", bound=L.Message)
+
+
+class LinkTruth:
+    """Ground truth from an emulator (``EMU_TRUTH`` frames): the emulated plant's true joint angles.
+
+    Simulation only, for what exists in simulation alone (the PC's whiteboard
+    inked by the true pen, a drawing's precision); the charts never see it.
+    It offers what :class:`ttt_sm.twin.truth.ArmTruth` offers those parts:
+    :attr:`q`, :meth:`angles`, :meth:`tool_pose`, :attr:`offsets`.
+    """
+
+    def __init__(self, params: ArmParams, q: tuple[float, float, float, float], offsets: tuple[float, float, float],
+                 step: int) -> None:
+        self.params = params
+        self._q = q
+        self._offsets = offsets
+        #: The firmware step these angles are after.
+        self.step = step
+
+    def update(self, q: tuple[float, float, float, float], step: int) -> None:
+        self._q, self.step = q, step
+
+    @property
+    def q(self) -> np.ndarray:
+        """True joint angles q1..q4 (rad), a copy."""
+        return np.array(self._q)
+
+    def angles(self) -> tuple[float, float, float, float]:
+        return self._q
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """The true encoder offsets (rad): an encoder angle plus these is the joint angle within half a count."""
+        return np.array(self._offsets)
+
+    def tool_pose(self) -> np.ndarray:
+        """The true tool pose x, y, z (m), phi (rad): forward kinematics of :attr:`q`."""
+        return fk(self.q, self.params.geometry)
+
+
+@dataclass(frozen=True)
+class LinkLoss:
+    """The PC declared the link lost: why, and the clock readings it decided on (``time.monotonic``, s).
+
+    ``last_frame_at``: the last valid frame from the firmware.  ``declared_at``:
+    when the silence was found longer than ``timeout_s``.  ``checked_before``:
+    the look before that one, when it was not yet (the loss is declared at
+    the first look past the limit).
+    """
+
+    reason: str
+    last_frame_at: float
+    declared_at: float
+    checked_before: float
+    timeout_s: float
+
+    @property
+    def silence_s(self) -> float:
+        """How long nothing valid had come when the loss was declared."""
+        return self.declared_at - self.last_frame_at
 
 
 class SerialArmError(RuntimeError):
@@ -85,16 +164,52 @@ class SerialArm:
         self.bytes_sent = 0
         self.bytes_received = 0
         self._status: L.Status | None = None
+        self._steps = 0  # control steps run (the arm's time)
+        self._sent_for = -1  # the control step the last setpoints were sent for
+        #: The emulator's ground truth (simulation only); None from a board, which sends none.
+        self.truth: LinkTruth | None = None
+        #: Whether the other end is a gated emulator (its ``EMU_TRUTH`` says so): it keeps no deadline.
+        self.gated = False
         self._replies: list[L.Message] = []
+        #: The wire: one thread at a time sends, reads and decodes (the chart loop, or the idle link's keeper).
+        self._io = threading.RLock()
+        self._last_tx = time.monotonic()
+        #: When the last valid frame came from the firmware (``time.monotonic``).
+        self.last_frame_at = time.monotonic()
+        #: The link's loss, while it lasts (a valid frame clears it); :attr:`losses` keeps every one.
+        self.lost: LinkLoss | None = None
+        self.losses: list[LinkLoss] = []
+        #: Called (from the keeper's thread) when the PC declares the link lost.
+        self.on_link_lost: Callable[[LinkLoss], None] | None = None
+        self.heartbeats_sent = 0
+        self.heartbeat_replies = 0
+        self._tokens = itertools.count(1)
+        #: When (``time.monotonic``) the last new STATUS came, and its firmware step.
+        self.status_at = 0.0
+        self.status_step = 0
+        self._closing = threading.Event()
+        self._keeper: threading.Thread | None = None
+        # The keeper runs at its maker's scheduling priority: one that ran lower could be held off the
+        # processor while holding the interpreter's lock, and hold up a chart loop of higher priority.
+        get_policy = getattr(os, "sched_getscheduler", None)
+        self._policy = (get_policy(0), os.sched_getparam(0)) if get_policy is not None else None
         try:
             self._ser = serial.serial_for_url(port, baudrate=baudrate, timeout=0)
         except (OSError, serial.SerialException) as e:
             raise SerialArmError(f"cannot open the arm's port {port}: {e}") from e
+        fileno = getattr(self._ser, "fileno", None)
         try:
-            self.handshake = self._open()
+            self._fd: int | None = fileno() if fileno is not None else None
+        except (OSError, serial.SerialException, AttributeError):
+            self._fd = None
+        try:
+            with self._io:
+                self.handshake = self._open()
         except BaseException:
             self._ser.close()
             raise
+        self._keeper = threading.Thread(target=self._keep, name=f"serial-arm keeper {port}", daemon=True)
+        self._keeper.start()
 
     # ---- opening the link ---------------------------------------------------------
 
@@ -123,10 +238,16 @@ class SerialArm:
                 raise SerialArmError(f"gains block {block}: read back {back.values_}, sent {tuple(want)}")
         self._send(L.Start())
         self._status = self._wait_for(L.Status, HANDSHAKE_TIMEOUT_S, after_start=True)
+        self._steps = self._status.step
         return hs
 
     def close(self) -> None:
-        self._ser.close()
+        self._closing.set()
+        keeper, self._keeper = self._keeper, None
+        if keeper is not None and keeper is not threading.current_thread():
+            keeper.join(1.0)
+        with self._io:
+            self._ser.close()
 
     def __enter__(self) -> SerialArm:
         return self
@@ -143,18 +264,37 @@ class SerialArm:
         except (OSError, serial.SerialException) as e:
             raise LinkLost(f"cannot write to the arm's port: {e}") from e
         self.bytes_sent += len(data)
+        self._last_tx = time.monotonic()
 
-    def _poll(self) -> None:
+    def _poll(self, wait_s: float = 0.0) -> None:
+        """Read what has come (waiting up to `wait_s` for a first byte, without spinning) and take its frames."""
         try:
+            if wait_s > 0 and not self._ser.in_waiting and self._fd is not None:
+                select.select([self._fd], [], [], wait_s)
             data = self._ser.read(self._ser.in_waiting or 1)
         except (OSError, serial.SerialException) as e:
             raise LinkLost(f"cannot read from the arm's port: {e}") from e
         if data:
             self.bytes_received += len(data)
-            for m in self.rx.feed(data):
+            messages = self.rx.feed(data)
+            if messages:
+                self.last_frame_at = time.monotonic()
+                self.lost = None
+            for m in messages:
                 if isinstance(m, L.Status):
                     if self._status is None or m.step > self._status.step or m.state != self._status.state:
                         self._status = m
+                        self.status_at, self.status_step = self.last_frame_at, m.step
+                elif isinstance(m, L.HeartbeatReply):
+                    self.heartbeat_replies += 1
+                    self._replies.append(m)
+                    del self._replies[:-8]  # replies nobody asked for (the keeper's) are not kept
+                elif isinstance(m, L.EmuTruth):
+                    self.gated = m.gated
+                    if self.truth is None:
+                        self.truth = LinkTruth(self.params, m.q, m.offsets, m.step)
+                    else:
+                        self.truth.update(m.q, m.step)
                 else:
                     self._replies.append(m)
 
@@ -171,37 +311,118 @@ class SerialArm:
             if time.monotonic() > give_up:
                 raise LinkLost(f"no {kind.__name__} from the firmware within {timeout_s * 1000:.0f} ms "
                                f"({self.rx.rejected} frames rejected)")
-            self._poll()
+            self._poll(min(0.005, max(0.0, give_up - time.monotonic())))
+
+    def _timeout(self) -> float:
+        return max(self.link_timeout_s, GATED_TIMEOUT_S) if self.gated else self.link_timeout_s
+
+    def _keep(self) -> None:
+        """The link's keeper: a HEARTBEAT when nothing was sent for a while; a loss declared on silence.
+
+        It looks every :data:`KEEPER_TICK_S` while the wire is free (the chart
+        loop, waiting for a status, watches the link itself).
+        """
+        if self._policy is not None and self._policy[0] != os.SCHED_OTHER:
+            try:
+                os.sched_setscheduler(0, *self._policy)
+            except OSError:
+                pass  # the maker's priority is not ours to take: the keeper runs at the normal one
+        checked = time.monotonic()
+        while not self._closing.wait(KEEPER_TICK_S):
+            if not self._io.acquire(blocking=False):
+                continue
+            try:
+                if self._closing.is_set():
+                    return
+                if time.monotonic() - self._last_tx >= HEARTBEAT_PERIOD_S:
+                    self._send(L.Heartbeat(next(self._tokens) & 0xFFFFFFFF))
+                    self.heartbeats_sent += 1
+                self._poll()
+                now = time.monotonic()
+                timeout = self._timeout()
+                if self.lost is None and now - self.last_frame_at > timeout:
+                    self._declare_lost(f"no status from the firmware for {timeout * 1000:.0f} ms (heartbeats"
+                                       f" unanswered; {self.rx.rejected} frames rejected)", now, checked)
+                checked = now
+            except LinkLost as exc:  # the port itself failed
+                now = time.monotonic()
+                if self.lost is None:
+                    self._declare_lost(str(exc), now, checked)
+                checked = now
+            finally:
+                self._io.release()
+
+    def _declare_lost(self, reason: str, now: float, checked_before: float) -> None:
+        loss = LinkLoss(reason, self.last_frame_at, now, checked_before, self._timeout())
+        self.lost = loss
+        self.losses.append(loss)
+        if self.on_link_lost is not None:
+            self.on_link_lost(loss)
+
+    def heartbeat(self, timeout_s: float = HANDSHAKE_TIMEOUT_S) -> L.HeartbeatReply:
+        """Send a ``HEARTBEAT`` and return the firmware's reply: its step and its link counters."""
+        token = next(self._tokens) & 0xFFFFFFFF
+        with self._io:
+            self._send(L.Heartbeat(token))
+            self.heartbeats_sent += 1
+            give_up = time.monotonic() + timeout_s
+            while True:
+                reply = self._wait_for(L.HeartbeatReply, max(0.0, give_up - time.monotonic()))
+                if reply.token == token:
+                    return reply
 
     def _wait_step(self, target: int) -> None:
-        give_up = time.monotonic() + self.link_timeout_s
-        while self._status is None or self._status.step < target:
-            before = self._status
-            self._poll()
-            if self._status is not before:
-                give_up = time.monotonic() + self.link_timeout_s
-            if self._status is not None and self._status.state != 1:
-                raise LinkLost(f"the firmware is in {self._status.state_name} at step {self._status.step}")
+        timeout = self._timeout()
+        give_up = time.monotonic() + timeout
+        while True:
+            status = self._status
+            if status is not None and status.state != 1:
+                raise LinkLost(f"the firmware is in {status.state_name} at step {status.step}")
+            if status is not None and status.step >= target:
+                return
+            self._poll(min(0.005, timeout))
+            if self._status is not status:
+                give_up = time.monotonic() + timeout
             if time.monotonic() > give_up:
-                raise LinkLost(f"no status from the firmware for {self.link_timeout_s * 1000:.0f} ms "
+                raise LinkLost(f"no status from the firmware for {timeout * 1000:.0f} ms "
                                f"(waiting for step {target}; {self.rx.rejected} frames rejected)")
 
     # ---- the Arm protocol ---------------------------------------------------------------
 
     @property
     def t(self) -> float:
-        return 0.0 if self._status is None else self._status.step * self.dt
+        return self._steps * self.dt
 
     @property
     def steps(self) -> int:
-        return 0 if self._status is None else self._status.step
+        """Control steps run: the firmware's, as of its last status, and those stepped since within a chart step."""
+        return self._steps
 
     def step(self, n: int = 1) -> None:
-        """Stream the setpoints and wait until the firmware has run `n` more control steps (in chart steps)."""
-        target = self.steps + n
-        while self.steps < target:
-            self._send(L.Setpoints(self.steps, (self._q[0], self._q[1], self._q[2], self._q[3]), self._fr_sw))
-            self._wait_step(min(target, self.steps + self.divider))
+        """Stream the setpoints and wait until the firmware has run `n` more control steps.
+
+        The setpoints go out at each chart step's first control step; the
+        firmware reports at each chart step's end, so that is where this waits.
+        Stepping one control step at a time (the debugger, a paced clock),
+        the steps within a chart step return at once: the firmware runs them
+        on the setpoints it has.
+        """
+        with self._io:
+            self._step(n)
+
+    def _step(self, n: int) -> None:
+        target = self._steps + n
+        d = self.divider
+        while self._steps < target:
+            if self._steps % d == 0 and self._sent_for != self._steps:
+                self._send(L.Setpoints(self._steps, (self._q[0], self._q[1], self._q[2], self._q[3]), self._fr_sw))
+                self._sent_for = self._steps
+            nxt = min(target, (self._steps // d + 1) * d)
+            if nxt % d == 0:
+                self._wait_step(nxt)
+                assert self._status is not None  # _wait_step returns with one
+                nxt = max(nxt, self._status.step)  # on its own clock, the firmware may be further on
+            self._steps = nxt
 
     def set_setpoints(self, q_des: Sequence[float], fr_sw: bool = False) -> None:
         q = [float(v) for v in q_des[:4]]
@@ -234,7 +455,8 @@ class SerialArm:
         shift = float(offset_rad) - self._offsets[d]
         self._offsets[d] = float(offset_rad)
         self._q[d] += shift  # the firmware moves its setpoint with the offset: keep ours with it
-        self._send(L.Drive(d, L.Op.OFFSET, float(offset_rad)))
+        with self._io:
+            self._send(L.Drive(d, L.Op.OFFSET, float(offset_rad)))
 
     def enabled(self) -> tuple[bool, bool, bool]:
         m = 0 if self._status is None else self._status.modes
@@ -242,7 +464,8 @@ class SerialArm:
 
     def set_enabled(self, drive: int, enabled: bool) -> None:
         d = check_drive(drive) - 1
-        self._send(L.Drive(d, L.Op.CLOSED if enabled else L.Op.OFF, 0.0))
+        with self._io:
+            self._send(L.Drive(d, L.Op.CLOSED if enabled else L.Op.OFF, 0.0))
 
     @property
     def link_stats(self) -> dict[str, int]:
@@ -251,4 +474,4 @@ class SerialArm:
                 "frames_ok": self.rx.frames_ok, "rejected": self.rx.rejected, "lost": self.rx.seq.lost}
 
 
-__all__ = ["SerialArm", "SerialArmError", "LinkLost", "LINK_TIMEOUT_S"]
+__all__ = ["SerialArm", "SerialArmError", "LinkLost", "LinkLoss", "LinkTruth", "LINK_TIMEOUT_S", "HEARTBEAT_PERIOD_S"]

@@ -23,17 +23,14 @@ from __future__ import annotations
 import logging
 import os
 import select
-import shutil
-import tempfile
 import threading
 import time
-import tty
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
-from pathlib import Path
 
+from ..ptylink import PtyLink, PtyLinkError
 from .errors import EncodeError, SerialLinkError
 from .protocol import CELLS, MAX_STATUS_TEXT, SEQ_MODULUS, Level, crc16, encode_frame, encode_status
 
@@ -221,23 +218,13 @@ class CameraEmulator:
             raise ValueError(f"first_seq must be 0..{SEQ_MODULUS - 1}, got {first_seq}")
         self._source = frame_source
         self.rate_hz = float(rate_hz)
-        self._own_dir: Path | None = None
-        if link is None:
-            self._own_dir = Path(tempfile.mkdtemp(prefix="ttt-camera-"))
-            link = self._own_dir / "camera"
-        self._link = Path(link)
-        if not self._link.parent.is_dir():
-            raise EmulatorError(f"the folder of the link {self._link} does not exist; create it or choose"
-                                " another --link")
-        if self._link.exists() and not self._link.is_symlink():
-            raise EmulatorError(f"{self._link} exists and is not a symlink; the emulator only replaces its own"
-                                " link: choose another --link")
+        try:
+            self._pty = PtyLink(link, "camera")
+        except PtyLinkError as exc:
+            raise EmulatorError(str(exc)) from None
         self._seq = first_seq
         self._log = logger or _LOG
         self._lock = threading.RLock()
-        self._master: int | None = None
-        self._slave: int | None = None
-        self._device: str | None = None
         self._faults: deque[Fault] = deque()
         self._replug_at: float | None = None
         self._stop = threading.Event()
@@ -249,49 +236,36 @@ class CameraEmulator:
     @property
     def port(self) -> str:
         """The stable path the reader opens (a symlink to the current pty)."""
-        return str(self._link)
+        return self._pty.port
 
     @property
     def device(self) -> str | None:
         """The current pseudo-terminal slave, ``/dev/pts/N``; None while unplugged."""
-        return self._device
+        return self._pty.device
 
     @property
     def plugged(self) -> bool:
-        return self._master is not None
+        return self._pty.is_open
 
     def plug(self) -> str:
         """Make a new pseudo-terminal and point :attr:`port` at it; returns its ``/dev/pts/N``."""
         with self._lock:
-            if self._master is not None:
-                assert self._device is not None
-                return self._device
-            master, slave = os.openpty()
-            # Raw: no echo, no CR/LF translation, no line editing: bytes pass as on a UART.
-            tty.setraw(slave)
-            os.set_blocking(master, False)
-            self._master, self._slave = master, slave  # the slave stays open so the pty keeps its settings
-            self._device = os.ttyname(slave)
-            tmp = self._link.with_name(f".{self._link.name}.{os.getpid()}.tmp")
-            tmp.unlink(missing_ok=True)
-            os.symlink(self._device, tmp)
-            os.replace(tmp, self._link)  # atomic: a reader sees the old link or the new one
+            if self._pty.is_open:
+                assert self._pty.device is not None
+                return self._pty.device
+            device = self._pty.open()
             self._n["plugs"] += 1
-            self._log.info("camera emulator: %s -> %s", self._link, self._device)
-            return self._device
+            self._log.info("camera emulator: %s -> %s", self._pty.link, device)
+            return device
 
     def unplug(self) -> None:
         """Remove :attr:`port` and close the pseudo-terminal: the reader's next read fails, its reopen too."""
         with self._lock:
-            if self._master is None:
+            if not self._pty.is_open:
                 return
-            self._link.unlink(missing_ok=True)
-            for fd in (self._master, self._slave):
-                if fd is not None:
-                    os.close(fd)
-            self._master = self._slave = None
-            self._log.info("camera emulator: %s unplugged (%s gone)", self._link, self._device)
-            self._device = None
+            device = self._pty.device
+            self._pty.close()
+            self._log.info("camera emulator: %s unplugged (%s gone)", self._pty.link, device)
             self._n["unplugs"] += 1
 
     # -- the thread ---------------------------------------------------------
@@ -304,7 +278,7 @@ class CameraEmulator:
             return self
         self.plug()
         self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name=f"camera-emulator {self._link}", daemon=True)
+        self._thread = threading.Thread(target=self._run, name=f"camera-emulator {self._pty.link}", daemon=True)
         self._thread.start()
         return self
 
@@ -317,10 +291,9 @@ class CameraEmulator:
             if thread.is_alive():
                 self._log.error("camera emulator: thread still busy after %g s (a frame_source that hangs?);"
                                 " leaving it as a daemon", timeout_s)
-        self.unplug()
-        if self._own_dir is not None:
-            shutil.rmtree(self._own_dir, ignore_errors=True)
-            self._own_dir = None
+        with self._lock:
+            self.unplug()
+            self._pty.remove()
 
     def __enter__(self) -> CameraEmulator:
         """Start streaming when there is a frame_source; only plug otherwise (send frames yourself)."""
@@ -432,7 +405,7 @@ class CameraEmulator:
 
     def _write(self, data: bytes, wait_s: float) -> bool:
         with self._lock:
-            fd = self._master
+            fd = self._pty.master
             if fd is None:
                 self._n["bytes_dropped"] += len(data)
                 return False

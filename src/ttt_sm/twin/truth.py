@@ -11,6 +11,7 @@ the debugger's ``q_true`` signal.  Code typed on ``Arm`` never reads it.
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 import numpy as np
 
@@ -19,6 +20,29 @@ from . import _cascade as C
 from . import _plant as P
 from .kinematics import fk
 from .plant import Plant
+
+
+class GroundTruth(Protocol):
+    """What the simulation-only parts (the whiteboard's ink, precision figures) read of ground truth.
+
+    :class:`ArmTruth` offers it for the in-process twin; an emulated arm
+    behind a serial link offers it from the emulator's plant
+    (``ttt_sm.hardware.serial_arm.LinkTruth``).
+    """
+
+    @property
+    def q(self) -> np.ndarray:
+        """True joint angles q1..q4 (rad)."""
+
+    def angles(self) -> tuple[float, float, float, float]:
+        """:attr:`q` as plain floats."""
+
+    def tool_pose(self) -> np.ndarray:
+        """The true tool pose x, y, z (m), phi (rad)."""
+
+    @property
+    def offsets(self) -> np.ndarray:
+        """The true encoder offsets (rad)."""
 
 
 class ArmTruth:
@@ -113,4 +137,4 @@ class ArmTruth:
         return kinetic + gravity + spring
 
 
-__all__ = ["ArmTruth"]
+__all__ = ["ArmTruth", "GroundTruth"]

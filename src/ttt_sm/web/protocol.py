@@ -45,6 +45,10 @@ The commands, with their fields (``?``: optional, default in brackets):
 ``game_cell``        ``row``, ``column`` (1..5): the person draws there
 ``game_play``        the Tic-tac-toe page's Play
 ``game_stop``        its Stop: the arm returns to its start pose, then stops
+``operate_trigger``  ``symbol`` (``"X"``, ``"O"`` or ``"sine"``),
+                     ``magnitude_cm`` (0 .. 10), ``speed`` (0 .. 5): the
+                     Operational page's Trigger (:mod:`.operate`)
+``operate_stop``     its Stop_simulation: the arm returns to its start pose
 ===================  ==========================================================
 
 Every command may carry ``id`` (a number or a short text), echoed in its reply.
@@ -204,6 +208,12 @@ def symbol(cmd: str, name: str, value: Any) -> str:
     return str(value)
 
 
+def shape(cmd: str, name: str, value: Any) -> str:
+    if value not in ("X", "O", "sine"):
+        raise ProtocolError(f"{cmd}: {name!r} must be \"X\", \"O\" or \"sine\", got {_describe(value)}")
+    return str(value)
+
+
 @dataclass(frozen=True)
 class Field:
     check: Check
@@ -242,6 +252,9 @@ COMMANDS: Mapping[str, Mapping[str, Field]] = {
     "game_cell": {"row": Field(integer(1, 5)), "column": Field(integer(1, 5))},
     "game_play": {},
     "game_stop": {},
+    "operate_trigger": {"symbol": Field(shape), "magnitude_cm": Field(number(0.0, 10.0)),
+                        "speed": Field(number(0.0, 5.0))},
+    "operate_stop": {},
 }
 
 

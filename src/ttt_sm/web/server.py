@@ -8,6 +8,7 @@ protocol tests run without a browser or a socket).
 
 Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
 (the Tic-tac-toe page, :mod:`.game`; its camera picture ``/api/game/photo.png``),
+``/operate`` (the Operational page, :mod:`.operate`),
 ``/static/...`` (the pages' scripts and styles, from the package: nothing from
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
 SVG, :mod:`.diagrams`), ``/api/trace.jsonl`` (the trace so far), ``/ws``.
@@ -138,6 +139,9 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
     async def game(request: Request) -> Response:
         return page("game.html")
 
+    async def operate(request: Request) -> Response:
+        return page("operate.html")
+
     async def game_photo(request: Request) -> Response:
         png = await asyncio.to_thread(photo_png, session.debugger)
         if png is None:
@@ -242,6 +246,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         Route("/charts", charts),
         Route("/game", game),
         Route("/api/game/photo.png", game_photo),
+        Route("/operate", operate),
         Route("/api/diagram/{chart}", diagram),
         Route("/api/trace.jsonl", trace),
         WebSocketRoute("/ws", ws),

@@ -131,3 +131,22 @@ def _until(page: Page, ok: Any, limit: int = 2000) -> dict[str, Any]:
         if ok(f):
             return f
     raise AssertionError("no such frame")
+
+
+def test_the_sine_waves_magnitude_is_its_peak_to_peak_on_the_whiteboard(
+        operating: tuple[Session, Any, Page, dict[str, Any]]) -> None:
+    session, _, page, _ = operating
+    session.call(lambda d: d.robot.run_until(lambda: d.robot.control.ready, 200.0), timeout_s=300)
+    strokes_before = session.call(lambda d: len(d.robot.board.strokes))
+    ok = page.answer(page.send(type="operate_trigger", symbol="sine", magnitude_cm=4, speed=5))
+    assert ok["text"] == "Trigger: a sine wave, 4 cm peak to peak, speed 5 (30 mm/s)"
+    assert session.call(lambda d: d.robot.control.sine_amplitude) == pytest.approx(0.02)
+    done = session.call(lambda d: d.robot.run_until(lambda: bool(session.operate.results)
+                                                    and session.operate.results[-1]["symbol"] == "sine", 200.0),
+                        timeout_s=300)
+    assert done
+    ink = session.call(lambda d: [s.points for s in d.robot.board.strokes[strokes_before:] if s.author == "robot"])
+    y = [p[1] for points in ink for p in points]
+    assert abs((max(y) - min(y)) - 0.040) < 0.001  # the pen's centre line: 40 mm from crest to trough
+    result = session.call(lambda d: session.operate.results[-1])
+    assert result["speed_mm_s"] == 30.0 and result["closure_gap_mm"] is None and result["rms_error_mm"] < 0.5

@@ -18,9 +18,9 @@ const CAPACITY = 3000;
 const WINDOW_S = 20;
 
 const GRAPHS = [
-  { id: "x_axis", title: "X axis", unit: "mm", series: [["x_desired_mm", "desired", "#1f4e9c"], ["x_fk_mm", "forward kinematics of the encoders", "#d33"]] },
-  { id: "y_axis", title: "Y axis", unit: "mm", series: [["y_desired_mm", "desired", "#1f4e9c"], ["y_fk_mm", "forward kinematics of the encoders", "#d33"]] },
-  { id: "z_axis", title: "Z axis", unit: "mm", series: [["z_desired_mm", "desired", "#1f4e9c"], ["z_fk_mm", "forward kinematics of the encoders", "#d33"]] },
+  { id: "x_axis", title: "X axis", unit: "mm", series: [["x_desired_mm", "desired", "#1f4e9c"], ["x_fk_mm", "FK of the encoders", "#d33"]] },
+  { id: "y_axis", title: "Y axis", unit: "mm", series: [["y_desired_mm", "desired", "#1f4e9c"], ["y_fk_mm", "FK of the encoders", "#d33"]] },
+  { id: "z_axis", title: "Z axis", unit: "mm", series: [["z_desired_mm", "desired", "#1f4e9c"], ["z_fk_mm", "FK of the encoders", "#d33"]] },
   { id: "first_drive", title: "First drive", unit: "A", series: [["current_1_a", "motor current", "#1d7a1d"]] },
   { id: "second_drive", title: "Second drive", unit: "A", series: [["current_2_a", "motor current", "#1d7a1d"]] },
   { id: "third_drive", title: "Third drive", unit: "A", series: [["current_3_a", "motor current", "#1d7a1d"]] },

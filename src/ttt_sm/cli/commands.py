@@ -137,8 +137,11 @@ def cmd_play(args: argparse.Namespace) -> int:
               f"{', '.join(files.values())}", file=sys.stderr)
         return 128 + (signal.SIGTERM if exc.why == "SIGTERM" else signal.SIGINT)
     finally:
+        # The ttt-sm process exits next: once the game ended it keeps ignoring signals (main does the same
+        # when any command returns; putting the handlers back first left a moment for a late one to land).
+        keep_ignoring = finished and getattr(args, "ttt_sm_process", False)
         for sig, handler in handlers.items():
-            signal.signal(sig, handler)
+            signal.signal(sig, signal.SIG_IGN if keep_ignoring else handler)
         clear_status()
         if session is not None:
             session.close()

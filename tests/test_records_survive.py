@@ -194,7 +194,7 @@ def test_the_demos_record_survives_a_signal_with_the_board_as_it_was(tmp_path: P
     assert steps == ["initialised", "drawn", "drawn", "drawn", "board_saved", "erased"][:len(steps)]
     if last["event"] == "interrupted":  # where it stood, and the board of that moment
         assert {"t", "tick", "control"} <= last.keys()
-        assert Path(last["pictures"]["stopped"]).is_file()
+        assert Path(last["pictures"]["board"]).is_file()
     else:
         assert last["erased"] is True and (out / "board_erased.png").is_file()
 

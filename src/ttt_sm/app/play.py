@@ -68,7 +68,7 @@ def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
         except Exception as picture_exc:  # the record's last line matters more than the picture
             picture = f"not saved: {picture_exc}"
         record.end(how, **data, t=round(robot.t, 4), tick=robot.chart_ticks,
-                   control=sorted(robot.active("Control")), pictures={"stopped": picture})
+                   control=sorted(robot.active("Control")), pictures={"board": picture})
         raise
     record.end("finished", t=round(robot.t, 4), tick=robot.chart_ticks, erased=result["erased"])
     return result

@@ -180,6 +180,25 @@ def test_the_benchs_results_are_written_section_by_section_and_survive_a_signal(
         assert last["section"] in ("ik", "loop", "pacing", "charts", None)
 
 
+@pytest.mark.parametrize("seed", [1, 2, *SOAK])
+def test_the_demos_record_survives_a_signal_with_the_board_as_it_was(tmp_path: Path, seed: int) -> None:
+    rng = random.Random(seed)
+    out = tmp_path / "demo"
+    record = out / "demo.jsonl"
+    sig, status, _, err = interrupt(["demo", "--seed", str(seed), "--out", str(out)], record, tmp_path, rng,
+                                    rng.randint(2, 60), max_delay_s=2.0, sig=signal_of(seed))
+    last = check_record(record, "demo", sig)
+    check_exit(status, err, last["event"], sig)
+    lines = read_lines(record)
+    steps = [e["event"] for e in lines if e.get("event") not in (None, "demo", *ENDINGS)]
+    assert steps == ["initialised", "drawn", "drawn", "drawn", "board_saved", "erased"][:len(steps)]
+    if last["event"] == "interrupted":  # where it stood, and the board of that moment
+        assert {"t", "tick", "control"} <= last.keys()
+        assert Path(last["pictures"]["board"]).is_file()
+    else:
+        assert last["erased"] is True and (out / "board_erased.png").is_file()
+
+
 def test_a_record_file_flushes_every_line_and_ends_once(tmp_path: Path) -> None:
     path = tmp_path / "deep" / "r.jsonl"
     with RecordFile(path) as record:

@@ -175,7 +175,7 @@ def bench_gui_section(params: ArmParams, seed: int = 0, quick: bool = False, soa
     from .web.bench import bench_gui
 
     return bench_gui(params, seed=seed, x1_s=10.0 if quick else 60.0, max_s=3.0 if quick else 15.0,
-                     soak_min=soak_min)
+                     soak_min=soak_min, plot_s=5.0 if quick else 30.0)
 
 
 def bench_link_section(params: ArmParams, seconds: float, seed: int = 0) -> dict[str, Any]:

@@ -231,6 +231,44 @@ def check_request(params: ArmParams, kind: str, row: int, column: int, speed: fl
         raise DrawError(f"size {size * 1000:.1f} mm does not fit a {b.cell_size * 1000:.0f} mm cell (4 mm at least)")
 
 
+def measure(robot: Robot, rec: DrawRecord, kind: str, row: int, column: int, t0: float, strokes_before: int,
+            wall0: float) -> DrawResult:
+    """One drawing's precision: its record and the robot's ink since stroke ``strokes_before``.
+
+    ``rec``: what a :class:`RecordStage` recorded while the drawing ran (from
+    ``t0``, simulated s; ``wall0``, ``time.perf_counter()`` then); ``kind``,
+    ``row``, ``column``: what was drawn.  The ink is the whiteboard's strokes
+    of author ``"robot"`` (a person's strokes on the same board are not
+    counted).  Raises :class:`DrawError` when the record commands no pen-down
+    path.
+    """
+    params, board, c = robot.params, robot.board, robot.control
+    desired = np.asarray(rec.desired)
+    runs = _pen_down_runs(desired, params.board.surface_z)
+    if not runs:
+        raise DrawError(f"drawing {kind} commanded no pen-down path")
+    strokes = [s for s in board.strokes[strokes_before:] if s.author == "robot"]
+    ink = np.vstack([s.points for s in strokes]) if strokes else np.zeros((0, 2))
+    err = _distance_to_runs(ink, runs) * 1e3 if len(ink) else np.array([math.inf])
+    tip = np.asarray(rec.tip)
+    fk_enc = np.asarray(rec.fk_encoder)[:, :2]
+    touching = np.isfinite(tip[:, 0])
+    fk_vs_true = np.hypot(*(fk_enc[touching] - tip[touching]).T) * 1e3 if touching.any() else np.zeros(1)
+    gap = None
+    if kind == "O":
+        gap = round(closure_gap_mm(board, c.x0, c.y0, c.R, tol_m=0.0005), 3)
+    tail = longest_tail_mm(strokes, runs, tol_m=TAIL_TOL_M)
+    return DrawResult(
+        kind=kind, row=row if kind in ("X", "O") else None, column=column if kind in ("X", "O") else None,
+        speed_mm_s=round(c.speed * 1e3, 3), size_mm=round(c.size * 1e3, 3) if kind in ("X", "O") else None,
+        rms_error_mm=round(float(np.sqrt(np.mean(err ** 2))), 4), max_error_mm=round(float(err.max()), 4),
+        fk_vs_true_max_mm=round(float(fk_vs_true.max()), 4), closure_gap_mm=gap,
+        longest_tail_mm=round(float(tail), 3), ink_points=int(len(ink)),
+        duration_s=round(robot.t - t0, 3), sim_time_s=round(robot.t, 3),
+        wall_time_s=round(time.perf_counter() - wall0, 3),
+    )
+
+
 class DrawSession:
     """A robot, its whiteboard and a recorder, ready to draw on command."""
 
@@ -302,32 +340,7 @@ class DrawSession:
 
     def _measure(self, kind: str, row: int, column: int, t0: float, strokes_before: int,
                  wall0: float) -> DrawResult:
-        rec = self.recorder.record
-        params, board, c = self.params, self.robot.board, self.robot.control
-        desired = np.asarray(rec.desired)
-        runs = _pen_down_runs(desired, params.board.surface_z)
-        if not runs:
-            raise DrawError(f"drawing {kind} commanded no pen-down path")
-        strokes = [s for s in board.strokes[strokes_before:] if s.author == "robot"]
-        ink = np.vstack([s.points for s in strokes]) if strokes else np.zeros((0, 2))
-        err = _distance_to_runs(ink, runs) * 1e3 if len(ink) else np.array([math.inf])
-        tip = np.asarray(rec.tip)
-        fk_enc = np.asarray(rec.fk_encoder)[:, :2]
-        touching = np.isfinite(tip[:, 0])
-        fk_vs_true = np.hypot(*(fk_enc[touching] - tip[touching]).T) * 1e3 if touching.any() else np.zeros(1)
-        gap = None
-        if kind == "O":
-            gap = round(closure_gap_mm(board, c.x0, c.y0, c.R, tol_m=0.0005), 3)
-        tail = longest_tail_mm(strokes, runs, tol_m=TAIL_TOL_M)
-        return DrawResult(
-            kind=kind, row=row if kind in ("X", "O") else None, column=column if kind in ("X", "O") else None,
-            speed_mm_s=round(c.speed * 1e3, 3), size_mm=round(c.size * 1e3, 3) if kind in ("X", "O") else None,
-            rms_error_mm=round(float(np.sqrt(np.mean(err ** 2))), 4), max_error_mm=round(float(err.max()), 4),
-            fk_vs_true_max_mm=round(float(fk_vs_true.max()), 4), closure_gap_mm=gap,
-            longest_tail_mm=round(float(tail), 3), ink_points=int(len(ink)),
-            duration_s=round(self.robot.t - t0, 3), sim_time_s=round(self.robot.t, 3),
-            wall_time_s=round(time.perf_counter() - wall0, 3),
-        )
+        return measure(self.robot, self.recorder.record, kind, row, column, t0, strokes_before, wall0)
 
     def _write(self, result: DrawResult, out_dir: Path) -> DrawResult:
         out_dir.mkdir(parents=True, exist_ok=True)

@@ -5,6 +5,12 @@ with their charts, the Control chart moves above the board, draws the
 playing field, an X and an O, erases the board, and finishes back at its
 start pose.  Every drawing is measured as in thesis section 3.5, and the
 board is saved as a picture (:mod:`ttt_sm.twin.board_picture`) before and after erasing.
+
+Given a :class:`~ttt_sm.runtime.recordfile.RecordFile` (``ttt-sm demo`` writes
+``--out``/demo.jsonl), :func:`run_play` writes what happens as it happens:
+every chart transition, each step done (a line with ``event``), and a last
+line that says how the demo ended; a demo that is interrupted or fails saves
+the board as it is (``board_stopped.png``) and names it in that line.
 """
 
 from __future__ import annotations
@@ -17,6 +23,8 @@ from typing import Any
 
 from ..arm import Arm
 from ..params import ArmParams
+from ..runtime.listeners import Trace
+from ..runtime.recordfile import RecordFile, ending_of
 from ..twin.board_picture import save_board_picture
 from ..twin.truth import GroundTruth
 from .drawing import DrawError, DrawSession
@@ -31,21 +39,53 @@ def _what(kind: str, row: int, column: int) -> str:
 
 def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
              progress: Callable[[str], None] | None = None, arm: Arm | None = None,
-             truth: GroundTruth | None = None) -> dict[str, Any]:
+             truth: GroundTruth | None = None, record: RecordFile | None = None) -> dict[str, Any]:
     """Initialise, draw the field, an X and an O, erase, finish; return what happened.
 
     `arm` and `truth`: another arm than the twin (``--arm serial:PORT``) and the ground truth it offers.
+    ``record``: written as the demo goes (transitions and steps), ended with how it ended.
     """
     say = progress or (lambda _m: None)
-    wall0 = time.perf_counter()
+    if record is not None:
+        record.add({"event": "demo", "seed": seed, "drawings": [list(d) for d in DEMO_DRAWINGS]})
     session = DrawSession(params, seed=seed, progress=say, arm=arm, truth=truth)
+    if record is None:
+        return _demo(session, seed, out_dir, say, lambda _event, **_data: None)
+    Trace(sink=record, keep=False).observe(*session.robot.charts.values())
     robot = session.robot
+
+    def note(event: str, **data: Any) -> None:
+        record.add({"event": event, "t": round(robot.t, 4), **data})
+
+    try:
+        result = _demo(session, seed, out_dir, say, note)
+    except BaseException as exc:  # the record says where it stopped, with the board as it is
+        how, data = ending_of(exc)
+        try:
+            picture = str(save_board_picture(robot.board, out_dir / "board_stopped.png",
+                                             f"The whiteboard when the demo stopped ({how})",
+                                             f"ttt-sm demo, seed {seed}, t = {robot.t:.1f} s"))
+        except Exception as picture_exc:  # the record's last line matters more than the picture
+            picture = f"not saved: {picture_exc}"
+        record.end(how, **data, t=round(robot.t, 4), tick=robot.chart_ticks,
+                   control=sorted(robot.active("Control")), pictures={"board": picture})
+        raise
+    record.end("finished", t=round(robot.t, 4), tick=robot.chart_ticks, erased=result["erased"])
+    return result
+
+
+def _demo(session: DrawSession, seed: int, out_dir: Path, say: Callable[[str], None],
+          note: Callable[..., None]) -> dict[str, Any]:
+    robot = session.robot
+    wall0 = time.perf_counter()
     t_ready = session.start()
+    note("initialised")
     out_dir.mkdir(parents=True, exist_ok=True)
     drawings = []
     for kind, row, column in DEMO_DRAWINGS:
         d = session.draw(kind, row, column)
         drawings.append(d)
+        note("drawn", kind=kind, row=row, column=column, rms_error_mm=d.rms_error_mm, max_error_mm=d.max_error_mm)
         say(f"  {d.kind}: rms {d.rms_error_mm:.3f} mm, max {d.max_error_mm:.3f} mm, {d.duration_s:.1f} s"
             + (f", closes within {d.closure_gap_mm:.2f} mm" if d.kind == "O" else ""))
     before = save_board_picture(robot.board, out_dir / "board_drawn.png",
@@ -53,6 +93,7 @@ def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
                                 f"ttt-sm demo, seed {seed}: what the true pen tip inked; next, the sponge erases it")
     ink_drawn = robot.board.ink_area_mm2()
     say(f"board saved: {before}")
+    note("board_saved", picture=str(before), ink_mm2=round(ink_drawn, 1))
 
     say("erasing")
     robot.control_stage.erase_requested = True
@@ -62,6 +103,7 @@ def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
     if not robot.run_until(lambda: not c.erasing, 300.0):
         raise DrawError("erasing did not finish within 300 s")
     ink_left = robot.board.ink_area_mm2()
+    note("erased", ink_left_mm2=round(ink_left, 3))
     after = save_board_picture(robot.board, out_dir / "board_erased.png", "The whiteboard after erasing",
                                f"ttt-sm demo, seed {seed}: {ink_drawn:.0f} mm² of ink before, "
                                f"{ink_left:.1f} mm² left after the sponge's passes")

@@ -116,6 +116,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser = build_parser()
         args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else argv))
         command = args.command
+        args.ttt_sm_process = argv is None  # the process exits when the command returns
         status = int(args.func(args))
         if argv is None:
             _ignore_late_signals()

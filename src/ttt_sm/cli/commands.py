@@ -54,13 +54,15 @@ def open_arm(args: argparse.Namespace, params: ArmParams) -> ArmConnection | Non
 def cmd_demo(args: argparse.Namespace) -> int:
     from ..app.drawing import DrawError
     from ..app.play import run_play
+    from ..runtime.recordfile import RecordFile
 
     out = out_dir(args.out)
     params = load_arm(args.params)
     conn = open_arm(args, params)
     try:
-        result = run_play(params, seed=args.seed, out_dir=out, progress=progress(True),
-                          arm=conn.arm if conn else None, truth=conn.truth if conn else None)
+        with RecordFile(out / "demo.jsonl") as record:  # written as the demo goes; its last line says how it ended
+            result = run_play(params, seed=args.seed, out_dir=out, progress=progress(True),
+                              arm=conn.arm if conn else None, truth=conn.truth if conn else None, record=record)
     except DrawError as exc:
         raise CliError(str(exc)) from exc
     finally:
@@ -137,8 +139,11 @@ def cmd_play(args: argparse.Namespace) -> int:
               f"{', '.join(files.values())}", file=sys.stderr)
         return 128 + (signal.SIGTERM if exc.why == "SIGTERM" else signal.SIGINT)
     finally:
+        # The ttt-sm process exits next: once the game ended it keeps ignoring signals (main does the same
+        # when any command returns; putting the handlers back first left a moment for a late one to land).
+        keep_ignoring = finished and getattr(args, "ttt_sm_process", False)
         for sig, handler in handlers.items():
-            signal.signal(sig, handler)
+            signal.signal(sig, signal.SIG_IGN if keep_ignoring else handler)
         clear_status()
         if session is not None:
             session.close()
@@ -358,7 +363,8 @@ def register(sub: Any) -> None:
     sp.add_argument("--out", default="out/play", help="folder for the game record and the board PNGs")
     add_arm_option(sp)
     sp = add_command(sub, "demo", cmd_demo, "initialise, draw the field, an X and an O, erase, finish (no game)")
-    sp.add_argument("--out", default="out/demo", help="folder for the board PNGs (default out/demo)")
+    sp.add_argument("--out", default="out/demo",
+                    help="folder for the board PNGs and demo.jsonl, its record written as it goes (default out/demo)")
     add_arm_option(sp)
     sp = add_command(sub, "draw", cmd_draw,
                      "draw one thing with the Control chart and measure its precision (thesis 3.5)")

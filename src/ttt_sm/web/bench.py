@@ -23,6 +23,13 @@ flags as the browser tests) and measures:
   ``gui_game_headless_realtime_factor``: the same game in a session with no
   page attached (:func:`bench_gui_game`); ``ttt-sm bench`` reports them beside
   the headless ``game_realtime_factor`` of its ``game`` section;
+- ``gui_plot_rate_hz``: how often the Operational page (``/operate``) redrew its
+  graphs with new points, per wall second, at x1 (``gui_plot_points_per_s``: the
+  points each graph got per wall second; the session samples 25 a simulated
+  second), and ``gui_plot_latency_ms_p95``: from a sample taken in the
+  simulation to the page having drawn it (acknowledged from the
+  ``requestAnimationFrame`` callback that drew it; the oldest sample of each
+  frame), the Charts page closed;
 - with ``soak_min`` (``ttt-sm bench --only gui --gui-soak MIN``): the server's
   resident memory after 1 minute and after ``soak_min`` minutes at x10.
 
@@ -76,7 +83,7 @@ def _serve(session: Session) -> tuple[Any, threading.Thread, str]:
 
 
 def bench_gui(params: ArmParams, seed: int = 0, x1_s: float = 60.0, max_s: float = 15.0,
-              soak_min: float = 0.0, game: bool = True) -> dict[str, Any]:
+              soak_min: float = 0.0, plot_s: float = 30.0, game: bool = True) -> dict[str, Any]:
     """Measure the cockpit in Chromium (see the module's docstring)."""
     try:
         from playwright.sync_api import sync_playwright
@@ -156,7 +163,13 @@ def bench_gui(params: ArmParams, seed: int = 0, x1_s: float = 60.0, max_s: float
             out["gui_frame_bytes_median"] = int(statistics.median(sizes)) if sizes else None
             out["gui_frames_received"] = len(sizes)
 
+            page.close()
+            out.update(_measure_plots(browser, session, url, plot_s))
+
             if soak_min > 0:
+                page = browser.new_page(viewport={"width": 1600, "height": 1000})
+                page.goto(url + "/charts")
+                page.wait_for_selector("[data-state]", timeout=60_000)
                 session.submit(0, _command("speed", value=10.0))
                 page.get_by_role("button", name="Run", exact=True).click()
                 time.sleep(60.0)
@@ -243,6 +256,37 @@ def bench_gui_game(params: ArmParams, seed: int = 0, executable: str | None = No
                 "gui_game_realtime_factor": round(sim / wall, 1), "gui_game_outcome": outcome,
                 "gui_game_messages_received": len(received)})
     return out
+
+
+def _measure_plots(browser: Any, session: Session, url: str, seconds: float) -> dict[str, Any]:
+    """The Operational page's graphs at x1 for ``seconds``: redraws and points per wall second, latency."""
+    session.submit(0, _command("speed", value=1.0))
+    page = browser.new_page(viewport={"width": 1600, "height": 1000})
+    try:
+        page.goto(url + "/operate")
+        page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'paused'")
+        before = len(session.plot_latency_ms())
+        page.get_by_role("button", name="Run_simulation", exact=True).click()
+        page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'running'")
+        page.wait_for_function("window.operateStats.points > 0")
+        start = page.evaluate("window.operateStats")
+        wall0 = time.perf_counter()
+        time.sleep(seconds)
+        end = page.evaluate("window.operateStats")
+        wall = time.perf_counter() - wall0
+        session.submit(0, _command("pause"))
+        page.wait_for_function("document.querySelector('[data-role=mode]').textContent === 'paused'")
+    finally:
+        page.close()
+    latency = sorted(session.plot_latency_ms()[before:])
+    return {
+        "gui_plot_seconds": round(wall, 1),
+        "gui_plot_rate_hz": round((end["redraws"] - start["redraws"]) / wall, 1),
+        "gui_plot_points_per_s": round((end["points"] - start["points"]) / wall, 1),
+        "gui_plot_latency_ms_p95": round(latency[int(0.95 * (len(latency) - 1))], 1) if latency else None,
+        "gui_plot_latency_ms_median": round(statistics.median(latency), 1) if latency else None,
+        "gui_plot_latency_samples": len(latency),
+    }
 
 
 def _command(kind: str, **args: Any) -> Any:

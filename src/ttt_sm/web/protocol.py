@@ -48,6 +48,10 @@ The commands, with their fields (``?``: optional, default in brackets):
 ``game_engine``      ``engine``: ``"strong"`` or ``"thesis"``, the manipulator's
                      game algorithm (before the first move only)
 ``game_new``         a new game: a new robot from power-on, paused (Run starts it)
+``operate_trigger``  ``symbol`` (``"X"``, ``"O"`` or ``"sine"``),
+                     ``magnitude_cm`` (0 .. 10), ``speed`` (0 .. 5): the
+                     Operational page's Trigger (:mod:`.operate`)
+``operate_stop``     its Stop_simulation: the arm returns to its start pose
 ===================  ==========================================================
 
 Every command may carry ``id`` (a number or a short text), echoed in its reply.
@@ -213,6 +217,12 @@ def engine(cmd: str, name: str, value: Any) -> str:
     return str(value)
 
 
+def shape(cmd: str, name: str, value: Any) -> str:
+    if value not in ("X", "O", "sine"):
+        raise ProtocolError(f"{cmd}: {name!r} must be \"X\", \"O\" or \"sine\", got {_describe(value)}")
+    return str(value)
+
+
 @dataclass(frozen=True)
 class Field:
     check: Check
@@ -253,6 +263,9 @@ COMMANDS: Mapping[str, Mapping[str, Field]] = {
     "game_stop": {},
     "game_engine": {"engine": Field(engine)},
     "game_new": {},
+    "operate_trigger": {"symbol": Field(shape), "magnitude_cm": Field(number(0.0, 10.0)),
+                        "speed": Field(number(0.0, 5.0))},
+    "operate_stop": {},
 }
 
 

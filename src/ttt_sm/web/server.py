@@ -10,6 +10,7 @@ Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
 (the Tic-tac-toe page, :mod:`.game`; its camera picture ``/api/game/photo.png``),
 ``/api/arm/ink.png`` (the whiteboard's ink under the arm's top view, :mod:`.arm_view`),
 ``/api/camera/frame.png`` (the newest picture of ``--camera``, :mod:`.camera_feed`),
+``/operate`` (the Operational page, :mod:`.operate`),
 ``/static/...`` (the pages' scripts and styles, from the package: nothing from
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
 SVG, :mod:`.diagrams`), ``/api/trace.jsonl`` (the trace so far), ``/ws``.
@@ -142,6 +143,9 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
     async def game(request: Request) -> Response:
         return page("game.html")
 
+    async def operate(request: Request) -> Response:
+        return page("operate.html")
+
     async def game_photo(request: Request) -> Response:
         png = await asyncio.to_thread(photo_png, session.debugger)
         if png is None:
@@ -261,6 +265,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         Route("/api/game/photo.png", game_photo),
         Route("/api/arm/ink.png", arm_ink),
         Route("/api/camera/frame.png", camera_frame),
+        Route("/operate", operate),
         Route("/api/diagram/{chart}", diagram),
         Route("/api/trace.jsonl", trace),
         WebSocketRoute("/ws", ws),

@@ -61,6 +61,7 @@ from .camera_feed import CameraFeed, feed_view
 from .catalogue import describe_session
 from .coverage import CoverageError, colouring, load_scenarios, run_for_coverage, scenario_from_text
 from .game import GAME_COMMANDS, game_view, start_new_game
+from .operate import Operate
 from .protocol import Command
 
 log = logging.getLogger(__name__)
@@ -193,6 +194,8 @@ class Session:
         #: How the session ends, for the trace file's last line: ``("interrupted", {"signal": "SIGTERM"})``
         #: when a signal stops the server (``ttt-sm gui`` sets it), else finished (or the error).
         self.ending: tuple[str, dict[str, Any]] | None = None
+        #: The Operational page's side (web/operate.py): its graphs' samples, Trigger, the precision.
+        self.operate = Operate(debugger)
         debugger.add_listener(_TransitionTap(self))
         self._install_clock()
 
@@ -280,6 +283,10 @@ class Session:
         if "error" in box:
             raise box["error"]
         return box.get("value")
+
+    def plot_latency_ms(self) -> list[float]:
+        """Plot-latency samples so far: a graph's sample taken -> the Operational page has drawn it, ms."""
+        return [x * 1e3 for x in self.operate.latency()]
 
     def latency_ms(self) -> list[float]:
         """Latency samples so far: transition in the simulation -> the page has drawn it, ms."""
@@ -418,6 +425,12 @@ class Session:
 
     def _cmd_next(self, cid: int, timeout_s: float) -> dict[str, Any]:
         return self._stepping(lambda: self.debugger.next(timeout_s))
+
+    def _cmd_operate_trigger(self, cid: int, symbol: str, magnitude_cm: float, speed: float) -> dict[str, Any]:
+        return self.operate.trigger(symbol, magnitude_cm, speed)
+
+    def _cmd_operate_stop(self, cid: int) -> dict[str, Any]:
+        return self.operate.stop()
 
     def _cmd_speed(self, cid: int, value: float | None) -> dict[str, Any]:
         self.clock.set_speed(value)
@@ -606,6 +619,7 @@ class Session:
             "game": game_view(dbg),
             "arm": arm_view(robot),
             "camera": feed_view(self.camera_feed),
+            "operate": self.operate.view(),
         }
 
     def _frame(self, full: bool, state: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -637,6 +651,7 @@ class Session:
                                "target": r.target, "trigger": r.trigger}
                               for r in dbg.trace.records[-TRACE_ON_JOIN:]]
             frame["trace_total"] = dbg.trace.count
+            frame["plot"] = self.operate.plot_history()
             return frame
         sent = self._sent
         for key in ("data",):
@@ -647,7 +662,7 @@ class Session:
         frame["taken"] = {name: {i: c for i, c in counts.items() if sent.get("taken", {}).get(name, {}).get(i) != c}
                           for name, counts in state["taken"].items()}
         frame["taken"] = {name: counts for name, counts in frame["taken"].items() if counts}
-        for key in ("breakpoints", "actions", "forced", "stop", "game", "arm", "camera"):
+        for key in ("breakpoints", "actions", "forced", "stop", "game", "arm", "camera", "operate"):
             if sent.get(key, _MISSING) != state[key]:
                 frame[key] = state[key]
         return frame
@@ -664,6 +679,9 @@ class Session:
         full = self._resync
         frame = self._frame(full, state)
         frame["seq"] = self._seq
+        plot = self.operate.plot_since(self._seq)  # taken always: a full frame has them in its history
+        if plot is not None and not full:
+            frame["plot"] = plot
         if self._pending_stamps:
             self._stamps[self._seq] = self._pending_stamps
             if len(self._stamps) > 256:
@@ -679,6 +697,7 @@ class Session:
         self._dirty = False
 
     def _ack(self, seq: int, received: float) -> None:
+        self.operate.ack(seq, received)
         stamps = self._stamps.pop(seq, None)
         if stamps:
             with self._lock:

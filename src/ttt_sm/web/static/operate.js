@@ -1,0 +1,346 @@
+// The Operational page (/operate): the thesis' fig. 3.36 over the session's robot.
+//
+// A view, as every page: Run_simulation, Trigger and Stop_simulation send commands
+// (run, operate_trigger, operate_stop; checked by ttt_sm.web.protocol, handled by
+// ttt_sm.web.operate), and each frame's "operate" part (the status message, whether
+// Trigger is taken and why not, the last drawing's precision) and "plot" part (the
+// graphs' samples, taken in simulated time by the session) are drawn.  The graphs
+// are plain canvases drawn here; their data live in a ring buffer of fixed size.
+
+import { SessionLink } from "/static/session.js";
+
+const $ = (sel) => document.querySelector(sel);
+const role = (name) => $(`[data-role="${name}"]`);
+
+//: Samples kept per column (2 minutes at 25 a simulated second); the oldest are overwritten.
+const CAPACITY = 3000;
+//: The graphs show the last this many simulated seconds.
+const WINDOW_S = 20;
+
+const GRAPHS = [
+  { id: "x_axis", title: "X axis", unit: "mm", series: [["x_desired_mm", "desired", "#1f4e9c"], ["x_fk_mm", "FK of the encoders", "#d33"]] },
+  { id: "y_axis", title: "Y axis", unit: "mm", series: [["y_desired_mm", "desired", "#1f4e9c"], ["y_fk_mm", "FK of the encoders", "#d33"]] },
+  { id: "z_axis", title: "Z axis", unit: "mm", series: [["z_desired_mm", "desired", "#1f4e9c"], ["z_fk_mm", "FK of the encoders", "#d33"]] },
+  { id: "first_drive", title: "First drive", unit: "A", series: [["current_1_a", "motor current", "#1d7a1d"]] },
+  { id: "second_drive", title: "Second drive", unit: "A", series: [["current_2_a", "motor current", "#1d7a1d"]] },
+  { id: "third_drive", title: "Third drive", unit: "A", series: [["current_3_a", "motor current", "#1d7a1d"]] },
+  { id: "following_error", title: "Following error", unit: "deg", series: [["following_error_1_deg", "drive 1", "#1f4e9c"], ["following_error_2_deg", "drive 2", "#d33"], ["following_error_3_deg", "drive 3", "#1d7a1d"]] },
+];
+
+const MEANS = { X: "the X's side", O: "the O's diameter", sine: "the sine wave's peak to peak" };
+
+const state = { mode: "connecting", op: null, speedRange: [5, 30], toAck: [], dirty: false };
+// What the graphs received, for the tests and the bench: points, redraws, simulated time covered.
+const stats = { points: 0, redraws: 0, firstT: null, lastT: null };
+window.operateStats = stats;
+
+// -- the ring buffer ------------------------------------------------------------------------
+
+class Ring {
+  constructor(columns, capacity) {
+    this.columns = columns;
+    this.index = Object.fromEntries(columns.map((c, i) => [c, i]));
+    this.data = columns.map(() => new Float64Array(capacity));
+    this.capacity = capacity;
+    this.n = 0;      // rows held
+    this.next = 0;   // where the next row goes
+  }
+  push(row) {
+    for (let i = 0; i < this.data.length; i++) {
+      const v = row[i];
+      this.data[i][this.next] = v === null || v === undefined ? NaN : v;
+    }
+    this.next = (this.next + 1) % this.capacity;
+    this.n = Math.min(this.n + 1, this.capacity);
+  }
+  // The k-th row held, oldest first: column `c`'s value.
+  at(c, k) {
+    return this.data[c][(this.next - this.n + k + this.capacity) % this.capacity];
+  }
+  get lastT() {
+    return this.n ? this.at(0, this.n - 1) : -Infinity;
+  }
+}
+
+let ring = new Ring(["t_s"], CAPACITY);
+
+function takePlot(plot) {
+  if (plot.reset) {
+    ring = new Ring(plot.columns, CAPACITY);
+  }
+  for (const row of plot.rows) {
+    if (!(row[0] > ring.lastT)) continue; // a joining page may get a sample twice
+    ring.push(row);
+    stats.points++;
+    if (stats.firstT === null) stats.firstT = row[0];
+    stats.lastT = row[0];
+  }
+  state.dirty = true;
+}
+
+// -- the graphs -----------------------------------------------------------------------------
+
+function buildGraphs() {
+  const box = role("graphs");
+  for (const g of GRAPHS) {
+    const fig = document.createElement("figure");
+    fig.className = "graph";
+    fig.dataset.graph = g.id;
+    const cap = document.createElement("figcaption");
+    const title = document.createElement("b");
+    title.textContent = `${g.title}, ${g.unit}`;
+    const legend = document.createElement("span");
+    legend.className = "legend";
+    for (const [, label, colour] of g.series) {
+      const i = document.createElement("i");
+      i.style.background = colour;
+      legend.append(i, label);
+    }
+    const csv = document.createElement("button");
+    csv.type = "button";
+    csv.textContent = "CSV";
+    csv.setAttribute("aria-label", `${g.title} CSV`);
+    csv.title = "download this graph's data (every sample held) as CSV";
+    csv.addEventListener("click", () => download(g));
+    cap.append(title, legend, csv);
+    const canvas = document.createElement("canvas");
+    canvas.setAttribute("role", "img");
+    canvas.setAttribute("aria-label", `${g.title}: ${g.series.map((s) => s[1]).join(", ")}, ${g.unit}, the last ${WINDOW_S} s`);
+    fig.append(cap, canvas);
+    box.append(fig);
+    g.canvas = canvas;
+  }
+}
+
+function niceRange(lo, hi) {
+  if (!Number.isFinite(lo)) return [-1, 1];
+  if (hi - lo < 1e-9) {
+    const pad = Math.max(Math.abs(lo) * 0.05, 0.01);
+    return [lo - pad, hi + pad];
+  }
+  const pad = (hi - lo) * 0.08;
+  return [lo - pad, hi + pad];
+}
+
+function fmt(v) {
+  const a = Math.abs(v);
+  return a >= 100 ? v.toFixed(0) : a >= 10 ? v.toFixed(1) : a >= 1 ? v.toFixed(2) : v.toFixed(3);
+}
+
+function drawGraph(g) {
+  const canvas = g.canvas;
+  const dpr = window.devicePixelRatio || 1;
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+    canvas.width = Math.round(w * dpr);
+    canvas.height = Math.round(h * dpr);
+  }
+  const ctx = canvas.getContext("2d");
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.clearRect(0, 0, w, h);
+  const left = 52, right = 6, top = 6, bottom = 18;
+  const cols = g.series.map(([name]) => ring.index[name]).filter((c) => c !== undefined);
+  const tEnd = ring.n ? ring.lastT : WINDOW_S;
+  const tStart = tEnd - WINDOW_S;
+  let first = ring.n;
+  while (first > 0 && ring.at(0, first - 1) >= tStart) first--;
+  let lo = Infinity, hi = -Infinity;
+  for (const c of cols) {
+    for (let k = first; k < ring.n; k++) {
+      const v = ring.at(c, k);
+      if (v < lo) lo = v;
+      if (v > hi) hi = v;
+    }
+  }
+  [lo, hi] = niceRange(lo, hi);
+  const x = (t) => left + ((t - tStart) / WINDOW_S) * (w - left - right);
+  const y = (v) => top + (1 - (v - lo) / (hi - lo)) * (h - top - bottom);
+  ctx.strokeStyle = "#ddd";
+  ctx.fillStyle = "#666";
+  ctx.font = "11px sans-serif";
+  ctx.lineWidth = 1;
+  ctx.textAlign = "right";
+  ctx.textBaseline = "middle";
+  for (const v of [lo, (lo + hi) / 2, hi]) {
+    ctx.beginPath();
+    ctx.moveTo(left, y(v));
+    ctx.lineTo(w - right, y(v));
+    ctx.stroke();
+    ctx.fillText(fmt(v), left - 4, y(v));
+  }
+  ctx.textAlign = "center";
+  ctx.textBaseline = "top";
+  for (let s = Math.ceil(tStart / 5) * 5; s <= tEnd; s += 5) {
+    ctx.fillText(`${s} s`, x(s), h - bottom + 3);
+  }
+  g.series.forEach(([name, , colour]) => {
+    const c = ring.index[name];
+    if (c === undefined) return;
+    ctx.strokeStyle = colour;
+    ctx.lineWidth = 1.5;
+    ctx.beginPath();
+    let pen = false;
+    for (let k = first; k < ring.n; k++) {
+      const v = ring.at(c, k);
+      if (Number.isNaN(v)) {
+        pen = false;
+        continue;
+      }
+      const px = x(ring.at(0, k)), py = y(v);
+      if (pen) ctx.lineTo(px, py);
+      else ctx.moveTo(px, py);
+      pen = true;
+    }
+    ctx.stroke();
+  });
+}
+
+function redraw() {
+  if (state.dirty) {
+    state.dirty = false;
+    for (const g of GRAPHS) drawGraph(g);
+    stats.redraws++;
+  }
+  // The frames are drawn: acknowledged for the latency figures (the session's clock).
+  for (const seq of state.toAck) link.ack(seq);
+  state.toAck = [];
+  requestAnimationFrame(redraw);
+}
+
+function csvText(g) {
+  const names = ["t_s", ...g.series.map(([name]) => name)];
+  const cols = names.map((n) => ring.index[n]);
+  const lines = [names.join(",")];
+  for (let k = 0; k < ring.n; k++) {
+    lines.push(cols.map((c) => (c === undefined || Number.isNaN(ring.at(c, k)) ? "" : String(ring.at(c, k)))).join(","));
+  }
+  return lines.join("\n") + "\n";
+}
+
+function download(g) {
+  const url = URL.createObjectURL(new Blob([csvText(g)], { type: "text/csv" }));
+  const a = document.createElement("a");
+  a.href = url;
+  a.download = `${g.id}.csv`;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 10_000);
+}
+
+// -- the controls ---------------------------------------------------------------------------
+
+function say(text, error) {
+  const box = role("reply");
+  box.textContent = text;
+  box.dataset.error = error ? "true" : "false";
+}
+
+// A slider and its number box: the box takes a typed value only inside the slider's range;
+// outside it the value is refused, said, and left in the box as typed (never clamped).
+function pair(name, unit, sliderRole, boxRole, onChange) {
+  const slider = role(sliderRole), box = role(boxRole);
+  const lo = Number(slider.min), hi = Number(slider.max);
+  slider.addEventListener("input", () => {
+    box.value = slider.value;
+    box.setAttribute("aria-invalid", "false");
+    check();
+    onChange();
+  });
+  box.addEventListener("input", () => {
+    const v = box.valueAsNumber;
+    const ok = box.value !== "" && Number.isFinite(v) && v >= lo && v <= hi;
+    box.setAttribute("aria-invalid", ok ? "false" : "true");
+    if (ok) slider.value = String(v);
+    check();
+    onChange();
+  });
+  return {
+    name, unit, lo, hi, slider, box,
+    valid: () => box.getAttribute("aria-invalid") !== "true",
+    // What Trigger sends: the value as typed (the session checks it too).
+    value: () => (box.value === "" || !Number.isFinite(box.valueAsNumber) ? box.value : box.valueAsNumber),
+  };
+}
+
+let magnitude, speed;
+
+function check() {
+  const bad = [magnitude, speed].filter((p) => !p.valid());
+  const box = role("check");
+  box.textContent = bad.map((p) => `${p.name} ${p.box.value === "" ? "(empty)" : p.box.value} is refused: it must be a number`
+    + ` from ${p.lo} to ${p.hi}${p.unit}; the slider stays at ${p.slider.value}${p.unit}`).join(" ");
+  box.dataset.error = bad.length ? "true" : "false";
+}
+
+function describeSettings() {
+  role("magnitude-means").textContent = MEANS[role("symbol").value];
+  const s = speed.valid() ? Number(speed.slider.value) : NaN;
+  const [lo, hi] = state.speedRange;
+  role("speed-mm-s").textContent = Number.isFinite(s) ? `${(lo + ((hi - lo) * s) / 5).toFixed(1)} mm/s` : "";
+}
+
+function drawOperate(op) {
+  state.op = op;
+  if (op.speed_mm_s_range) state.speedRange = op.speed_mm_s_range;
+  role("status").textContent = op.status;
+  const trigger = $('[data-cmd="trigger"]');
+  trigger.disabled = !op.trigger;
+  role("why").textContent = op.trigger ? "" : `Trigger is off: ${op.why}`;
+  $('[data-cmd="stop"]').disabled = op.turning_off;
+  const p = op.precision;
+  const cell = (key) => role("precision").querySelector(`[data-key="${key}"]`);
+  if (p) {
+    const what = { X: "an X", O: "an O", sine: "a sine wave" }[p.symbol];
+    cell("what").textContent = `${what}, ${p.magnitude_cm} cm, speed ${p.speed} (${p.speed_mm_s} mm/s)`;
+    const mm = (v) => (v === null || v === undefined ? "–" : `${v.toFixed(3)} mm`);
+    cell("rms_error_mm").textContent = p.error ? p.error : mm(p.rms_error_mm);
+    cell("max_error_mm").textContent = mm(p.max_error_mm);
+    cell("closure_gap_mm").textContent = mm(p.closure_gap_mm);
+    cell("fk_vs_true_max_mm").textContent = mm(p.fk_vs_true_max_mm);
+    cell("duration_s").textContent = `${p.duration_s.toFixed(1)} s of simulated time`;
+  }
+  describeSettings();
+}
+
+function drawFrame(f) {
+  if (f.mode !== undefined) {
+    state.mode = f.mode;
+    const mode = role("mode");
+    mode.textContent = f.mode;
+    mode.dataset.mode = f.mode;
+    $('[data-cmd="run"]').disabled = f.mode === "running";
+  }
+  if (f.t !== undefined) role("sim-time").textContent = f.t.toFixed(1);
+  if (f.operate) drawOperate(f.operate);
+  if (f.plot) takePlot(f.plot);
+  if (f.error) say(f.error, true);
+}
+
+function onMessage(m) {
+  if (m.type === "frame") {
+    drawFrame(m);
+    state.toAck.push(m.seq);
+  } else if (m.type === "reply") {
+    say(m.text || "", false);
+  } else if (m.type === "error") {
+    say(m.error, true);
+  }
+}
+
+const link = new SessionLink(onMessage, (status) => {
+  if (status !== "connected") role("mode").textContent = status;
+});
+
+buildGraphs();
+magnitude = pair("Magnitude", " cm", "magnitude", "magnitude-box", describeSettings);
+speed = pair("Speed", "", "speed", "speed-box", describeSettings);
+role("symbol").addEventListener("change", describeSettings);
+describeSettings();
+$('[data-cmd="run"]').addEventListener("click", () => link.send({ type: "run" }));
+$('[data-cmd="stop"]').addEventListener("click", () => link.send({ type: "operate_stop" }));
+$('[data-cmd="trigger"]').addEventListener("click", () => {
+  link.send({ type: "operate_trigger", symbol: role("symbol").value, magnitude_cm: magnitude.value(), speed: speed.value() });
+});
+link.connect();
+requestAnimationFrame(redraw);

@@ -1,0 +1,212 @@
+"""The Operational page (/operate) in Chromium: Run_simulation, Trigger, the sliders, the graphs, CSV.
+
+One session for the module, paused at power-on, as fast as it goes once
+Run_simulation is clicked; the tests run in order on it (the arm waits at its
+waiting pose after the first).  What the drawing tests assert on is the
+simulated whiteboard's ink, read in the simulation thread, beside what the
+page shows.
+
+The screenshot of docs/gui.md's ``/operate`` section is taken after the O;
+``make screenshots`` (``TTT_SM_SCREENSHOTS=docs/img``) writes it into docs/img.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from ttt_sm.debug.debugger import Debugger
+from ttt_sm.params import load_params
+from ttt_sm.web.operate import MSG_DRAWING, MSG_INITIALISING, MSG_READY, MSG_TURNING_OFF, SAMPLE_PERIOD_S
+from ttt_sm.web.session import Session
+
+from .conftest import Cockpit, serve
+
+SHOT = "gui_operate.png"
+#: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
+LONG = 240_000
+
+
+@pytest.fixture(scope="module")
+def operate_cockpit(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cockpit]:
+    """A session at power-on, paused, as fast as it goes when run."""
+    dbg = Debugger.build(load_params(), seed=0)
+    trace = tmp_path_factory.mktemp("operate") / "trace.jsonl"
+    session = Session(dbg, speed=None, running=False, trace_path=trace)
+    server, thread, url = serve(session)
+    try:
+        yield Cockpit(url, session, server)
+    finally:
+        server.should_exit = True
+        thread.join(30)
+
+
+def text_of(page: Any, role: str) -> str:
+    return str(page.locator(f'[data-role="{role}"]').text_content()).strip()
+
+
+def wait_status(page: Any, text: str, timeout: int = LONG) -> None:
+    page.wait_for_function("(text) => document.querySelector('[data-role=status]').textContent.trim() === text",
+                           arg=text, timeout=timeout)
+
+
+def open_operate(page: Any, cockpit: Cockpit) -> None:
+    page.goto(cockpit.page_url("/operate"))
+    page.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'",
+                           timeout=30_000)
+
+
+def trigger(page: Any) -> Any:
+    return page.get_by_role("button", name="Trigger", exact=True)
+
+
+def fit_circle(points: np.ndarray) -> tuple[float, float, float]:
+    """The least-squares circle through ``points`` (x, y rows): centre and diameter, m."""
+    x, y = points[:, 0], points[:, 1]
+    a = np.column_stack([x, y, np.ones_like(x)])
+    c = np.linalg.lstsq(a, x * x + y * y, rcond=None)[0]
+    xc, yc = c[0] / 2, c[1] / 2
+    return float(xc), float(yc), 2 * math.sqrt(c[2] + xc * xc + yc * yc)
+
+
+def test_trigger_is_off_before_the_arm_waits_and_a_typed_value_out_of_range_is_refused(
+        browser: Any, operate_cockpit: Cockpit) -> None:
+    page = browser.new_page()
+    try:
+        open_operate(page, operate_cockpit)
+        assert page.get_by_role("status", name="manipulator status").text_content() == MSG_INITIALISING
+        assert trigger(page).is_disabled()
+        assert text_of(page, "why").startswith("Trigger is off: the manipulator is not at its waiting pose yet")
+        magnitude = page.get_by_role("slider", name="Magnitude", exact=True)
+        box = page.get_by_role("spinbutton", name="Magnitude (cm)", exact=True)
+        magnitude.fill("4.5")  # the slider moves the box
+        assert box.input_value() == "4.5"
+        box.fill("12")
+        check = page.get_by_role("status", name="the values typed")
+        assert check.text_content() == ("Magnitude 12 is refused: it must be a number from 0 to 10 cm;"
+                                        " the slider stays at 4.5 cm")
+        assert box.get_attribute("aria-invalid") == "true"
+        assert box.input_value() == "12" and magnitude.input_value() == "4.5"  # not clamped, not taken
+        speed = page.get_by_role("spinbutton", name="Speed (0 to 5)", exact=True)
+        speed.fill("-1")
+        assert "Speed -1 is refused: it must be a number from 0 to 5" in str(check.text_content())
+        speed.fill("2")
+        box.fill("6")
+        assert text_of(page, "check") == "" and box.get_attribute("aria-invalid") == "false"
+        assert page.get_by_role("slider", name="Speed", exact=True).input_value() == "2"
+        assert text_of(page, "speed-mm-s") == "15.0 mm/s"
+    finally:
+        page.close()
+
+
+def test_an_o_of_6_cm_at_speed_3_is_a_circle_of_60_mm_on_the_whiteboard(
+        browser: Any, operate_cockpit: Cockpit, tmp_path: Path) -> None:
+    session = operate_cockpit.session
+    page = browser.new_page(viewport={"width": 1500, "height": 1000})
+    charts = browser.new_page(viewport={"width": 1200, "height": 900})
+    try:
+        open_operate(page, operate_cockpit)
+        page.get_by_role("button", name="Run_simulation", exact=True).click()
+        wait_status(page, MSG_DRAWING)  # the field first: the Control chart's own order
+        assert trigger(page).is_disabled()
+        wait_status(page, MSG_READY)
+        page.wait_for_function("!document.querySelector('[data-cmd=trigger]').disabled", timeout=30_000)
+        page.get_by_label("Symbol", exact=True).select_option("O")
+        assert text_of(page, "magnitude-means") == "the O's diameter"
+        # A typed value out of range reaches the session as typed, and the session refuses it too.
+        box = page.get_by_role("spinbutton", name="Magnitude (cm)", exact=True)
+        box.fill("10.5")
+        actions_before = session.call(lambda d: len(d.actions))
+        trigger(page).click()
+        page.wait_for_function("document.querySelector('[data-role=reply]').dataset.error === 'true'",
+                               timeout=30_000)
+        assert text_of(page, "reply") == "operate_trigger: 'magnitude_cm' must be a number from 0 to 10, got 10.5"
+        assert session.call(lambda d: len(d.actions)) == actions_before  # nothing set, nothing posted
+        box.fill("6")
+        page.get_by_role("spinbutton", name="Speed (0 to 5)", exact=True).fill("3")
+        assert text_of(page, "speed-mm-s") == "20.0 mm/s"
+        charts.goto(operate_cockpit.page_url("/charts"))
+        charts.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'",
+                                 timeout=30_000)
+        strokes_before, t0 = session.call(lambda d: (len(d.robot.board.strokes), d.robot.t))
+        trigger(page).click()
+        # the same session in the chart cockpit: Trigger's inputs and event, within a frame
+        charts.wait_for_function("document.querySelector('[data-role=actions]').textContent.includes("
+                                 "'post Control button')", timeout=30_000)
+        assert "set Control.size 0.06" in str(charts.locator('[data-role="actions"]').text_content())
+        page.wait_for_function("document.querySelector('[data-role=reply]').textContent.startsWith('Trigger:')",
+                               timeout=30_000)
+        assert text_of(page, "reply") == "Trigger: an O, 6 cm diameter, speed 3 (20 mm/s)"
+        page.wait_for_function("document.querySelector('[data-key=what]').textContent.startsWith('an O')",
+                               timeout=LONG)
+        wait_status(page, MSG_READY)
+        t1 = session.call(lambda d: d.robot.t)
+
+        def ink(d: Debugger) -> np.ndarray:
+            strokes = [s for s in d.robot.board.strokes[strokes_before:] if s.author == "robot"]
+            return np.vstack([s.points for s in strokes])
+
+        points = session.call(ink)
+        xc, yc, diameter = fit_circle(points)
+        centre = session.call(lambda d: (d.robot.control.x0, d.robot.control.y0))
+        assert abs(diameter - 0.060) <= 0.0005, diameter
+        assert math.hypot(xc - centre[0], yc - centre[1]) < 0.0005
+        # every ink point lies on that circle (no tail, no second stroke elsewhere)
+        assert np.abs(np.hypot(points[:, 0] - xc, points[:, 1] - yc) - diameter / 2).max() < 0.0005
+        precision = session.call(lambda d: session.operate.results[-1])
+        assert text_of(page, "precision").count("mm") >= 3
+        assert precision["closure_gap_mm"] is not None and precision["closure_gap_mm"] < 1.0
+        assert f"{precision['rms_error_mm']:.3f} mm" in text_of(page, "precision")
+        # the graphs got at least 10 points a simulated second over the drawing
+        got = page.evaluate("window.operateStats")
+        assert got["points"] >= 10 * (got["lastT"] - got["firstT"])
+        assert got["firstT"] <= t0 and got["lastT"] >= t1 - 0.5
+        assert got["redraws"] > 0
+        shot = Path(os.environ.get("TTT_SM_SCREENSHOTS") or tmp_path) / SHOT
+        page.screenshot(path=str(shot))
+        assert shot.stat().st_size > 20_000
+
+        # X axis, as CSV: the page's samples, those the session took, 0.04 s apart over the drawing
+        with page.expect_download() as info:
+            page.get_by_role("button", name="X axis CSV", exact=True).click()
+        download = info.value
+        assert download.suggested_filename == "x_axis.csv"
+        rows = list(csv.reader(io.StringIO(Path(download.path()).read_text(encoding="utf-8"))))
+        assert rows[0] == ["t_s", "x_desired_mm", "x_fk_mm"]
+        table = [[float(v) for v in r] for r in rows[1:]]
+        times = [r[0] for r in table]
+        assert all(math.isclose(b - a, SAMPLE_PERIOD_S, abs_tol=1e-6) for a, b in zip(times, times[1:], strict=False))
+        during = [r for r in table if t0 <= r[0] <= t1]
+        assert len(during) >= 10 * (t1 - t0)
+        taken = {row[0]: row for row in session.call(lambda d: list(session.operate.stage.history))}
+        assert all(taken[r[0]][1:3] == r[1:] for r in during if r[0] in taken)
+        assert sum(r[0] in taken for r in during) > 100
+        # the pen followed the circle: desired x spans the O's 60 mm
+        assert max(r[1] for r in during) - min(r[1] for r in during) >= 59.0
+    finally:
+        charts.close()
+        page.close()
+
+
+def test_stop_simulation_turns_the_manipulator_off_and_trigger_says_why(
+        browser: Any, operate_cockpit: Cockpit) -> None:
+    page = browser.new_page()
+    try:
+        open_operate(page, operate_cockpit)
+        wait_status(page, MSG_READY, timeout=30_000)
+        page.get_by_role("button", name="Stop_simulation", exact=True).click()
+        wait_status(page, MSG_TURNING_OFF, timeout=30_000)
+        page.wait_for_function("document.querySelector('[data-cmd=trigger]').disabled", timeout=30_000)
+        assert text_of(page, "why") == "Trigger is off: the manipulator is being turned off"
+        operate_cockpit.session.call(lambda d: d.robot.run_until(lambda: d.robot.control.at_start, 60.0))
+        assert operate_cockpit.session.call(lambda d: bool(d.robot.control.at_start))
+    finally:
+        page.close()

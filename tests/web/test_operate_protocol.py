@@ -1,0 +1,152 @@
+"""The Operational page's commands over the WebSocket, without a browser: checks, refusals, the stream."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from starlette.testclient import TestClient
+
+from ttt_sm.debug.debugger import Debugger
+from ttt_sm.params import load_params
+from ttt_sm.web.operate import COLUMNS, MSG_DRAWING, MSG_INITIALISING, MSG_READY, SAMPLE_PERIOD_S, speed_mm_s
+from ttt_sm.web.protocol import ProtocolError, parse_command
+from ttt_sm.web.server import create_app
+from ttt_sm.web.session import Session
+
+from .test_protocol import Page, state_of
+
+
+@pytest.mark.parametrize(("message", "error"), [
+    ('{"type": "operate_trigger", "symbol": "O", "magnitude_cm": 12, "speed": 3}',
+     "operate_trigger: 'magnitude_cm' must be a number from 0 to 10, got 12"),
+    ('{"type": "operate_trigger", "symbol": "O", "magnitude_cm": -0.5, "speed": 3}',
+     "operate_trigger: 'magnitude_cm' must be a number from 0 to 10, got -0.5"),
+    ('{"type": "operate_trigger", "symbol": "O", "magnitude_cm": 6, "speed": 5.5}',
+     "operate_trigger: 'speed' must be a number from 0 to 5, got 5.5"),
+    ('{"type": "operate_trigger", "symbol": "O", "magnitude_cm": "6", "speed": 3}',
+     "operate_trigger: 'magnitude_cm' must be a number from 0 to 10, got \"6\""),
+    ('{"type": "operate_trigger", "symbol": "square", "magnitude_cm": 6, "speed": 3}',
+     "operate_trigger: 'symbol' must be \"X\", \"O\" or \"sine\", got \"square\""),
+    ('{"type": "operate_trigger", "symbol": "O", "speed": 3}', "operate_trigger: missing field 'magnitude_cm'"),
+    ('{"type": "operate_stop", "now": true}', "operate_stop: unknown field 'now'; fields: none"),
+])
+def test_a_malformed_operate_command_is_refused_by_name(message: str, error: str) -> None:
+    with pytest.raises(ProtocolError) as exc:
+        parse_command(message)
+    assert str(exc.value) == error
+
+
+def test_the_speed_slider_maps_linearly_from_5_to_30_mm_s() -> None:
+    assert [speed_mm_s(s) for s in (0, 1, 3, 5)] == [5.0, 10.0, 20.0, 30.0]
+
+
+@pytest.fixture(scope="module")
+def operating() -> Iterator[tuple[Session, Any, Page, dict[str, Any]]]:
+    """A paused session at power-on, as fast as it goes, with one page joined over the test client.
+
+    Also the full frame the page got when it joined.
+    """
+    session = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
+    session.start()
+    try:
+        with TestClient(create_app(session, manage_session=False)) as client, client.websocket_connect("/ws") as ws:
+            page = Page(ws)
+            _, full = page.join()
+            yield session, client, page, full
+    finally:
+        session.stop()
+
+
+def test_before_the_arm_waits_trigger_is_refused_and_says_why(
+        operating: tuple[Session, Any, Page, dict[str, Any]]) -> None:
+    session, client, page, full = operating
+    assert '<label for="magnitude">Magnitude</label>' in client.get("/operate").text
+    op = full["operate"]
+    assert op["status"] == MSG_INITIALISING
+    assert op["trigger"] is False and "not at its waiting pose yet" in op["why"]
+    assert full["plot"]["columns"] == list(COLUMNS) and full["plot"]["reset"] is True
+    before = state_of(session)
+    answer = page.answer(page.send(type="operate_trigger", symbol="O", magnitude_cm=6, speed=3))
+    assert answer["type"] == "error"
+    assert answer["error"].startswith("operate_trigger: Trigger is not taken now: the manipulator is not at its"
+                                      " waiting pose yet")
+    assert state_of(session) == before  # nothing was set, nothing posted
+    page.send(type="operate_trigger", symbol="O", magnitude_cm=10.5, speed=3)
+    bad = page.answer()  # refused before it is a command: no id
+    assert bad["error"] == "operate_trigger: 'magnitude_cm' must be a number from 0 to 10, got 10.5"
+    stop = page.answer(page.send(type="operate_stop"))
+    assert stop["error"] == ("operate_stop: the manipulator has not been started: nothing to turn off"
+                             " (Run_simulation first)")
+    assert state_of(session) == before
+
+
+def test_trigger_at_the_waiting_pose_draws_and_the_frames_carry_samples_in_simulated_time(
+        operating: tuple[Session, Any, Page, dict[str, Any]]) -> None:
+    session, _, page, _ = operating
+    # the arm initialises, draws the field and waits at its waiting pose
+    session.call(lambda d: d.robot.run_until(lambda: d.robot.control.ready, 200.0), timeout_s=300)
+    page.send(type="pause")  # a frame after the run above
+    op = _until(page, lambda f: f.get("operate", {}).get("status") == MSG_READY)["operate"]
+    assert op["trigger"] is True and op["why"] == ""
+    dot = page.answer(page.send(type="operate_trigger", symbol="X", magnitude_cm=0.2, speed=3))
+    assert dot["error"] == ("operate_trigger: an X of 0.2 cm is a dot: choose a Magnitude of 0.4 cm or more")
+    ok = page.answer(page.send(type="operate_trigger", symbol="X", magnitude_cm=2.5, speed=4))
+    assert ok["type"] == "reply" and ok["text"] == "Trigger: an X, 2.5 cm side, speed 4 (25 mm/s)"
+    control = session.call(lambda d: (d.robot.control.size, d.robot.control.speed, d.robot.control.symbol))
+    assert control == (pytest.approx(0.025), pytest.approx(0.025), 1)
+    again = page.answer(page.send(type="operate_trigger", symbol="X", magnitude_cm=2.5, speed=4))
+    assert again["error"] == ("operate_trigger: Trigger is not taken now: the manipulator is drawing: Trigger"
+                              " again when it waits at its waiting pose")
+    page.send(type="run")
+    rows: list[list[Any]] = []
+    statuses = set()
+    while True:
+        f = page.frame()
+        rows += f.get("plot", {}).get("rows", [])
+        if "operate" in f:
+            statuses.add(f["operate"]["status"])
+            if f["operate"]["drawings"] == 1:
+                break
+    page.send(type="pause")
+    result = f["operate"]["precision"]
+    assert result["symbol"] == "X" and result["speed_mm_s"] == 25.0
+    assert 0 < result["rms_error_mm"] < 0.5 and result["closure_gap_mm"] is None
+    assert statuses >= {MSG_DRAWING, MSG_READY}
+    # the samples: 25 a simulated second, in order, each row every column
+    t = [r[0] for r in rows]
+    assert all(len(r) == len(COLUMNS) for r in rows)
+    assert all(math.isclose(b - a, SAMPLE_PERIOD_S, abs_tol=1e-6) for a, b in zip(t, t[1:], strict=False))
+    assert len(rows) >= 10 * (t[-1] - t[0])
+    # while the X is drawn the desired pen is on the board and the encoders' forward kinematics follows it
+    down = [r for r in rows if r[5] is not None and r[5] < 0]
+    assert down and max(abs(r[1] - r[2]) for r in down) < 2.0
+
+
+def _until(page: Page, ok: Any, limit: int = 2000) -> dict[str, Any]:
+    for _ in range(limit):
+        f = page.frame()
+        if ok(f):
+            return f
+    raise AssertionError("no such frame")
+
+
+def test_the_sine_waves_magnitude_is_its_peak_to_peak_on_the_whiteboard(
+        operating: tuple[Session, Any, Page, dict[str, Any]]) -> None:
+    session, _, page, _ = operating
+    session.call(lambda d: d.robot.run_until(lambda: d.robot.control.ready, 200.0), timeout_s=300)
+    strokes_before = session.call(lambda d: len(d.robot.board.strokes))
+    ok = page.answer(page.send(type="operate_trigger", symbol="sine", magnitude_cm=4, speed=5))
+    assert ok["text"] == "Trigger: a sine wave, 4 cm peak to peak, speed 5 (30 mm/s)"
+    assert session.call(lambda d: d.robot.control.sine_amplitude) == pytest.approx(0.02)
+    done = session.call(lambda d: d.robot.run_until(lambda: bool(session.operate.results)
+                                                    and session.operate.results[-1]["symbol"] == "sine", 200.0),
+                        timeout_s=300)
+    assert done
+    ink = session.call(lambda d: [s.points for s in d.robot.board.strokes[strokes_before:] if s.author == "robot"])
+    y = [p[1] for points in ink for p in points]
+    assert abs((max(y) - min(y)) - 0.040) < 0.001  # the pen's centre line: 40 mm from crest to trough
+    result = session.call(lambda d: session.operate.results[-1])
+    assert result["speed_mm_s"] == 30.0 and result["closure_gap_mm"] is None and result["rms_error_mm"] < 0.5

@@ -43,6 +43,20 @@ from ..twin.kinematics import IKError, arm_chain_py
 from .wiring import Wiring, not_wired
 
 
+def _chart_step_row(row: np.ndarray, steps: int) -> tuple[float, ...]:
+    """A setpoint filter's row (``a11 a12 b1 a21 a22 b2``, one control step) over `steps` control steps.
+
+    The setpoint is held over a chart step, so the filter over it is
+    ``x <- A^n x + (A^(n-1) + ... + I) B u``: one update per chart step.
+    """
+    a = np.array([[row[0], row[1]], [row[3], row[4]]])
+    b = np.array([row[2], row[5]])
+    an, bn = np.eye(2), np.zeros(2)
+    for _ in range(steps):
+        an, bn = a @ an, a @ bn + b
+    return float(an[0, 0]), float(an[0, 1]), float(bn[0]), float(an[1, 0]), float(an[1, 1]), float(bn[1])
+
+
 #: A drive counts as at its speed clamp this long after the model left it, s: the lag its
 #: acceleration left behind decays with the position loop (outer crossover 6 Hz: about 30 ms).
 FAST_HOLD_S = 0.1
@@ -102,9 +116,8 @@ class SafetyStage:
         self._reinitialise = reinitialise
         c = params.control
         self._chart_dt = c.chart_dt
-        self._steps = c.chart_divider
-        self._rows = {False: tuple(setpoint_filter_row(c.setpoint_cutoff_hz, c.dt).tolist()),
-                      True: tuple(setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt).tolist())}
+        self._rows = {False: _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_hz, c.dt), c.chart_divider),
+                      True: _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt), c.chart_divider)}
         self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
         g = params.geometry
         self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
@@ -118,8 +131,9 @@ class SafetyStage:
         self._step_max = [max_joint_speed(d) * c.chart_dt for d in params.drives]
         self._fast = [0, 0, 0]  # chart steps the drive still counts as at its speed clamp
         self._fast_steps = max(1, round(FAST_HOLD_S / c.chart_dt))
-        self._offsets = list(arm.offset_estimates())
-        self._counts = list(arm.sensors().counts)
+        self._offsets = arm.offset_estimates()
+        self._counts = arm.sensors().counts
+        self._speed_per_count = tuple(r / c.chart_dt for r in self._rpc)
         self._pose: list[float] | None = None  # what the drives hold while the chart trips
         self._lift_for = math.nan  # the lift_z the pose was solved for
         self._lift_from: list[float] = []
@@ -143,6 +157,10 @@ class SafetyStage:
         """The ``Link`` block: the arm's own report of its link, where it has one (else True)."""
         return bool(getattr(self.arm, "link_ok", True))
 
+    def commanded_speed(self) -> list[float]:
+        """Each drive's commanded speed, rad/s: the rate of the model of its setpoint filter."""
+        return [dp / self._chart_dt for dp in self._dp]
+
     def blocks(self) -> dict[str, object]:
         """The objects holding the outputs of this stage's blocks (Link, Camera); Monitor and FK are arguments."""
         return {"Link": self, "Camera": self.camera}
@@ -150,34 +168,30 @@ class SafetyStage:
     def wire(self, wiring: Wiring) -> None:
         """Compile this stage's part of the wiring table."""
         self._feed = wiring.feed([self.chart.chart_name], args=("Monitor", "FK"))
-        self._outputs = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.lift_z", "SafeState.bridge_off",
-                                       "SafeState.reinit")
+        self._outputs = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.lift_z",
+                                       "SafeState.bridge_off", "SafeState.reinit")
 
     def tick(self, signals: Signals) -> None:
-        """Monitor in, chart ticked, the safe state out."""
+        """Monitor in, chart ticked, the safe state out (written out drive by drive: it runs every chart step)."""
         arm = self.arm
         sensors = signals.sensors
         assert sensors is not None
-        enc = arm.encoder_angles()
+        e1, e2, e3 = enc = arm.encoder_angles()
         offsets = arm.offset_estimates()
-        r, p, rpc, dt = self._r, self._p, self._rpc, self._chart_dt
-        counts = sensors.counts
-        err, speed, cmd, current = [0.0] * 3, [0.0] * 3, [0.0] * 3, [0.0] * 3
-        for i in range(3):
-            if offsets[i] != self._offsets[i]:  # the init chart moved the encoder coordinates: so do the setpoints
-                r[i] += offsets[i] - self._offsets[i]
-                p[i] += offsets[i] - self._offsets[i]
-                self._offsets[i] = offsets[i]
-            err[i] = p[i] - enc[i]
-            speed[i] = abs(counts[i] - self._counts[i]) * rpc[i] / dt
-            cmd[i] = self._dp[i] / dt
-            current[i] = abs(sensors.current_a[i])
-        self._counts = list(counts)
-        self.err = err
+        if offsets != self._offsets:  # the init chart moved the encoder coordinates: so do the setpoints
+            self._shift(offsets)
+        p = self._p
+        c1, c2, c3 = counts = sensors.counts
+        k1, k2, k3 = self._counts
+        s1, s2, s3 = self._speed_per_count
+        i1, i2, i3 = sensors.current_a
+        self._counts = counts
+        self.err = err = [p[0] - e1, p[1] - e2, p[2] - e3]
         servo = arm.servo_setpoint
-        x, y, z, phi, _, _, _, _ = arm_chain_py(enc[0], enc[1], enc[2], servo, *self._geometry)
-        fast = [self._fast[0] > 0, self._fast[1] > 0, self._fast[2] > 0]
-        self._feed(err, speed, cmd, current, list(enc), fast, x, y, z)
+        x, y, z, phi, _, _, _, _ = arm_chain_py(e1, e2, e3, servo, *self._geometry)
+        fast = self._fast
+        self._feed(err, [abs(c1 - k1) * s1, abs(c2 - k2) * s2, abs(c3 - k3) * s3], self.commanded_speed(),
+                   [abs(i1), abs(i2), abs(i3)], enc, [fast[0] > 0, fast[1] > 0, fast[2] > 0], x, y, z)
         if self.overrides:
             vars(self.chart).update(self.overrides)
         self.chart.tick()
@@ -216,6 +230,14 @@ class SafetyStage:
             self._lift_to = None
         self._advance_model(signals.q_set, bool(signals.fr_sw))
 
+    def _shift(self, offsets: tuple[float, float, float]) -> None:
+        """The encoder offsets changed by this much: the model's angles move with them."""
+        for i in range(3):
+            delta = offsets[i] - self._offsets[i]
+            self._r[i] += delta
+            self._p[i] += delta
+        self._offsets = offsets
+
     def _lift_pose(self, lift_z: float) -> list[float]:
         """Joint setpoints with the tool where it was at the trip, at height `lift_z`; the held pose if out of reach."""
         assert self._pose is not None
@@ -229,28 +251,30 @@ class SafetyStage:
 
     def _advance_model(self, q_set: Sequence[float] | np.ndarray, fr_sw: bool) -> None:
         """Step the setpoint-filter model as the controller will, over the control steps of this chart step."""
-        a11, a12, b1, a21, a22, b2 = self._rows[fr_sw]
-        r, v, p, dp = self._r, self._v, self._p, self._dp
-        for i in range(3):
-            u, ri, vi = float(q_set[i]), r[i], v[i]
-            for _ in range(self._steps):
-                ri, vi = a11 * ri + a12 * vi + b1 * u, a21 * ri + a22 * vi + b2 * u
-            r[i], v[i] = ri, vi
-            step = self._step_max[i]
-            dp[i] = max(-step, min(step, ri - p[i]))
-            p[i] += dp[i]
+        a11, a12, b1, a21, a22, b2 = self._rows[fr_sw]  # the filter over the chart step's control steps
+        r, v, p, dp, fast, step_max = self._r, self._v, self._p, self._dp, self._fast, self._step_max
+        for i in (0, 1, 2):
+            u, ri, vi = q_set[i], r[i], v[i]
+            r[i] = rn = a11 * ri + a12 * vi + b1 * u
+            v[i] = a21 * ri + a22 * vi + b2 * u
+            step, d = step_max[i], rn - p[i]
+            if d > step:
+                d = step
+            elif d < -step:
+                d = -step
+            dp[i] = d
+            p[i] += d
             # at the clamp, and for a while after, the drive lags its acceleration behind the model
-            self._fast[i] = self._fast_steps if abs(dp[i]) >= step else max(0, self._fast[i] - 1)
+            if d == step or d == -step:
+                fast[i] = self._fast_steps
+            elif fast[i]:
+                fast[i] -= 1
 
     def _restart(self) -> None:
         """The chart asked to re-initialise: the init charts start again, every drive switched on holding."""
         self._reinitialise()
         arm, r, v = self.arm, self._r, self._v
-        offsets = arm.offset_estimates()
-        for i in range(3):  # the offsets changed: the setpoints moved with them
-            r[i] += offsets[i] - self._offsets[i]
-            self._p[i] += offsets[i] - self._offsets[i]
-        self._offsets = list(offsets)
+        self._shift(arm.offset_estimates())  # they changed: the setpoints moved with them
         enc = arm.encoder_angles()
         for i, on in enumerate(arm.enabled()):
             if not on:  # switched on, a drive holds where it stands, its filter reset there

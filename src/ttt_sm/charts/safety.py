@@ -142,8 +142,33 @@ class Safety(TickChart):
     # -- guards: pure functions of inputs and data ------------------------------
 
     def arm_fault(self) -> bool:
-        """A drive's check failed, an initialisation gave up, or the link is lost."""
-        return self._arm_fault() is not None
+        """A drive's check failed, an initialisation gave up, or the link is lost.
+
+        Written out drive by drive: it runs on every chart step of a game
+        (:meth:`_arm_fault` says which check failed, once it has).
+        """
+        d = self.__dict__
+        if not d["link_ok"] or d["init_failed"]:
+            return True
+        ini = d["initialised"]
+        cur_max = d["max_current"] if ini else d["max_current_init"]
+        speed_max, silent = d["max_speed"], d["silent_s"]
+        if (d["speed_1"] > speed_max or d["speed_2"] > speed_max or d["speed_3"] > speed_max
+                or d["current_1"] > cur_max or d["current_2"] > cur_max or d["current_3"] > cur_max
+                or d["still_1"] >= silent or d["still_2"] >= silent or d["still_3"] >= silent):
+            return True
+        err_max = d["max_following_error"] if ini else d["max_following_error_init"]
+        fast = d["max_following_error_fast"]
+        if (abs(d["err_1"]) > (fast if d["fast_1"] and fast > err_max else err_max)
+                or abs(d["err_2"]) > (fast if d["fast_2"] and fast > err_max else err_max)
+                or abs(d["err_3"]) > (fast if d["fast_3"] and fast > err_max else err_max)):
+            return True
+        if ini:
+            m = d["limit_margin"]
+            return not (d["q_min_1"] - m <= d["q_1"] <= d["q_max_1"] + m
+                        and d["q_min_2"] - m <= d["q_2"] <= d["q_max_2"] + m
+                        and d["q_min_3"] - m <= d["q_3"] <= d["q_max_3"] + m)
+        return False
 
     def lifted(self) -> bool:
         """The tool is up at `lift_z`."""
@@ -158,8 +183,6 @@ class Safety(TickChart):
         err_max = d["max_following_error"] if ini else d["max_following_error_init"]
         cur_max = d["max_current"] if ini else d["max_current_init"]
         for k in (1, 2, 3):
-            if d[f"off_{k}"]:
-                continue
             found = self._drive_check(k, ini, err_max, cur_max)
             if found is not None:
                 return found, k
@@ -241,12 +264,12 @@ class Safety(TickChart):
         self._count_still()
 
     def _count_still(self) -> None:
-        d, dt, moving = self.__dict__, self.tick_period_s, self.moving_speed
-        for k in (1, 2, 3):
-            if abs(d[f"cmd_speed_{k}"]) > moving and d[f"speed_{k}"] == 0.0:
-                d[f"still_{k}"] += dt
-            else:
-                d[f"still_{k}"] = 0.0
+        """still_k: how long drive k's encoder has stood still while commanded faster than moving_speed."""
+        d = self.__dict__
+        dt, moving = self.tick_period_s, d["moving_speed"]
+        d["still_1"] = d["still_1"] + dt if d["speed_1"] == 0.0 and abs(d["cmd_speed_1"]) > moving else 0.0
+        d["still_2"] = d["still_2"] + dt if d["speed_2"] == 0.0 and abs(d["cmd_speed_2"]) > moving else 0.0
+        d["still_3"] = d["still_3"] + dt if d["speed_3"] == 0.0 and abs(d["cmd_speed_3"]) > moving else 0.0
 
 
 __all__ = ["Safety"]

@@ -172,6 +172,7 @@ class SafetyParams:
     max_current_init_a: float
     max_speed_rad_s: float
     moving_speed_rad_s: float
+    stall_ratio: float
     silent_s: float
     limit_margin_rad: float
     lift_height_m: float
@@ -272,6 +273,7 @@ LIMITS: dict[str, tuple[float, float]] = {
     "safety.max_following_error_fast_rad": (1e-4, 1.0),
     "safety.max_current_a": (0.01, 1000.0), "safety.max_current_init_a": (0.01, 1000.0),
     "safety.max_speed_rad_s": (0.1, 1000.0), "safety.moving_speed_rad_s": (1e-4, 10.0),
+    "safety.stall_ratio": (0.0, 1.0),
     "safety.silent_s": (1e-3, 1.0), "safety.limit_margin_rad": (0.0, 0.5), "safety.lift_height_m": (0.0, 0.1),
     "safety.lift_speed_m_s": (0.001, 1.0),
     "drive.supply_v": (0.1, 100.0), "drive.resistance_ohm": (1e-3, 1e3), "drive.inductance_h": (1e-7, 1.0),

@@ -51,7 +51,7 @@ def test_a_drive_2_search_that_runs_into_its_hard_stop_trips_before_the_init_cha
     t_stop = robot.t
     assert robot.run_until(lambda: robot.tripped, 1.0)
     assert robot.t - t_stop <= 0.1
-    assert robot.safety.reason.startswith("encoder silent while commanded to move on drive 2")
+    assert robot.safety.reason.startswith("encoder stalled while commanded to move on drive 2")
     assert sim.truth.at_limit[1] == 1  # it stands at its upper stop
     assert not robot.init_stage.failed
 
@@ -60,7 +60,13 @@ def test_a_blocked_drive_mid_line_is_held_and_the_game_ends_with_the_reason_in_i
     session = GameSession(P, seed=5, robot_symbol="O", engine="strong", camera="direct", record_trace=False)
     robot = session.robot
     board_z = P.board.surface_z
-    assert robot.run_until(lambda: robot.initialised and robot.truth.tool_pose()[2] < board_z, 120.0)
+    x0, x1, y0, y1 = P.board.board_bounds()
+
+    def pen_on_board() -> bool:
+        x, y, z, _ = robot.truth.tool_pose()
+        return bool(robot.initialised and x0 <= x <= x1 and y0 <= y <= y1 and z < board_z)
+
+    assert robot.run_until(pen_on_board, 120.0)
     robot.run_for(0.3)
     # block drive 2 where it stands: its hard stops close in on it
     sim = robot.sim
@@ -73,7 +79,7 @@ def test_a_blocked_drive_mid_line_is_held_and_the_game_ends_with_the_reason_in_i
     assert robot.t - t0 <= 0.1
     # the controller pushes against the block: its current, following error or still encoder trips the chart
     assert robot.safety.reason.startswith(("overcurrent on drive 2", "following error on drive 2",
-                                           "encoder silent while commanded to move on drive 2"))
+                                           "encoder stalled while commanded to move on drive 2"))
     held = robot.arm.encoder_angles()
     robot.run_for(1.0)
     assert np.allclose(robot.arm.encoder_angles(), held, atol=0.01)  # held where it stood

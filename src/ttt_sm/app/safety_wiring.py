@@ -69,7 +69,8 @@ def make_safety_chart(params: ArmParams, listeners: Sequence[object] = ()) -> Sa
         "max_following_error": s.max_following_error_rad, "max_following_error_init": s.max_following_error_init_rad,
         "max_following_error_fast": s.max_following_error_fast_rad,
         "max_current": s.max_current_a, "max_current_init": s.max_current_init_a, "max_speed": s.max_speed_rad_s,
-        "moving_speed": s.moving_speed_rad_s, "silent_s": s.silent_s, "limit_margin": s.limit_margin_rad,
+        "moving_speed": s.moving_speed_rad_s, "stall_ratio": s.stall_ratio, "silent_s": s.silent_s,
+        "limit_margin": s.limit_margin_rad,
         "lift_height": s.lift_height_m,
     }
     for k, d in enumerate(params.drives, start=1):

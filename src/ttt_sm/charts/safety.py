@@ -13,16 +13,21 @@ reports and what the PC commanded (docs/safety.md, "What trips it"):
 - the **encoder speed** `speed_k`, from the counts of the last chart step: a
   jump of the counter shows as a speed no drive can reach;
 - the **motor current** `current_k`;
-- how long the encoder has been **still while commanded to move**
-  (`cmd_speed_k` above `moving_speed`, the counts unchanged): `still_k`;
+- how long the encoder has **lagged while commanded to move**
+  (`cmd_speed_k` above `moving_speed`, the encoder slower than
+  `stall_ratio` of it, or not counting at all while the drives initialise:
+  a frozen encoder, a blocked motor): `still_k`;
 - the **joint angle** `q_k` against the joint limits (once initialised);
 - the **link** to the arm, where the backend reports one, and the **camera**.
 
 A fault takes it out of `monitoring`:
 
 - a fault of a drive or of the link goes to `stopped`: every drive holds
-  where it stands (setpoint = encoder angle), and a drive whose encoder or
-  current cannot be trusted is switched off (its bridge off);
+  where its encoder says it stands (setpoint = encoder angle: even a drive
+  whose encoder jumped stays where it is, its controller seeing no error),
+  and a drive that lags its command (a frozen encoder would let its
+  controller run away) or draws too much current is switched off (its
+  bridge off);
 - the camera lost, while the drives are sound, goes to `lift`: the pen is
   lifted (`lift_z`, the tool's height plus `lift_height`), then `hold`
   keeps the arm there; a drive fault while lifting or holding still stops.
@@ -57,9 +62,9 @@ def _per_drive(name: str, unit: str, default: object, doc: str) -> tuple[Data, D
 
 #: What a drive's check found, by kind: the first words of the reason, whether the drive is switched off.
 _KINDS = {
-    "jump": ("encoder jumped", True),
+    "jump": ("encoder jumped", False),
     "current": ("overcurrent", True),
-    "silent": ("encoder silent while commanded to move", True),
+    "silent": ("encoder stalled while commanded to move", True),
     "following": ("following error", False),
     "limit": ("joint limit", False),
 }
@@ -91,7 +96,7 @@ class Safety(TickChart):
         Data("lift_z", "m", math.nan, "tool height to lift the pen to (NaN: no lift)"),
         *_per_drive("off", "bool", False, "drive {k}'s bridge is switched off: its sensors cannot be trusted"),
         Data("reinit", "bool", False, "re-initialising: the drive-initialisation charts restart as it rises"),
-        Data("reason", "text", "", "why the chart tripped, in one line (empty while it never did)"),
+        Data("reason", "text", "", "why the chart tripped last, in one line (empty while it never did)"),
         Data("fault_drive", "1", 0, "the drive whose check tripped it, 1..3 (0: none or not a drive)"),
         Data("trips", "1", 0, "times the chart tripped since power-on"),
     )
@@ -102,8 +107,9 @@ class Safety(TickChart):
         Data("max_current", "A", 6.5, "motor current limit once initialised"),
         Data("max_current_init", "A", 7.0, "motor current limit while initialising (a hard stop is pushed)"),
         Data("max_speed", "rad/s", 8.0, "encoder speed beyond which the counter jumped"),
-        Data("moving_speed", "rad/s", 0.05, "commanded speed above which the encoder must count"),
-        Data("silent_s", "s", 0.02, "longest an encoder may stay still while commanded to move"),
+        Data("moving_speed", "rad/s", 0.05, "commanded speed above which the encoder must keep up"),
+        Data("stall_ratio", "1", 0.5, "an encoder slower than this part of the commanded speed lags"),
+        Data("silent_s", "s", 0.03, "longest an encoder may lag so while commanded to move"),
         Data("limit_margin", "rad", 0.02, "how far past a joint limit the encoder may read"),
         # the joint limits of the parameter file's arm (the application sets those of its own)
         Data("q_min_1", "rad", math.radians(-170.0), "lower joint limit of drive 1"),
@@ -112,7 +118,7 @@ class Safety(TickChart):
         Data("q_max_1", "rad", math.radians(170.0), "upper joint limit of drive 1"),
         Data("q_max_2", "rad", math.radians(135.0), "upper joint limit of drive 2"),
         Data("q_max_3", "rad", math.radians(30.0), "upper joint limit of drive 3"),
-        *_per_drive("still", "s", 0.0, "how long drive {k}'s encoder has been still while commanded to move"),
+        *_per_drive("still", "s", 0.0, "how long drive {k}'s encoder has lagged its commanded speed"),
         Data("lift_height", "m", 0.015, "how far the pen is lifted when the arm can still move"),
         Data("lift_tol", "m", 0.001, "the lift is done within this distance"),
     )
@@ -198,8 +204,8 @@ class Safety(TickChart):
         if current > cur_max:
             return f"{_KINDS['current'][0]} on drive {k}: {current:.3g} A > {cur_max:g} A"
         if still >= d["silent_s"]:
-            return (f"{_KINDS['silent'][0]} on drive {k}: still for {still * 1e3:.0f} ms at"
-                    f" {d[f'cmd_speed_{k}']:.3g} rad/s commanded")
+            return (f"{_KINDS['silent'][0]} on drive {k}: {speed:.3g} rad/s for {still * 1e3:.0f} ms at"
+                    f" {abs(d[f'cmd_speed_{k}']):.3g} rad/s commanded")
         if d[f"fast_{k}"]:
             err_max = max(err_max, d["max_following_error_fast"])
         if abs(err) > err_max:
@@ -264,12 +270,15 @@ class Safety(TickChart):
         self._count_still()
 
     def _count_still(self) -> None:
-        """still_k: how long drive k's encoder has stood still while commanded faster than moving_speed."""
+        """still_k: how long drive k's encoder has run at most stall_ratio of its commanded speed (0 while
+        initialising)."""
         d = self.__dict__
-        dt, moving = self.tick_period_s, d["moving_speed"]
-        d["still_1"] = d["still_1"] + dt if d["speed_1"] == 0.0 and abs(d["cmd_speed_1"]) > moving else 0.0
-        d["still_2"] = d["still_2"] + dt if d["speed_2"] == 0.0 and abs(d["cmd_speed_2"]) > moving else 0.0
-        d["still_3"] = d["still_3"] + dt if d["speed_3"] == 0.0 and abs(d["cmd_speed_3"]) > moving else 0.0
+        # while initialising, only a silent encoder counts: the searches push their stops on purpose
+        dt, moving, ratio = self.tick_period_s, d["moving_speed"], d["stall_ratio"] if d["initialised"] else 0.0
+        c1, c2, c3 = abs(d["cmd_speed_1"]), abs(d["cmd_speed_2"]), abs(d["cmd_speed_3"])
+        d["still_1"] = d["still_1"] + dt if c1 > moving and d["speed_1"] <= ratio * c1 else 0.0
+        d["still_2"] = d["still_2"] + dt if c2 > moving and d["speed_2"] <= ratio * c2 else 0.0
+        d["still_3"] = d["still_3"] + dt if c3 > moving and d["speed_3"] <= ratio * c3 else 0.0
 
 
 __all__ = ["Safety"]

@@ -51,7 +51,9 @@ def test_a_drive_2_search_that_runs_into_its_hard_stop_trips_before_the_init_cha
     t_stop = robot.t
     assert robot.run_until(lambda: robot.tripped, 1.0)
     assert robot.t - t_stop <= 0.1
-    assert robot.safety.reason.startswith("encoder stalled while commanded to move on drive 2")
+    # pushing the stop, the drive lags its setpoints and its encoder stops: either check trips the chart
+    assert robot.safety.reason.startswith(("encoder stalled while commanded to move on drive 2",
+                                           "following error on drive 2"))
     assert sim.truth.at_limit[1] == 1  # it stands at its upper stop
     assert not robot.init_stage.failed
 
@@ -68,25 +70,25 @@ def test_a_blocked_drive_mid_line_is_held_and_the_game_ends_with_the_reason_in_i
 
     assert robot.run_until(pen_on_board, 120.0)
     robot.run_for(0.3)
-    # block drive 2 where it stands: its hard stops close in on it
+    # block the drive the line moves fastest where it stands: its hard stops close in on it
     sim = robot.sim
     assert sim is not None
-    q2 = float(sim.truth.q[1])
+    k = int(np.argmax(np.abs(robot.safety_stage.commanded_speed())))
     from ttt_sm.twin import _plant as Pl
-    sim.plant.pp[1, Pl.PP_QMIN] = sim.plant.pp[1, Pl.PP_QMAX] = q2
+    sim.plant.pp[k, Pl.PP_QMIN] = sim.plant.pp[k, Pl.PP_QMAX] = float(sim.truth.q[k])
     t0 = robot.t
     assert robot.run_until(lambda: robot.tripped, 0.2)
     assert robot.t - t0 <= 0.1
-    # the controller pushes against the block: its current, following error or still encoder trips the chart
-    assert robot.safety.reason.startswith(("overcurrent on drive 2", "following error on drive 2",
-                                           "encoder stalled while commanded to move on drive 2"))
-    held = robot.arm.encoder_angles()
+    # the controller pushes against the block: its current, following error or stalled encoder trips the chart
+    assert robot.safety.reason.startswith((f"overcurrent on drive {k + 1}", f"following error on drive {k + 1}",
+                                           f"encoder stalled while commanded to move on drive {k + 1}"))
+    held = np.delete(robot.arm.encoder_angles(), k)
     robot.run_for(1.0)
-    assert np.allclose(robot.arm.encoder_angles(), held, atol=0.01)  # held where it stood
+    assert np.allclose(np.delete(robot.arm.encoder_angles(), k), held, atol=0.01)  # the others held where they stood
     with pytest.raises(GameError, match="safety stop: "):
         session.play()
     trips = [e for e in session.record.events if e["event"] == "safety_trip"]
-    assert len(trips) == 1 and trips[0]["reason"] == robot.safety.reason and trips[0]["drive"] == 2
+    assert len(trips) == 1 and trips[0]["reason"] == robot.safety.reason and trips[0]["drive"] == k + 1
     assert session.record.ended == "error"
     assert session.record.events[-1]["message"] == f"safety stop: {robot.safety.reason}"
 

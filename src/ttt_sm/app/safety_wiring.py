@@ -148,15 +148,12 @@ class SafetyStage:
         self.listeners: list[Callable[[str, dict[str, Any]], object]] = []
         # the Monitor block's outputs, one per drive, as this chart step computed them
         self.err: list[float] = [0.0, 0.0, 0.0]
+        #: The ``Link`` block: the arm's own report of its link, where it has one (else True), read every tick.
+        self.link_ok = True
         #: Inputs forced by a test or scenario (``Robot.set_input(..., force=True)``): name -> value.
         self.overrides: dict[str, object] = {}
         self._feed: Callable[..., None] = not_wired
         self._outputs: Callable[[], Any] = not_wired
-
-    @property
-    def link_ok(self) -> bool:
-        """The ``Link`` block: the arm's own report of its link, where it has one (else True)."""
-        return bool(getattr(self.arm, "link_ok", True))
 
     def commanded_speed(self) -> list[float]:
         """Each drive's commanded speed, rad/s: the rate of the model of its setpoint filter."""
@@ -177,6 +174,7 @@ class SafetyStage:
         arm = self.arm
         sensors = signals.sensors
         assert sensors is not None
+        self.link_ok = bool(getattr(arm, "link_ok", True))
         e1, e2, e3 = enc = arm.encoder_angles()
         offsets = arm.offset_estimates()
         if offsets != self._offsets:  # the init chart moved the encoder coordinates: so do the setpoints

@@ -118,6 +118,13 @@ class _SessionClock:
             s.debugger.pause()
 
 
+def safety_view(robot: Any) -> dict[str, Any]:
+    """The ``safety`` part of a frame: the Safety chart's declared outputs (docs/safety.md), plain data."""
+    chart = robot.safety
+    return {"tripped": bool(chart.tripped), "reason": str(chart.reason), "trips": int(chart.trips),
+            "reinitialising": bool(chart.reinit)}
+
+
 class Session:
     """A robot under a :class:`Debugger`, run in a thread of its own, viewed by any number of pages.
 
@@ -581,6 +588,7 @@ class Session:
             "stop": self._stop,
             "game": game_view(dbg),
             "operate": self.operate.view(),
+            "safety": safety_view(robot),
         }
 
     def _frame(self, full: bool, state: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -623,7 +631,7 @@ class Session:
         frame["taken"] = {name: {i: c for i, c in counts.items() if sent.get("taken", {}).get(name, {}).get(i) != c}
                           for name, counts in state["taken"].items()}
         frame["taken"] = {name: counts for name, counts in frame["taken"].items() if counts}
-        for key in ("breakpoints", "actions", "forced", "stop", "game", "operate"):
+        for key in ("breakpoints", "actions", "forced", "stop", "game", "operate", "safety"):
             if sent.get(key, _MISSING) != state[key]:
                 frame[key] = state[key]
         return frame

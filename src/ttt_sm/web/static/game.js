@@ -118,6 +118,14 @@ function drawGame(g) {
   }
 }
 
+// The Safety chart's state (docs/safety.md): shown while it holds the arm, with its reason.
+function drawSafety(s) {
+  const box = role("safety");
+  box.hidden = !s.tripped;
+  box.dataset.error = s.tripped ? "true" : "false";
+  box.textContent = s.tripped ? `Safety stop: ${s.reason}` : "";
+}
+
 function drawFrame(f) {
   if (f.mode !== undefined) {
     state.mode = f.mode;
@@ -128,6 +136,7 @@ function drawFrame(f) {
   }
   if (f.t !== undefined) role("sim-time").textContent = f.t.toFixed(1);
   if ("game" in f) drawGame(f.game);
+  if ("safety" in f) drawSafety(f.safety);
   if (f.stop && f.stop.kind === "game") say(f.stop.text, true);
   if (f.error) say(f.error, true);
 }

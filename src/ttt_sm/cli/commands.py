@@ -323,8 +323,8 @@ def _choices(text: str, known: Any, option: str) -> list[str]:
 
 
 def cmd_faults(args: argparse.Namespace) -> int:
-    from ..app.fault_matrix import fault_matrix
-    from ..app.faults import TWIN_FAULTS
+    from ..faults.matrix import fault_matrix
+    from ..faults.twin import TWIN_FAULTS
 
     faults = _choices(args.only, TWIN_FAULTS, "--only") if args.only else list(TWIN_FAULTS)
     phases = [FAULT_PHASES[p] for p in _choices(args.phases, FAULT_PHASES, "--phases")] if args.phases \

@@ -17,7 +17,7 @@ fault would change, in the plant or in the readings, never in the charts:
 - ``power_cut``: the H-bridges' supply falls to 0 V (the motors are
   shorted through the bridges, which brakes them) and the servo stops;
 - ``camera_lost`` is no fault of the arm: the robot's ``Camera`` block says
-  the camera no longer answers (:class:`~.safety_wiring.CameraStatus`).
+  the camera no longer answers (:class:`~ttt_sm.app.safety_wiring.CameraStatus`).
 
 Simulation only: it writes the twin's plant, which a real arm has none of.
 """

@@ -1,7 +1,7 @@
 """The fault matrix: every fault of the twin in every phase of the robot's work (``ttt-sm faults``).
 
-One cell is one fault (:mod:`.faults`) injected in one phase, on a new robot
-built on a :class:`~.faults.FaultyArm`:
+One cell is one fault (:mod:`.twin`) injected in one phase, on a new robot
+built on a :class:`~.twin.FaultyArm`:
 
 - ``initialising``: 1.5 s after power-on, while drive 1 searches its index;
 - ``drawing the field``: 0.3 s into the field's first line, pen on the board;
@@ -31,7 +31,7 @@ initialised again.  It reports (docs/safety.md, "Fault matrix"):
   from the onset to the end of the watch: ink the pen laid (or smeared) that
   the drawing did not ask for after the fault;
 - ``record_intact``: the record written as it happened (a ``game.jsonl``
-  of :class:`~.game_record.GameRecord`) reads back whole, with the onset, the
+  of :class:`~ttt_sm.app.game_record.GameRecord`) reads back whole, with the onset, the
   trip and its reason, the reset and the end;
 - ``recovered``: after the reset every drive is initialised again and the
   Safety chart watches.
@@ -51,6 +51,8 @@ from typing import Any
 
 import numpy as np
 
+from ..app.game_record import GameRecord, read_record
+from ..app.robot import Robot
 from ..params import ArmParams
 from ..sched.scheduler import Signals
 from ..twin.control import Gains
@@ -58,9 +60,7 @@ from ..twin.kinematics import arm_chain_py, link_points
 from ..twin.sim import ArmSim
 from ..twin.tuning import design_gains
 from ..twin.whiteboard import Whiteboard
-from .faults import DRIVE_FAULTS, TWIN_FAULTS, FaultyArm
-from .game_record import GameRecord, read_record
-from .robot import Robot
+from .twin import DRIVE_FAULTS, TWIN_FAULTS, FaultyArm
 
 PHASES = ("initialising", "drawing the field", "drawing a symbol", "erasing")
 #: How long a cell watches after the onset before the fault is switched off, s.

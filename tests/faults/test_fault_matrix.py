@@ -11,9 +11,9 @@ import json
 import numpy as np
 import pytest
 
-from ttt_sm.app.fault_matrix import DETECT_TARGET_S, PHASES, FaultMatrixError, fault_matrix, run_cell
-from ttt_sm.app.faults import ENCODER_JUMP_RAD, TWIN_FAULTS, FaultError, FaultyArm
 from ttt_sm.cli import main
+from ttt_sm.faults.matrix import DETECT_TARGET_S, PHASES, FaultMatrixError, fault_matrix, run_cell
+from ttt_sm.faults.twin import ENCODER_JUMP_RAD, TWIN_FAULTS, FaultError, FaultyArm
 from ttt_sm.params import load_params
 from ttt_sm.twin import _plant as Pl
 from ttt_sm.twin.sim import ArmSim

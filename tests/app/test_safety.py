@@ -99,7 +99,7 @@ def test_reset_after_a_trip_initialises_the_drives_again_and_the_arm_draws_the_f
     robot.run_for(2.0)
     robot.set_input("Safety", "err_1", 0.5, force=True)  # as if drive 1 lagged half a radian
     robot.chart_step()
-    assert robot.tripped and robot.safety.reason == "following error on drive 1: 0.5 rad > 0.015 rad"
+    assert robot.tripped and robot.safety.reason == "following error on drive 1: 0.5 rad > 0.025 rad"
     robot.release("Safety", "err_1")
     robot.run_for(0.5)
     robot.post("Safety", "reset")

@@ -101,7 +101,7 @@ class Safety(TickChart):
         Data("trips", "1", 0, "times the chart tripped since power-on"),
     )
     local = (
-        Data("max_following_error", "rad", 0.015, "following error limit once initialised"),
+        Data("max_following_error", "rad", 0.025, "following error limit once initialised"),
         Data("max_following_error_init", "rad", 0.04, "following error limit while initialising"),
         Data("max_following_error_fast", "rad", 0.1, "following error limit of a drive at its speed clamp"),
         Data("max_current", "A", 6.5, "motor current limit once initialised"),

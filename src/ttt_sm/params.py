@@ -162,6 +162,24 @@ class IKParams:
 
 
 @dataclass(frozen=True)
+class SafetyParams:
+    """Thresholds of the Safety chart (docs/safety.md, "Thresholds")."""
+
+    max_following_error_rad: float
+    max_following_error_init_rad: float
+    max_following_error_fast_rad: float
+    max_current_a: float
+    max_current_init_a: float
+    max_speed_rad_s: float
+    moving_speed_rad_s: float
+    stall_ratio: float
+    silent_s: float
+    limit_margin_rad: float
+    lift_height_m: float
+    lift_speed_m_s: float
+
+
+@dataclass(frozen=True)
 class DriveParams:
     """One DC drive: motor, gear, load, encoder, switches and hard stops."""
 
@@ -207,6 +225,7 @@ class ArmParams:
     masses: Masses
     control: ControlParams
     ik: IKParams
+    safety: SafetyParams
     drives: tuple[DriveParams, DriveParams, DriveParams]
     source: str = "<built-in>"
 
@@ -250,6 +269,13 @@ LIMITS: dict[str, tuple[float, float]] = {
     "control.speed_filter_hz": (0.1, 10_000.0), "control.inner_crossover_hz": (0.1, 10_000.0),
     "control.outer_crossover_hz": (0.01, 10_000.0), "control.gear_play_compensation": (0.0, 1.0),
     "ik.damping": (1e-9, 10.0), "ik.tolerance": (1e-12, 1e-2), "ik.max_iterations": (1, 10_000),
+    "safety.max_following_error_rad": (1e-4, 1.0), "safety.max_following_error_init_rad": (1e-4, 1.0),
+    "safety.max_following_error_fast_rad": (1e-4, 1.0),
+    "safety.max_current_a": (0.01, 1000.0), "safety.max_current_init_a": (0.01, 1000.0),
+    "safety.max_speed_rad_s": (0.1, 1000.0), "safety.moving_speed_rad_s": (1e-4, 10.0),
+    "safety.stall_ratio": (0.0, 1.0),
+    "safety.silent_s": (1e-3, 1.0), "safety.limit_margin_rad": (0.0, 0.5), "safety.lift_height_m": (0.0, 0.1),
+    "safety.lift_speed_m_s": (0.001, 1.0),
     "drive.supply_v": (0.1, 100.0), "drive.resistance_ohm": (1e-3, 1e3), "drive.inductance_h": (1e-7, 1.0),
     "drive.torque_constant": (1e-4, 10.0), "drive.rotor_inertia": (1e-9, 1.0), "drive.motor_viscous": (0.0, 1.0),
     "drive.motor_coulomb": (0.0, 10.0), "drive.gear_ratio": (1.0, 10_000.0), "drive.load_inertia": (1e-6, 100.0),
@@ -405,7 +431,8 @@ def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> A
     """
     at = _Where(where, text)
     sections = {"geometry": Geometry, "board": Board, "pen": Pen, "sponge": Sponge,
-                "servo": Servo, "masses": Masses, "control": ControlParams, "ik": IKParams}
+                "servo": Servo, "masses": Masses, "control": ControlParams, "ik": IKParams,
+                "safety": SafetyParams}
     unknown = sorted(set(data) - set(sections) - {"drive"})
     if unknown:
         raise ParameterError(f"{where}: unknown section(s) {', '.join(str(u)[:30] for u in unknown[:5])}")

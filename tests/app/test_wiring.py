@@ -90,7 +90,7 @@ def game_robot() -> Robot:
 
 
 #: Blocks whose outputs their stage computes every chart step and passes to the feeds as arguments.
-ARGUMENT_BLOCKS = ("FK", "IK")
+ARGUMENT_BLOCKS = ("FK", "IK", "Monitor")
 
 
 def _plant(robot: Robot) -> tuple[dict[str, float], list[object]]:
@@ -135,7 +135,7 @@ def test_every_row_that_feeds_a_chart_copies_its_source_into_the_input(game_robo
     values, arguments = _plant(robot)
     robot.wiring.feed(list(robot.charts), args=ARGUMENT_BLOCKS)(*arguments)
     rows = [r for r in robot.wiring.rows if r.target.block in robot.charts]
-    assert len(rows) == 30
+    assert len(rows) == 53  # 30 into the thesis' charts and the game's, 23 into the Safety chart
     for row in rows:
         assert getattr(robot.charts[row.target.block], row.target.port) == values[str(row.source)], row.wire
 
@@ -158,8 +158,8 @@ def test_a_game_is_wired_from_the_robots_table_and_the_games():
     try:
         robot = session.robot
         assert robot.wires == (*ROBOT_WIRES, *GAME_WIRES)
-        assert list(robot.charts) == ["DriveInit1", "DriveInit2", "DriveInit3", "Control", "AlgorithmActivator",
-                                      "Game"]
+        assert list(robot.charts) == ["DriveInit1", "DriveInit2", "DriveInit3", "Control", "Safety",
+                                      "AlgorithmActivator", "Game"]
         assert robot.wiring.unused() == []
     finally:
         session.close()

@@ -213,7 +213,7 @@ def test_a_robot_scenario_cannot_name_a_chart_the_robot_does_not_hold() -> None:
     with pytest.raises(ScenarioError) as info:
         load("name: n\nsteps:\n  - run: {seconds: 1}\n  - expect: Game.off\n", catalog=None)
     assert str(info.value) == ("s.yaml:4: expect: Game is not part of the simulated robot (its charts:"
-                               " DriveInit1, DriveInit2, DriveInit3, Control); run it alone: put 'chart: Game'"
+                               " DriveInit1, DriveInit2, DriveInit3, Control, Safety); run it alone: put 'chart: Game'"
                                " at the top of the file")
     s = load("name: n\nsteps:\n  - set: {Robotic.request: true}\n  - expect: q_true[1] > 0\n")
     assert s.bare is None

@@ -275,3 +275,43 @@ def test_stop_in_the_middle_of_a_stroke_lifts_the_pen_and_returns_the_arm(browse
         assert state["outcome"] == "halted"
     finally:
         page.close()
+
+
+def test_a_blocked_drive_mid_stroke_shows_the_safety_stop_and_its_reason(browser: Any, game_cockpit: Cockpit) -> None:
+    """docs/safety.md: the Safety chart trips on a real fault of the twin, and the page says why."""
+    page = browser.new_page()
+    session = game_cockpit.session
+    try:
+        open_game(page, game_cockpit)
+        assert page.locator('[data-role="safety"]').is_hidden()
+        session.call(lambda d: d.add_breakpoint("enter Control.field_pen_down"))
+        page.get_by_role("button", name="Run", exact=True).click()
+        deadline = time.monotonic() + LONG / 1e3
+        while not (session.mode == "paused" and session.call(lambda d: d.breakpoints[0].hits) >= 1):
+            assert time.monotonic() < deadline, "the breakpoint on the field's first pen-down was not hit"
+            time.sleep(0.05)
+        page.wait_for_function("!document.querySelector('[data-cmd=run]').disabled", timeout=30_000)
+
+        def block_drive_2_mid_stroke(d: Debugger) -> None:
+            from ttt_sm.twin import _plant as P
+
+            d.delete(None)
+            while not d.robot.board.contact.pen_touching:
+                d.step(10)
+            d.step(200)
+            sim = d.robot.sim
+            assert sim is not None
+            sim.plant.pp[1, P.PP_QMIN] = sim.plant.pp[1, P.PP_QMAX] = float(sim.plant.ps[1, P.PS_Q])
+
+        session.call(block_drive_2_mid_stroke)
+        page.get_by_role("button", name="Run", exact=True).click()
+        page.wait_for_function("!document.querySelector('[data-role=safety]').hidden", timeout=LONG)
+        reason = session.call(lambda d: (bool(d.robot.tripped), str(d.robot.safety.reason)))
+        assert reason[0] and "drive 2" in reason[1]
+        assert text_of(page, "safety") == f"Safety stop: {reason[1]}"
+        assert page.locator('[data-role="safety"]').get_attribute("data-error") == "true"
+        # the game cannot go on, and says so where the page says what the game told
+        page.wait_for_function("document.querySelector('[data-role=told]').textContent.includes('safety stop')",
+                               timeout=30_000)
+    finally:
+        page.close()

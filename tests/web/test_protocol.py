@@ -134,7 +134,7 @@ def test_a_message_too_long_is_refused_before_it_is_read() -> None:
 def test_a_page_joins_and_gets_what_runs_and_a_full_frame(client: TestClient, session: Session) -> None:
     with client.websocket_connect("/ws") as ws:
         info, full = Page(ws).join()
-    assert [c["name"] for c in info["charts"]] == ["DriveInit1", "DriveInit2", "DriveInit3", "Control"]
+    assert [c["name"] for c in info["charts"]] == ["DriveInit1", "DriveInit2", "DriveInit3", "Control", "Safety"]
     control = next(c for c in info["charts"] if c["name"] == "Control")
     wait_1 = next(s for s in control["states"] if s["id"] == "wait_1")
     assert wait_1["qname"] == "Control.start_stop.wait_1"

@@ -261,6 +261,9 @@ class GameDriver:
         if flow is None:
             return
         wait = self.wait
+        if self.session.robot.tripped:
+            self._stop(GameError(f"safety stop: {self.session.robot.safety.reason}"))
+            return
         if wait is not None:
             self.waited += 1
             if not self.session.watch(wait):
@@ -465,6 +468,8 @@ class GameSession:
         self.play_again = False
         self.robot.add_charts((self.activator, self.game), GAME_WIRES, GameStage(self))
         self.robot.game = self
+        # the Safety chart's trips and resets go into the record as they happen, with their reasons
+        self.robot.safety_stage.listeners.append(lambda kind, data: self._event(kind, **data))
         #: Building the twin (controller design, compiled kernels loaded), the charts and the camera.
         self.setup_wall_s = time.perf_counter() - setup0
 
@@ -537,6 +542,7 @@ class GameSession:
             # A stop is honoured here only, right after a chart step and before the game goes on with what
             # it waited for: a state a replay to the same chart tick reaches again.
             self._check_stop()
+            self._check_safety()
             if status is not None and robot.chart_ticks % every == 0:
                 status(f"t = {robot.t:.0f} s simulated: {wait.what}")
             return self.watch(wait)
@@ -546,6 +552,11 @@ class GameSession:
                 raise GameError(f"the game did not end within {self.time_limit_s:g} s of simulated time (its time"
                                 f" limit), while waiting for {wait.what}")
             raise self.wait_failed(wait)
+
+    def _check_safety(self) -> None:
+        """The Safety chart holds the arm (docs/safety.md): the game cannot go on, and says why."""
+        if self.robot.tripped:
+            raise GameError(f"safety stop: {self.robot.safety.reason}")
 
     def _waiting(self) -> bool:
         return bool(self.robot.control.ready)

@@ -40,18 +40,22 @@ def servo_init_angle(params: ArmParams) -> float:
     return -(params.drives[1].park_rad + params.drives[2].park_rad)
 
 
-def make_init_charts(params: ArmParams, listeners: Sequence[object] = ()) -> tuple[
-        DriveInit1, DriveInit2, DriveInit3]:
-    """The three init charts with the switch and parking angles of `params`."""
+def make_init_charts(params: ArmParams, listeners: Sequence[object] = (),
+                     offsets: Sequence[float] = (0.0, 0.0, 0.0)) -> tuple[DriveInit1, DriveInit2, DriveInit3]:
+    """The three init charts with the switch and parking angles of `params`.
+
+    `offsets`: the encoder offsets the arm applies when the charts start (0 at
+    power-on; a re-initialisation sets those that make every encoder read 0).
+    """
     d1, d2, d3 = params.drives
     period = params.control.chart_dt
     lst = list(listeners)
     c1 = DriveInit1(tick_period_s=period, listeners=lst,
-                    data={"index_angle": d1.index_rad, "park": d1.park_rad})
+                    data={"index_angle": d1.index_rad, "park": d1.park_rad, "offset": offsets[0]})
     c2 = DriveInit2(tick_period_s=period, listeners=lst,
-                    data={"index_angle": d2.index_rad, "park": d2.park_rad})
+                    data={"index_angle": d2.index_rad, "park": d2.park_rad, "offset": offsets[1]})
     c3 = DriveInit3(tick_period_s=period, listeners=lst,
-                    data={"index_angle": d3.index_rad, "park": d3.park_rad})
+                    data={"index_angle": d3.index_rad, "park": d3.park_rad, "offset": offsets[2]})
     return c1, c2, c3
 
 
@@ -96,6 +100,7 @@ class DriveInitStage:
         self.sched = sched
         self.charts = charts
         self.encoder = EncoderBlock(params)
+        self.encoder.applied = [c.offset for c in charts]  # what the arm applies already (0 at power-on)
         self.servo_init = servo_init_angle(params)
         #: Inputs forced by a test or scenario, applied after the Encoder blocks: (chart index, name) -> value.
         self.overrides: dict[tuple[int, str], object] = {}
@@ -107,6 +112,15 @@ class DriveInitStage:
         self._setpoints: Callable[[], list[float]] = not_wired  # type: ignore[assignment]
         self._offsets: Callable[[], list[float]] = not_wired  # type: ignore[assignment]
         self._status: Callable[[], tuple[list[bool], list[bool]]] = not_wired  # type: ignore[assignment]
+
+    @property
+    def any_gave_up(self) -> bool:
+        """The table's ``Homing.any_gave_up``: a chart gave up (:attr:`failed`)."""
+        return self.failed
+
+    @any_gave_up.setter
+    def any_gave_up(self, value: bool) -> None:
+        self.failed = value
 
     def blocks(self) -> dict[str, object]:
         """The objects holding the outputs of this stage's blocks (Encoder, Homing), by block name.

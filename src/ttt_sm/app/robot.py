@@ -5,8 +5,9 @@ and (later) the GUIs drive.  It knows the charts by name, steps the loop by a
 control step or a chart step, runs until a condition holds, and exposes the
 chart data and the signals of the current step without anyone reading code.
 
-It holds the three drive-initialisation charts and the Control chart, wired
-by the table of :mod:`.wires`; a game adds its charts (:meth:`Robot.add_charts`).
+It holds the three drive-initialisation charts, the Control chart and the
+Safety chart (docs/safety.md), wired by the table of :mod:`.wires`; a game
+adds its charts (:meth:`Robot.add_charts`).
 
 The charts' wiring and the scheduler talk to an :class:`~ttt_sm.arm.Arm`
 (:attr:`Robot.arm`).  Ground truth (:attr:`Robot.truth`, the simulated arm's
@@ -33,6 +34,7 @@ from ..twin.workspace import check_reach
 from .compensation import GearPlayCompensation
 from .control_wiring import ControlStage, make_control_chart
 from .init_wiring import DriveInitStage, make_init_charts, settled_pose
+from .safety_wiring import CameraStatus, SafetyStage, make_safety_chart
 from .wires import BLOCKS, ROBOT_WIRES
 from .wiring import Wire, WiredStage, wire_stages
 
@@ -105,21 +107,27 @@ class Robot:
         #: Ground truth, simulation only (None for an arm that is no simulation).
         self.truth = truth
         self.sched = Scheduler(params, arm)
+        self.listeners = list(listeners)
         init = make_init_charts(params, listeners)
         self.init_stage = DriveInitStage(params, arm, self.sched, init)
         self.compensation = GearPlayCompensation(params, lambda: self.init_stage.done)
         self.board = Whiteboard(params, seed=seed)
-        joint_stages: list[Stage] = [self.init_stage, self.compensation]
+        #: The ``Camera`` block the Safety chart watches: a game sets it from its camera link.
+        self.camera_status = CameraStatus()
+        self.safety = make_safety_chart(params, listeners)
+        self.safety_stage = SafetyStage(params, arm, self.sched, self.safety, self.reinitialise, self.camera_status)
+        joint_stages: list[Stage] = [self.init_stage, self.compensation, self.safety_stage]
         if truth is not None:
             joint_stages.append(BoardStage(self.board, truth))
         self.sched.joint_stages = joint_stages
         self.control = make_control_chart(params, listeners)
         self.control_stage = ControlStage(params, arm, self.init_stage, self.control)
         self.sched.task_stages = [self.control_stage]
-        self.charts: dict[str, TickChart] = {c.chart_name: c for c in (*init, self.control)}
+        self.charts: dict[str, TickChart] = {c.chart_name: c for c in (*init, self.control, self.safety)}
         #: The wiring table this robot runs (:mod:`.wires`), checked against the charts here.
         self.wires: tuple[Wire, ...] = tuple(wires)
-        self._wired: list[WiredStage] = [self.init_stage, self.control_stage]
+        self._wired: list[WiredStage] = [self.init_stage, self.control_stage, self.safety_stage]
+        self._objects: dict[str, object] = {}
         self.wiring = wire_stages(self.wires, self.charts, self._wired, BLOCKS)
         #: The game around the charts when a :class:`~.game.GameSession` added its own, else None
         #: (typed loosely: the game is built on the robot, not the robot on the game).
@@ -137,7 +145,41 @@ class Robot:
         table = (*self.wires, *wires)
         self.wiring = wire_stages(table, charts_now, wired, BLOCKS, objects)
         self.charts, self._wired, self.wires = charts_now, wired, table
+        self._objects = dict(objects or {})
         self.sched.task_stages.insert(0, stage)  # type: ignore[arg-type]
+
+    def reinitialise(self) -> None:
+        """Initialise the drives again, as at power-on: the Safety chart's reset (docs/safety.md).
+
+        Every encoder reads 0 where the drive stands, as at power-on (its
+        offset is minus its counts), and the joint limits are no longer
+        enforced (the drives do not know where they are); new drive-
+        initialisation charts and a new Control chart take the place of the
+        old ones, and the whole table is wired again.  The init charts search
+        their switches from where the arm stands.
+        """
+        counts = self.arm.sensors().counts
+        offsets = [-c * d.rad_per_count for c, d in zip(counts, self.params.drives, strict=True)]
+        for drive in (1, 2, 3):
+            self.arm.set_offset_estimate(drive, offsets[drive - 1])
+        self.sched.forget_homing()
+        init = make_init_charts(self.params, self.listeners, offsets)
+        old_init, old_control = self.init_stage, self.control_stage
+        self.init_stage = DriveInitStage(self.params, self.arm, self.sched, init)
+        self.control = make_control_chart(self.params, self.listeners)
+        self.control_stage = ControlStage(self.params, self.arm, self.init_stage, self.control)
+        self.sched.joint_stages = [self.init_stage if s is old_init else s for s in self.sched.joint_stages]
+        self.sched.task_stages = [self.control_stage if s is old_control else s for s in self.sched.task_stages]
+        self._wired = [self.init_stage if s is old_init else self.control_stage if s is old_control else s
+                       for s in self._wired]
+        for chart in (*init, self.control):
+            self.charts[chart.chart_name] = chart
+        self.wiring = wire_stages(self.wires, self.charts, self._wired, BLOCKS, self._objects)
+
+    @property
+    def tripped(self) -> bool:
+        """The Safety chart holds the arm in a safe state (its `reason` says why)."""
+        return bool(self.safety.tripped)
 
     # -- time ------------------------------------------------------------------
 
@@ -211,6 +253,8 @@ class Robot:
         """Where a forced input of `chart` is kept, and its key there."""
         if chart == self.control.chart_name:
             return self.control_stage.overrides, name
+        if chart == self.safety.chart_name:
+            return self.safety_stage.overrides, name
         return self.init_stage.overrides, (self._init_index(chart), name)
 
     def post(self, chart: str, event: str, **data: Any) -> None:
@@ -228,7 +272,7 @@ class Robot:
     def _init_index(self, chart: str) -> int:
         names = [c.chart_name for c in self.init_stage.charts]
         if chart not in names:
-            raise RobotError(f"only the init charts' and Control's inputs can be forced, not {chart!r}")
+            raise RobotError(f"only the init charts', Control's and Safety's inputs can be forced, not {chart!r}")
         return names.index(chart)
 
     # -- signals -------------------------------------------------------------------

@@ -16,10 +16,15 @@ loop has these blocks (what each declares, the table reads):
 - ``EraseFlag``: the thesis' Erase_flag: set by whoever asks for erasing
   (the game, `ttt-sm play`), reset once the Control chart erases;
 - ``Session``: the game around the charts (the Tic-tac-toe GUI, the engine,
-  the camera's moves): the result, the person's moves, the algorithm's answer.
+  the camera's moves): the result, the person's moves, the algorithm's answer;
+- ``Monitor``: what the Safety chart watches of each drive (following error,
+  encoder speed, commanded speed, current, angle), from the arm's readings;
+- ``Link``, ``Camera``: whether the arm's link and the camera answer;
+- ``SafeState``: what the Safety chart asks of the drives (hold, lift, a
+  bridge off, re-initialise).
 
 :data:`INIT_WIRES` wires the init charts (`ttt-sm init` runs them alone),
-:data:`ROBOT_WIRES` adds the Control chart (every
+:data:`ROBOT_WIRES` adds the Control and Safety charts (every
 :class:`~ttt_sm.app.robot.Robot`) and :data:`GAME_WIRES` the Game and
 AlgorithmActivator charts of a game.  The Robot checks them against the
 charts' declarations when it is built (docs/architecture.md, "Wiring").
@@ -58,6 +63,7 @@ HOMING = Block("Homing", "every drive passes its position through: a logical AND
     Port("gave_up", "bool", "the drive's init chart gave up", size=3),
 ), outputs=(
     Port("done", "bool", "every drive is initialised"),
+    Port("any_gave_up", "bool", "a drive's init chart gave up"),
 ))
 ERASE_FLAG = Block("EraseFlag", "the thesis' Erase_flag: erase at the next wait", inputs=(
     Port("request", "bool", "erasing asked for (set on its rising edge)"),
@@ -77,8 +83,30 @@ SESSION = Block("Session", "the game around the charts: GUI, engine, the camera'
     Port("o_pos", "1", "the person's moves, one bit per cell"),
 ))
 
+MONITOR = Block("Monitor", "what the Safety chart watches of each drive, from the arm's readings", outputs=(
+    Port("err", "rad", "following error: the setpoint filter's output minus the encoder angle", size=3),
+    Port("speed", "rad/s", "encoder speed over the last chart step, from the counts", size=3),
+    Port("cmd_speed", "rad/s", "commanded speed: the setpoint filter's rate", size=3),
+    Port("current", "A", "measured motor current, magnitude", size=3),
+    Port("q", "rad", "encoder angle", size=3),
+    Port("fast", "bool", "the setpoints move the drive at its speed clamp (or did within 0.1 s)", size=3),
+))
+LINK = Block("Link", "the arm's link, where the backend has one", outputs=(
+    Port("ok", "bool", "valid status keeps arriving (always true for the simulated arm)", attr="link_ok"),
+))
+CAMERA = Block("Camera", "the camera that sees the board, where the robot has one", outputs=(
+    Port("ok", "bool", "the camera answers (always true without one)"),
+))
+SAFE_STATE = Block("SafeState", "what the Safety chart asks of the drives", inputs=(
+    Port("tripped", "bool", "the setpoints are the Safety chart's"),
+    Port("hold", "bool", "hold the pose of the trip (or of the lift)"),
+    Port("lift_z", "m", "tool height to lift the pen to (NaN: none)"),
+    Port("bridge_off", "bool", "switch the drive's bridge off", size=3),
+    Port("reinit", "bool", "restart the drive-initialisation charts"),
+))
+
 #: The blocks of the loop that are not charts.
-BLOCKS = (ENCODER, IK, FK, DRIVES, HOMING, ERASE_FLAG, SESSION)
+BLOCKS = (ENCODER, IK, FK, DRIVES, HOMING, ERASE_FLAG, SESSION, MONITOR, LINK, CAMERA, SAFE_STATE)
 
 
 def _per_drive(source: str, target: str) -> list[Wire]:
@@ -122,8 +150,28 @@ CONTROL_WIRES: tuple[Wire, ...] = (
     Wire("Control.erasing", "EraseFlag.erasing"),
 )
 
-#: What every :class:`~ttt_sm.app.robot.Robot` runs: the init charts and the Control chart.
-ROBOT_WIRES: tuple[Wire, ...] = INIT_WIRES + CONTROL_WIRES
+#: The Safety chart between the arm's readings and the drives (docs/safety.md).
+SAFETY_WIRES: tuple[Wire, ...] = (
+    Wire("Homing.done", "Safety.initialised"),
+    Wire("Homing.any_gave_up", "Safety.init_failed"),
+    *_per_drive("Monitor.err[{i}]", "Safety.err_{k}"),
+    *_per_drive("Monitor.speed[{i}]", "Safety.speed_{k}"),
+    *_per_drive("Monitor.cmd_speed[{i}]", "Safety.cmd_speed_{k}"),
+    *_per_drive("Monitor.current[{i}]", "Safety.current_{k}"),
+    *_per_drive("Monitor.q[{i}]", "Safety.q_{k}"),
+    *_per_drive("Monitor.fast[{i}]", "Safety.fast_{k}"),
+    Wire("FK.Z", "Safety.Z_now"),
+    Wire("Link.ok", "Safety.link_ok"),
+    Wire("Camera.ok", "Safety.camera_ok"),
+    Wire("Safety.tripped", "SafeState.tripped"),
+    Wire("Safety.holding", "SafeState.hold"),
+    Wire("Safety.lift_z", "SafeState.lift_z"),
+    *_per_drive("Safety.off_{k}", "SafeState.bridge_off[{i}]"),
+    Wire("Safety.reinit", "SafeState.reinit"),
+)
+
+#: What every :class:`~ttt_sm.app.robot.Robot` runs: the init charts, the Control chart and the Safety chart.
+ROBOT_WIRES: tuple[Wire, ...] = INIT_WIRES + CONTROL_WIRES + SAFETY_WIRES
 
 #: A game adds the Game chart and the AlgorithmActivator (fig. 3.30) and the session around them.
 GAME_WIRES: tuple[Wire, ...] = (

@@ -307,6 +307,51 @@ def cmd_init(args: argparse.Namespace) -> int:
     return 0 if ok else 1
 
 
+#: The phases of ``ttt-sm faults --phases``, by their short names.
+FAULT_PHASES = {"init": "initialising", "field": "drawing the field", "symbol": "drawing a symbol",
+                "erase": "erasing"}
+
+
+def _choices(text: str, known: Any, option: str) -> list[str]:
+    """A comma-separated list of names from `known`, in the order given; a clear error names a stranger."""
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    bad = [n for n in names if n not in known]
+    if bad or not names:
+        raise CliError(f"{option}: {'no name given' if not names else f'unknown {bad[0]!r}'};"
+                       f" choose from {', '.join(known)}")
+    return names
+
+
+def cmd_faults(args: argparse.Namespace) -> int:
+    from ..faults.matrix import fault_matrix
+    from ..faults.twin import TWIN_FAULTS
+
+    faults = _choices(args.only, TWIN_FAULTS, "--only") if args.only else list(TWIN_FAULTS)
+    phases = [FAULT_PHASES[p] for p in _choices(args.phases, FAULT_PHASES, "--phases")] if args.phases \
+        else list(FAULT_PHASES.values())
+    params = load_arm(args.params)
+    try:
+        report = fault_matrix(params, faults, phases, seed=args.seed, status=status_line())
+    finally:
+        clear_status()
+    lines = [f"{'fault':15} {'phase':18} {'detected':>9} {'safe':>8} {'limits':>6} {'zone':>4} {'ink':>7}"
+             f" {'record':>6} {'recovered':>9}"]
+    for c in report["cells"]:
+        detect = f"{c['detect_ms']:.0f} ms" if c["detected"] else "no"
+        safe = f"{c['time_to_safe_ms']:.0f} ms" if c["time_to_safe_ms"] is not None else "-"
+        lines.append(f"{c['fault']:15} {c['phase']:18} {detect:>9} {safe:>8} {c['limit_violations']:>6}"
+                     f" {c['board_zone_entries']:>4} {c['ink_smear_mm']:>4.1f} mm {str(c['record_intact']):>6}"
+                     f" {str(c['recovered']):>9}")
+    summary = report["summary"]
+    lines.append(f"{summary['detected']} of {summary['cells']} detected, {summary['detected_within_100_ms']} within"
+                 f" 100 ms; {summary['limit_violations']} limit violations; {summary['records_lost']} records lost;"
+                 f" {summary['recovered']} recovered ({report['wall_time_s']:.0f} s)")
+    emit(report, args.json, "\n".join(lines))
+    ok = summary["detected_within_100_ms"] == summary["cells"] and not summary["limit_violations"] \
+        and not summary["records_lost"]
+    return 0 if ok else 1
+
+
 #: What `charts export` writes by default: what charts/ in the repository holds.
 REPO_CHART_FORMATS = ("svg", "mermaid")
 
@@ -397,6 +442,13 @@ def register(sub: Any) -> None:
     sp.add_argument("--time-limit", type=float, default=40.0, metavar="SECONDS",
                     help="longest one initialisation may run, simulated seconds (default 40; one takes 6-12)")
     add_arm_option(sp)
+    sp = add_command(sub, "faults", cmd_faults,
+                     "inject each fault of the twin in each phase and measure what the Safety chart does")
+    sp.add_argument("--only", default=None, metavar="FAULTS",
+                    help="comma-separated faults (default all): encoder_frozen,encoder_jump,motor_blocked,"
+                         "current_spike,servo_stuck,power_cut,camera_lost")
+    sp.add_argument("--phases", default=None, metavar="PHASES",
+                    help="comma-separated phases (default all): init,field,symbol,erase")
     sp = add_command(sub, "charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
     sp.add_argument("action", choices=["export", "check"])
     sp.add_argument("--format", default=None,

@@ -213,13 +213,13 @@ class Catalog:
     def default(cls) -> Catalog:
         """The project's charts (named by class, as :class:`~ttt_sm.app.robot.Robot` names them).
 
-        The robot holds the drive-initialisation charts and Control; the game's
+        The robot holds the drive-initialisation charts, Control and Safety; the game's
         charts (AlgorithmActivator, Game) are added by the game session, so a
         scenario runs them bare.
         """
-        from ..charts import ALL_CHARTS, INIT_CHARTS, Control
+        from ..charts import ALL_CHARTS, INIT_CHARTS, Control, Safety
 
-        robot = tuple(c.__name__ for c in (*INIT_CHARTS, Control))
+        robot = tuple(c.__name__ for c in (*INIT_CHARTS, Control, Safety))
         return cls({c.__name__: c for c in ALL_CHARTS}, SIGNALS, robot)
 
     def chart(self, name: str) -> type[TickChart] | None:

@@ -179,6 +179,12 @@ class Scheduler:
         self._lo[drive - 1] = self.q_min[drive - 1]
         self._hi[drive - 1] = self.q_max[drive - 1]
 
+    def forget_homing(self) -> None:
+        """Stop enforcing the drives' joint limits: their offsets are being searched again (a re-initialisation)."""
+        for drive in (1, 2, 3):
+            self._lo[drive - 1] = -math.inf
+            self._hi[drive - 1] = math.inf
+
     def mark_all_homed(self) -> None:
         """Enforce every drive's limits and hold where the arm is: all offsets are known.
 

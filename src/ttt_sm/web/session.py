@@ -120,6 +120,13 @@ class _SessionClock:
             s.debugger.pause()
 
 
+def safety_view(robot: Any) -> dict[str, Any]:
+    """The ``safety`` part of a frame: the Safety chart's declared outputs (docs/safety.md), plain data."""
+    chart = robot.safety
+    return {"tripped": bool(chart.tripped), "reason": str(chart.reason), "trips": int(chart.trips),
+            "reinitialising": bool(chart.reinit)}
+
+
 class Session:
     """A robot under a :class:`Debugger`, run in a thread of its own, viewed by any number of pages.
 
@@ -620,6 +627,7 @@ class Session:
             "arm": arm_view(robot),
             "camera": feed_view(self.camera_feed),
             "operate": self.operate.view(),
+            "safety": safety_view(robot),
         }
 
     def _frame(self, full: bool, state: dict[str, Any] | None = None) -> dict[str, Any]:
@@ -662,7 +670,7 @@ class Session:
         frame["taken"] = {name: {i: c for i, c in counts.items() if sent.get("taken", {}).get(name, {}).get(i) != c}
                           for name, counts in state["taken"].items()}
         frame["taken"] = {name: counts for name, counts in frame["taken"].items() if counts}
-        for key in ("breakpoints", "actions", "forced", "stop", "game", "arm", "camera", "operate"):
+        for key in ("breakpoints", "actions", "forced", "stop", "game", "arm", "camera", "operate", "safety"):
             if sent.get(key, _MISSING) != state[key]:
                 frame[key] = state[key]
         return frame

@@ -155,6 +155,14 @@ function drawGame(g) {
   if (g.percentages) drawReading(role("reading"), g.percentages, g.read);
 }
 
+// The Safety chart's state (docs/safety.md): shown while it holds the arm, with its reason.
+function drawSafety(s) {
+  const box = role("safety");
+  box.hidden = !s.tripped;
+  box.dataset.error = s.tripped ? "true" : "false";
+  box.textContent = s.tripped ? `Safety stop: ${s.reason}` : "";
+}
+
 function drawFrame(f) {
   if (f.mode !== undefined) {
     state.mode = f.mode;
@@ -170,6 +178,7 @@ function drawFrame(f) {
     if (f.full) state.arm.resync();
     if ("arm" in f) state.arm.draw(f.arm);
   }
+  if ("safety" in f) drawSafety(f.safety);
   if (f.stop && f.stop.kind === "game") say(f.stop.text, true);
   if (f.error) say(f.error, true);
 }

@@ -1,0 +1,286 @@
+"""Wiring of the Safety chart (docs/safety.md) into the scheduler.
+
+:class:`SafetyStage` is a joint stage, run after the drive-initialisation
+charts and the gear-play compensation have set this chart step's setpoints.
+It plays the ``Monitor`` block of the wiring table: from what the arm
+reports (encoder counts and angles, currents, the offsets the init charts
+set) and what the PC commanded, it computes each drive's following error
+against a model of the controller's setpoint filter (the same filter,
+``twin.control.setpoint_filter_row``, stepped with the same setpoints,
+followed no faster than the controller's speed clamp
+``twin.control.max_joint_speed``), the encoder speed from the counts, the
+commanded speed (the model's) and the current.  It
+feeds the Safety chart, ticks it, and carries out what the chart outputs:
+
+- ``SafeState.hold``: the setpoints become the pose the arm had when the
+  chart tripped (encoder angles and the servo's last setpoint), or, while
+  the chart lifts the pen, a ramp at ``[safety] lift_speed_m_s`` to that
+  pose solved by inverse kinematics at the tool height ``lift_z`` (a step
+  of the setpoints would ask the drives for a current beyond the limit);
+- ``SafeState.bridge_off``: that drive's bridge is switched off (``Arm.set_enabled``);
+- ``SafeState.reinit`` rising: the robot restarts its drive-initialisation charts
+  (:meth:`~ttt_sm.app.robot.Robot.reinitialise`) and switches the drives on again.
+
+It reads only what a real arm reports (:class:`~ttt_sm.arm.Arm`).  Each trip
+and reset is told to the robot's safety listeners (a game writes them into
+its record).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..arm import Arm
+from ..charts.safety import Safety
+from ..params import ArmParams
+from ..sched.scheduler import Scheduler, Signals
+from ..twin.control import max_joint_speed, setpoint_filter_row
+from ..twin.kinematics import IKError, arm_chain_py
+from .wiring import Wiring, not_wired
+
+
+def _chart_step_row(row: np.ndarray, steps: int) -> tuple[float, ...]:
+    """A setpoint filter's row (``a11 a12 b1 a21 a22 b2``, one control step) over `steps` control steps.
+
+    The setpoint is held over a chart step, so the filter over it is
+    ``x <- A^n x + (A^(n-1) + ... + I) B u``: one update per chart step.
+    """
+    a = np.array([[row[0], row[1]], [row[3], row[4]]])
+    b = np.array([row[2], row[5]])
+    an, bn = np.eye(2), np.zeros(2)
+    for _ in range(steps):
+        an, bn = a @ an, a @ bn + b
+    return float(an[0, 0]), float(an[0, 1]), float(bn[0]), float(an[1, 0]), float(an[1, 1]), float(bn[1])
+
+
+#: A drive counts as at its speed clamp this long after the model left it, s: the lag its
+#: acceleration left behind decays with the position loop (outer crossover 6 Hz: about 30 ms).
+FAST_HOLD_S = 0.1
+
+
+def make_safety_chart(params: ArmParams, listeners: Sequence[object] = ()) -> Safety:
+    """The Safety chart with the thresholds of ``[safety]`` and the joint limits of `params`."""
+    s = params.safety
+    data: dict[str, Any] = {
+        "max_following_error": s.max_following_error_rad, "max_following_error_init": s.max_following_error_init_rad,
+        "max_following_error_fast": s.max_following_error_fast_rad,
+        "max_current": s.max_current_a, "max_current_init": s.max_current_init_a, "max_speed": s.max_speed_rad_s,
+        "moving_speed": s.moving_speed_rad_s, "stall_ratio": s.stall_ratio, "silent_s": s.silent_s,
+        "limit_margin": s.limit_margin_rad,
+        "lift_height": s.lift_height_m,
+    }
+    for k, d in enumerate(params.drives, start=1):
+        data[f"q_min_{k}"] = d.limit_min_rad
+        data[f"q_max_{k}"] = d.limit_max_rad
+    return Safety(tick_period_s=params.control.chart_dt, listeners=list(listeners), data=data)
+
+
+class CameraStatus:
+    """The ``Camera`` block: whether the camera answers.  True while a robot has no camera.
+
+    A game sets :attr:`ok` from its camera link; a fault test clears it.
+    """
+
+    def __init__(self) -> None:
+        self.ok = True
+
+
+class SafetyStage:
+    """Joint stage: the Monitor block, the Safety chart, and the safe state it asks for.
+
+    Parameters
+    ----------
+    params : ArmParams
+        The arm (control rate, setpoint filters, encoder resolutions, geometry).
+    arm : Arm
+        What the monitor reads and the safe state commands.
+    sched : Scheduler
+        Its inverse kinematics solves the lift.
+    chart : Safety
+        The chart.
+    reinitialise : callable
+        Restarts the drive-initialisation charts (the robot's).
+    camera : CameraStatus
+        The ``Camera`` block.
+    """
+
+    def __init__(self, params: ArmParams, arm: Arm, sched: Scheduler, chart: Safety,
+                 reinitialise: Callable[[], None], camera: CameraStatus) -> None:
+        self.arm = arm
+        self.sched = sched
+        self.chart = chart
+        self.camera = camera
+        self._reinitialise = reinitialise
+        c = params.control
+        self._chart_dt = c.chart_dt
+        self._rows = {False: _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_hz, c.dt), c.chart_divider),
+                      True: _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt), c.chart_divider)}
+        self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
+        g = params.geometry
+        self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
+        self._tool = (0.0, 0.0, 0.0)
+        # the model of the controller's setpoint filters: angle and rate per drive (encoder coordinates),
+        # and where the drive can be: the filter's angle followed no faster than the speed clamp
+        self._r = list(arm.encoder_angles())
+        self._v = [0.0, 0.0, 0.0]
+        self._p = list(self._r)
+        self._dp = [0.0, 0.0, 0.0]
+        self._step_max = [max_joint_speed(d) * c.chart_dt for d in params.drives]
+        self._fast = [0, 0, 0]  # chart steps the drive still counts as at its speed clamp
+        self._fast_steps = max(1, round(FAST_HOLD_S / c.chart_dt))
+        self._offsets = arm.offset_estimates()
+        self._counts = arm.sensors().counts
+        self._speed_per_count = tuple(r / c.chart_dt for r in self._rpc)
+        self._pose: list[float] | None = None  # what the drives hold while the chart trips
+        self._lift_for = math.nan  # the lift_z the pose was solved for
+        self._lift_from: list[float] = []
+        self._lift_to: list[float] | None = None  # the lift's end while the ramp runs
+        self._lift_steps = 0
+        s = params.safety
+        self._lift_s = max(s.lift_height_m / s.lift_speed_m_s, c.chart_dt)  # how long the lift's ramp takes
+        self._tripped = False
+        self._reinit = False
+        #: Called with (kind, data) on every trip ("safety_trip") and reset ("safety_reset").
+        self.listeners: list[Callable[[str, dict[str, Any]], object]] = []
+        # the Monitor block's outputs, one per drive, as this chart step computed them
+        self.err: list[float] = [0.0, 0.0, 0.0]
+        #: The ``Link`` block: the arm's own report of its link, where it has one (else True), read every tick.
+        self.link_ok = True
+        #: Inputs forced by a test or scenario (``Robot.set_input(..., force=True)``): name -> value.
+        self.overrides: dict[str, object] = {}
+        self._feed: Callable[..., None] = not_wired
+        self._outputs: Callable[[], Any] = not_wired
+
+    def commanded_speed(self) -> list[float]:
+        """Each drive's commanded speed, rad/s: the rate of the model of its setpoint filter."""
+        return [dp / self._chart_dt for dp in self._dp]
+
+    def blocks(self) -> dict[str, object]:
+        """The objects holding the outputs of this stage's blocks (Link, Camera); Monitor and FK are arguments."""
+        return {"Link": self, "Camera": self.camera}
+
+    def wire(self, wiring: Wiring) -> None:
+        """Compile this stage's part of the wiring table."""
+        self._feed = wiring.feed([self.chart.chart_name], args=("Monitor", "FK"))
+        self._outputs = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.lift_z",
+                                       "SafeState.bridge_off", "SafeState.reinit")
+
+    def tick(self, signals: Signals) -> None:
+        """Monitor in, chart ticked, the safe state out (written out drive by drive: it runs every chart step)."""
+        arm = self.arm
+        sensors = signals.sensors
+        assert sensors is not None
+        self.link_ok = bool(getattr(arm, "link_ok", True))
+        e1, e2, e3 = enc = arm.encoder_angles()
+        offsets = arm.offset_estimates()
+        if offsets != self._offsets:  # the init chart moved the encoder coordinates: so do the setpoints
+            self._shift(offsets)
+        p = self._p
+        c1, c2, c3 = counts = sensors.counts
+        k1, k2, k3 = self._counts
+        s1, s2, s3 = self._speed_per_count
+        i1, i2, i3 = sensors.current_a
+        self._counts = counts
+        self.err = err = [p[0] - e1, p[1] - e2, p[2] - e3]
+        servo = arm.servo_setpoint
+        x, y, z, phi, _, _, _, _ = arm_chain_py(e1, e2, e3, servo, *self._geometry)
+        fast = self._fast
+        self._feed(err, [abs(c1 - k1) * s1, abs(c2 - k2) * s2, abs(c3 - k3) * s3], self.commanded_speed(),
+                   [abs(i1), abs(i2), abs(i3)], enc, [fast[0] > 0, fast[1] > 0, fast[2] > 0], x, y, z)
+        if self.overrides:
+            vars(self.chart).update(self.overrides)
+        self.chart.tick()
+        tripped, hold, lift_z, off, reinit = self._outputs()
+        if tripped and not self._tripped:
+            self._tell("safety_trip", reason=self.chart.reason, drive=self.chart.fault_drive)
+        self._tripped = bool(tripped)
+        if reinit and not self._reinit:
+            self._restart()
+            # this step's setpoints were made in the old coordinates: hold where the drives stand instead
+            signals.q_set = [*arm.encoder_angles(), servo]
+        self._reinit = bool(reinit)
+        if hold:
+            if self._pose is None:
+                self._pose = [*enc, servo]
+                self._tool = (x, y, phi)
+            if lift_z == lift_z and lift_z != self._lift_for:  # a lift to solve (not NaN, not solved yet)
+                self._lift_for = lift_z
+                self._lift_from = list(self._pose)
+                self._lift_to = self._lift_pose(lift_z)
+                self._lift_steps = 0
+            if self._lift_to is not None:  # a ramp in joint space: the move a step would make is too hard
+                self._lift_steps += 1
+                f = min(1.0, self._lift_steps * self._chart_dt / self._lift_s)
+                self._pose = [a + f * (b - a) for a, b in zip(self._lift_from, self._lift_to, strict=True)]
+                if f >= 1.0:
+                    self._lift_to = None
+            enabled = arm.enabled()
+            for k in range(3):
+                if off[k] and enabled[k]:
+                    arm.set_enabled(k + 1, False)
+            signals.q_set = list(self._pose)
+        else:
+            self._pose = None
+            self._lift_for = math.nan
+            self._lift_to = None
+        self._advance_model(signals.q_set, bool(signals.fr_sw))
+
+    def _shift(self, offsets: tuple[float, float, float]) -> None:
+        """The encoder offsets changed by this much: the model's angles move with them."""
+        for i in range(3):
+            delta = offsets[i] - self._offsets[i]
+            self._r[i] += delta
+            self._p[i] += delta
+        self._offsets = offsets
+
+    def _lift_pose(self, lift_z: float) -> list[float]:
+        """Joint setpoints with the tool where it was at the trip, at height `lift_z`; the held pose if out of reach."""
+        assert self._pose is not None
+        x, y, phi = self._tool
+        try:
+            q, _ = self.sched.ik.solve_pose(x, y, lift_z, phi)
+        except IKError:
+            return self._pose
+        # IK answers joint angles; the drives take encoder coordinates (offsets applied: the same once initialised)
+        return [float(q[0]), float(q[1]), float(q[2]), float(q[3])]
+
+    def _advance_model(self, q_set: Sequence[float] | np.ndarray, fr_sw: bool) -> None:
+        """Step the setpoint-filter model as the controller will, over the control steps of this chart step."""
+        a11, a12, b1, a21, a22, b2 = self._rows[fr_sw]  # the filter over the chart step's control steps
+        r, v, p, dp, fast, step_max = self._r, self._v, self._p, self._dp, self._fast, self._step_max
+        for i in (0, 1, 2):
+            u, ri, vi = q_set[i], r[i], v[i]
+            r[i] = rn = a11 * ri + a12 * vi + b1 * u
+            v[i] = a21 * ri + a22 * vi + b2 * u
+            step, d = step_max[i], rn - p[i]
+            if d > step:
+                d = step
+            elif d < -step:
+                d = -step
+            dp[i] = d
+            p[i] += d
+            # at the clamp, and for a while after, the drive lags its acceleration behind the model
+            if d == step or d == -step:
+                fast[i] = self._fast_steps
+            elif fast[i]:
+                fast[i] -= 1
+
+    def _restart(self) -> None:
+        """The chart asked to re-initialise: the init charts start again, every drive switched on holding."""
+        self._reinitialise()
+        arm, r, v = self.arm, self._r, self._v
+        self._shift(arm.offset_estimates())  # they changed: the setpoints moved with them
+        enc = arm.encoder_angles()
+        for i, on in enumerate(arm.enabled()):
+            if not on:  # switched on, a drive holds where it stands, its filter reset there
+                arm.set_enabled(i + 1, True)
+                r[i], v[i], self._p[i], self._dp[i] = enc[i], 0.0, enc[i], 0.0
+        self._tell("safety_reset")
+
+    def _tell(self, kind: str, **data: Any) -> None:
+        for listener in self.listeners:
+            listener(kind, data)

@@ -3,6 +3,16 @@
 ``pytester`` runs pytest on made-up scenario folders (tests/scenario_runner).
 ``browser_fixtures`` gives the browser tests Debian's Chromium through Playwright
 (``browser``, ``page``, ``js_file``).
+
+Ctrl-C is answered as in a terminal even when the suite runs as a background job
+(``make test &`` or ``nohup``: the shell starts it with SIGINT ignored, and every
+process it starts inherits that): the tests stop ``ttt-sm arm serve`` and others
+with SIGINT, and a process that ignores it would never stop.
 """
+
+import signal
+
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 pytest_plugins = ["ttt_sm.scenario.pytest_plugin", "pytester", "browser_fixtures"]

@@ -132,6 +132,9 @@ class Robot:
         #: The game around the charts when a :class:`~.game.GameSession` added its own, else None
         #: (typed loosely: the game is built on the robot, not the robot on the game).
         self.game: object | None = None
+        #: Called with the new charts each time :meth:`reinitialise` puts them in the old ones' place
+        #: (a debugger attaches its trace and breakpoints to them).
+        self.charts_replaced: list[Callable[[Sequence[TickChart]], None]] = []
 
     def add_charts(self, charts: Sequence[TickChart], wires: Sequence[Wire], stage: WiredStage,
                    objects: dict[str, object] | None = None) -> None:
@@ -155,8 +158,9 @@ class Robot:
         offset is minus its counts), and the joint limits are no longer
         enforced (the drives do not know where they are); new drive-
         initialisation charts and a new Control chart take the place of the
-        old ones, and the whole table is wired again.  The init charts search
-        their switches from where the arm stands.
+        old ones (their clocks going on from the old ones' chart tick), the
+        whole table is wired again and :attr:`charts_replaced` is told.  The
+        init charts search their switches from where the arm stands.
         """
         counts = self.arm.sensors().counts
         offsets = [-c * d.rad_per_count for c, d in zip(counts, self.params.drives, strict=True)]
@@ -173,8 +177,12 @@ class Robot:
         self._wired = [self.init_stage if s is old_init else self.control_stage if s is old_control else s
                        for s in self._wired]
         for chart in (*init, self.control):
+            # the run's clock goes on: the new chart's ticks (its trace, its timeline) follow the old one's
+            chart.start_clock_at(self.charts[chart.chart_name].tick_count)
             self.charts[chart.chart_name] = chart
         self.wiring = wire_stages(self.wires, self.charts, self._wired, BLOCKS, self._objects)
+        for tell in self.charts_replaced:
+            tell((*init, self.control))
 
     @property
     def tripped(self) -> bool:

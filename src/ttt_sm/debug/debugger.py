@@ -162,18 +162,30 @@ class Debugger:
         for chart in robot.charts.values():
             chart.add_listener(self.trace, self.listener, *self._listeners)
         self.state_history.observe(robot.charts.values())
-        self._index = ChartIndex(dict(robot.charts))
         self._divider = robot.params.control.chart_divider
         self._dt = robot.params.control.dt
+        self._watch_charts(robot)
+        self._before: list[Any] | None = None
+        self._before_tick = 0
+        self._game_stopped = _game_error(robot) is not None
+        robot.charts_replaced.append(self._charts_replaced)
+
+    def _watch_charts(self, robot: Robot) -> None:
+        self._index = ChartIndex(dict(robot.charts))
         self._names.forget()
         # The charts' data just before the last chart tick (for data_diff): one
         # itemgetter per chart over its instance dict, where the declared data live.
         self._data_getters = [(name, [d.name for d in c.declarations()], c.__dict__)
                               for name, c in robot.charts.items()]
         self._getters = [(_values_of(names), d) for _, names, d in self._data_getters]
-        self._before: list[Any] | None = None
-        self._before_tick = 0
-        self._game_stopped = _game_error(robot) is not None
+
+    def _charts_replaced(self, charts: Sequence[TickChart]) -> None:
+        """The Safety chart's reset gave the robot new drive-initialisation and Control charts
+        (:meth:`Robot.reinitialise`): the trace, the breakpoints, the timeline and every view see them."""
+        for chart in charts:
+            chart.add_listener(self.trace, self.listener, *self._listeners)
+        self.state_history.observe(charts)
+        self._watch_charts(self.robot)
 
     @property
     def game(self) -> GameSession | None:

@@ -68,13 +68,20 @@ class Timeline:
         self._order: dict[str, list[str]] = {}
 
     def observe(self, charts: Iterable[StateChart]) -> Timeline:
-        """Attach to charts; the states active now count as entered at the chart's current tick."""
+        """Attach to charts; the states active now count as entered at the chart's current tick.
+
+        A chart observed under a name already observed takes the old one's
+        place (the Safety chart's reset builds new drive-initialisation and
+        Control charts): the states the old one left active are left now.
+        """
         for chart in charts:
             name = _name(chart)
             self._closed.setdefault(name, deque())
             self._dropped.setdefault(name, 0)
             self._order[name] = [s.id for s in type(chart).structure().states]  # type: ignore[attr-defined]
             tick = _tick(chart)
+            for key in [k for k in self._open if k[0] == name]:
+                self._close(name, key[1], self._open.pop(key), tick)
             for state in chart.configuration:
                 self._open[(name, state.id)] = tick
             chart.add_listener(self)
@@ -90,11 +97,14 @@ class Timeline:
         entered = self._open.pop((name, source.id), None)
         if entered is None:
             return
+        self._close(name, source.id, entered, _tick(machine))
+
+    def _close(self, name: str, state: str, entered: int, left: int) -> None:
         closed = self._closed.setdefault(name, deque())
         if len(closed) >= self.keep:
             closed.popleft()
             self._dropped[name] = self._dropped.get(name, 0) + 1
-        closed.append(Interval(name, source.id, entered, _tick(machine)))
+        closed.append(Interval(name, state, entered, left))
 
     # -- reading -------------------------------------------------------------------
 

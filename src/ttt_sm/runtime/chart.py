@@ -322,8 +322,19 @@ class TickChart(StateChart, metaclass=TickChartMeta):
 
     @property
     def tick_count(self) -> int:
-        """Chart ticks since construction."""
+        """Chart ticks since construction (or since :meth:`start_clock_at`'s tick)."""
         return self._ticks
+
+    def start_clock_at(self, tick: int) -> None:
+        """Count this chart's ticks from ``tick``: a chart that takes another's place mid-run keeps
+        the run's clock (its trace and timeline go on where the other's stopped).  Before its first tick only."""
+        d = self.__dict__
+        if d["_ticks"]:
+            raise TemporalLogicError(f"{self.chart_name}: its clock has run {d['_ticks']} ticks already;"
+                                     " start_clock_at is for a chart not yet ticked")
+        d["_ticks"] = int(tick)
+        for state in d["_entered_at"]:
+            d["_entered_at"][state] = int(tick)
 
     @property
     def time_s(self) -> float | None:

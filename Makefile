@@ -19,7 +19,8 @@ gui: setup
 
 # The pictures of docs/gui.md, taken in Chromium from a live cockpit.
 screenshots: setup
-	TTT_SM_SCREENSHOTS=docs/img $(PY) -m pytest -q tests/web/test_gui_screenshots.py tests/web/test_game_page.py tests/web/test_operate_page.py -k "guide or whole_game or circle"
+	TTT_SM_SCREENSHOTS=docs/img $(PY) -m pytest -q tests/web/test_gui_screenshots.py tests/web/test_game_page.py tests/web/test_operate_page.py \
+		tests/web/test_safety_reset_page.py -k "guide or whole_game or circle or blocked_drive"
 
 soak: setup
 	$(PY) -m pytest -q -m soak; rc=$$?; [ $$rc -eq 5 ] && echo "no soak tests" || exit $$rc

@@ -13,6 +13,7 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pytest
 import uvicorn
@@ -34,6 +35,11 @@ class Cockpit:
 
     def page_url(self, path: str = "/charts") -> str:
         return self.url + path
+
+
+def text_of(page: Any, role: str) -> str:
+    """The text of the page's element ``data-role=role``, trimmed."""
+    return str(page.locator(f'[data-role="{role}"]').text_content()).strip()
 
 
 def serve(session: Session, token: str | None = None) -> tuple[uvicorn.Server, threading.Thread, str]:

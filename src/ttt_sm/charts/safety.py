@@ -209,7 +209,8 @@ class Safety(TickChart):
         if d[f"fast_{k}"]:
             err_max = max(err_max, d["max_following_error_fast"])
         if abs(err) > err_max:
-            return f"{_KINDS['following'][0]} on drive {k}: {abs(err):.3g} rad > {err_max:g} rad"
+            # four digits: an error just past its limit must not read as the limit ("0.025 rad > 0.025 rad")
+            return f"{_KINDS['following'][0]} on drive {k}: {abs(err):.4g} rad > {err_max:g} rad"
         if ini:
             q, lo, hi, m = d[f"q_{k}"], d[f"q_min_{k}"], d[f"q_max_{k}"], d["limit_margin"]
             if q < lo - m or q > hi + m:

@@ -130,7 +130,9 @@ class OperateStage:
         self.on_done = on_done
 
     def tick(self, signals: Signals) -> None:
-        c = self.control
+        c = self.robot.control
+        if c is not self.control:  # the Safety chart's reset: a new Control chart, initialising again
+            self.control, self.waited, self.drawing = c, False, None
         if not c.busy:
             self.waited = True
         if self.recorder is not None:
@@ -248,6 +250,8 @@ class Operate:
         if self.debugger.game is not None:
             return ("this session plays a game: the Game chart commands the arm (start `ttt-sm gui` without"
                     " --game to draw shapes here)")
+        if robot.tripped:
+            return f"the Safety chart holds the arm ({robot.safety.reason}): Reset it once the cause is removed"
         if c.finish or c.at_start:
             return "the manipulator is being turned off"
         if stage.drawing is not None:

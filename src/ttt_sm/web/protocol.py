@@ -52,6 +52,9 @@ The commands, with their fields (``?``: optional, default in brackets):
                      ``magnitude_cm`` (0 .. 10), ``speed`` (0 .. 5): the
                      Operational page's Trigger (:mod:`.operate`)
 ``operate_stop``     its Stop_simulation: the arm returns to its start pose
+``safety_reset``     every page's Reset of the Safety chart (docs/safety.md):
+                     its ``reset`` event, posted as ``post Safety reset``
+                     is; refused while the chart has not tripped
 ===================  ==========================================================
 
 Every command may carry ``id`` (a number or a short text), echoed in its reply.
@@ -266,6 +269,7 @@ COMMANDS: Mapping[str, Mapping[str, Field]] = {
     "operate_trigger": {"symbol": Field(shape), "magnitude_cm": Field(number(0.0, 10.0)),
                         "speed": Field(number(0.0, 5.0))},
     "operate_stop": {},
+    "safety_reset": {},
 }
 
 

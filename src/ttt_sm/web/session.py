@@ -439,6 +439,14 @@ class Session:
     def _cmd_operate_stop(self, cid: int) -> dict[str, Any]:
         return self.operate.stop()
 
+    def _cmd_safety_reset(self, cid: int) -> dict[str, Any]:
+        """Reset (docs/safety.md): the Safety chart's ``reset`` event, an input the debugger records."""
+        robot = self.debugger.robot
+        if not robot.tripped:
+            raise ValueError("the Safety chart has not tripped: there is nothing to reset")
+        self.debugger.post(robot.safety.chart_name, "reset")
+        return {"text": f"Reset: the Safety chart re-initialises the drives (it tripped on: {robot.safety.reason})"}
+
     def _cmd_speed(self, cid: int, value: float | None) -> dict[str, Any]:
         self.clock.set_speed(value)
         self.speed = value

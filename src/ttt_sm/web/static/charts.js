@@ -7,7 +7,7 @@
 // data-taken-count, a "flash" class on each transition taken, removed when its
 // animation ends), it never redraws a diagram.
 
-import { SessionLink } from "./session.js";
+import { addSafety, drawSafety, SessionLink } from "./session.js";
 
 const $ = (sel, root = document) => root.querySelector(sel);
 const $$ = (sel, root = document) => Array.from(root.querySelectorAll(sel));
@@ -162,6 +162,7 @@ function drawHeader(f) {
   const pace = role("pace");
   pace.textContent = parts.join(" · ");
   pace.dataset.overruns = String(p.overruns);
+  if ("safety" in f) drawSafety(f.safety);
   if (f.stop) say(f.stop.text, false, f.stop.kind);
   if (f.error) say(f.error, true);
 }
@@ -705,6 +706,7 @@ function cell(text, cls) {
 for (const b of $$("[data-cmd]")) {
   b.addEventListener("click", () => link.send({ type: b.dataset.cmd }));
 }
+addSafety(document.querySelector("header"), link);
 role("speed").addEventListener("change", (e) => {
   const v = e.target.value;
   link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });

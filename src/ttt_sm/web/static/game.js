@@ -7,12 +7,12 @@
 // through the camera, never what the page guessed.
 
 import { ArmViews } from "/static/arm.js";
-import { SessionLink } from "/static/session.js";
+import { drawCommon, pageHeader, SessionLink } from "/static/session.js";
 
 const $ = (sel) => document.querySelector(sel);
 const role = (name) => $(`[data-role="${name}"]`);
 
-const state = { game: null, mode: "connecting", photos: -1, arm: null };
+const state = { game: null, photos: -1, arm: null };
 
 function cellButtons() {
   const board = role("board");
@@ -155,30 +155,14 @@ function drawGame(g) {
   if (g.percentages) drawReading(role("reading"), g.percentages, g.read);
 }
 
-// The Safety chart's state (docs/safety.md): shown while it holds the arm, with its reason.
-function drawSafety(s) {
-  const box = role("safety");
-  box.hidden = !s.tripped;
-  box.dataset.error = s.tripped ? "true" : "false";
-  box.textContent = s.tripped ? `Safety stop: ${s.reason}` : "";
-}
-
 function drawFrame(f) {
-  if (f.mode !== undefined) {
-    state.mode = f.mode;
-    const mode = role("mode");
-    mode.textContent = f.mode;
-    mode.dataset.mode = f.mode;
-    $('[data-cmd="run"]').disabled = f.mode === "running";
-  }
-  if (f.t !== undefined) role("sim-time").textContent = f.t.toFixed(1);
+  drawCommon(f);
   if ("game" in f) drawGame(f.game);
   if ("camera" in f) drawCamera(f.camera);
   if (state.arm) {
     if (f.full) state.arm.resync();
     if ("arm" in f) state.arm.draw(f.arm);
   }
-  if ("safety" in f) drawSafety(f.safety);
   if (f.stop && f.stop.kind === "game") say(f.stop.text, true);
   if (f.error) say(f.error, true);
 }
@@ -201,6 +185,7 @@ const link = new SessionLink(onMessage, (status) => {
   if (status !== "connected") role("mode").textContent = status;
 });
 
+pageHeader(link);
 cellButtons();
 $('[data-cmd="run"]').addEventListener("click", () => link.send({ type: "run" }));
 $('[data-cmd="symbol"]').addEventListener("click", () => {

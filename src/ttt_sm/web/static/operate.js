@@ -7,7 +7,7 @@
 // graphs' samples, taken in simulated time by the session) are drawn.  The graphs
 // are plain canvases drawn here; their data live in a ring buffer of fixed size.
 
-import { SessionLink } from "/static/session.js";
+import { drawCommon, pageHeader, SessionLink } from "/static/session.js";
 
 const $ = (sel) => document.querySelector(sel);
 const role = (name) => $(`[data-role="${name}"]`);
@@ -29,7 +29,7 @@ const GRAPHS = [
 
 const MEANS = { X: "the X's side", O: "the O's diameter", sine: "the sine wave's peak to peak" };
 
-const state = { mode: "connecting", op: null, speedRange: [5, 30], toAck: [], dirty: false };
+const state = { op: null, speedRange: [5, 30], toAck: [], dirty: false };
 // What the graphs received, for the tests and the bench: points, redraws, simulated time covered.
 const stats = { points: 0, redraws: 0, firstT: null, lastT: null };
 window.operateStats = stats;
@@ -304,14 +304,7 @@ function drawOperate(op) {
 }
 
 function drawFrame(f) {
-  if (f.mode !== undefined) {
-    state.mode = f.mode;
-    const mode = role("mode");
-    mode.textContent = f.mode;
-    mode.dataset.mode = f.mode;
-    $('[data-cmd="run"]').disabled = f.mode === "running";
-  }
-  if (f.t !== undefined) role("sim-time").textContent = f.t.toFixed(1);
+  drawCommon(f);
   if (f.operate) drawOperate(f.operate);
   if (f.plot) takePlot(f.plot);
   if (f.error) say(f.error, true);
@@ -332,6 +325,7 @@ const link = new SessionLink(onMessage, (status) => {
   if (status !== "connected") role("mode").textContent = status;
 });
 
+pageHeader(link);
 buildGraphs();
 magnitude = pair("Magnitude", " cm", "magnitude", "magnitude-box", describeSettings);
 speed = pair("Speed", "", "speed", "speed-box", describeSettings);

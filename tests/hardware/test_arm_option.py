@@ -23,6 +23,7 @@ from pathlib import Path
 
 import pytest
 
+from ttt_sm.app.game_record import read_record
 from ttt_sm.cli import main
 from ttt_sm.hardware.firmware import build
 
@@ -166,6 +167,32 @@ def test_gui_over_the_emulator_builds_the_robot_on_the_link(emulator, tmp_path, 
     link_clean(report, min_setpoints=1)
     # every chart step the cockpit ran was one SETPOINTS frame the firmware took
     assert abs(report["stats"]["setpoints_ok"] - last["tick"]) <= 1, (report, last)
+
+
+def test_a_gui_game_over_the_emulator_writes_the_games_record(emulator, tmp_path):
+    """``ttt-sm gui --game --arm serial:PTY``: the game's record goes to --out as the game is played."""
+    out = tmp_path / "gui"
+    record = out / "game-1" / "game.jsonl"
+    gui = subprocess.Popen([sys.executable, "-m", "ttt_sm.cli", "gui", "--arm", emulator.arm, "--port", "0",
+                            "--game", "--person", "simulated", "--out", str(out)],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert gui.stdout is not None
+        lines = [gui.stdout.readline() for _ in range(2)]
+        assert "the chart cockpit is at http://" in lines[0], "".join(lines) + gui.communicate(timeout=30)[1]
+        assert f"each game's record goes to {out}/game-N/game.jsonl" in lines[1], lines
+        # the session runs at x1: wait for the init charts' first transitions, written to the record
+        give_up = time.monotonic() + 120
+        while (not record.exists() or record.read_text().count('"chart"') < 2) and time.monotonic() < give_up:
+            time.sleep(0.05)
+    finally:
+        gui.send_signal(signal.SIGINT)
+        out_text, err = gui.communicate(timeout=60)
+    assert gui.returncode == 0 and "Traceback" not in err, err
+    lines = read_record(record)
+    assert lines[0]["event"] == "game" and sum("chart" in e for e in lines) >= 2
+    assert lines[-1]["event"] == "interrupted", lines[-1]
+    link_clean(emulator.stop(), min_setpoints=1)
 
 
 @pytest.mark.parametrize("command", [["play", "--opponent", "simulated", "--camera", "direct"], ["demo"],

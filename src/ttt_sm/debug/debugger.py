@@ -148,7 +148,7 @@ class Debugger:
         (``--arm serial:PORT``); the robot is built on it once (no replay).
         """
         if arm is not None:
-            arm_recipe = ArmRecipe(params, arm, truth, seed, game=game, person=person)
+            arm_recipe = ArmRecipe(params, arm, truth, seed, game=game, person=person, record_root=record_root)
             return cls(arm_recipe.build(), arm_recipe, max_run_s=max_run_s, trace_path=trace_path)
         pose = None if q_start is None else tuple(float(v) for v in q_start)
         recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person, record_root=record_root) \

@@ -113,6 +113,8 @@ class ArmRecipe:
 
     It is built once: an arm behind a serial link cannot be powered on again
     in the same state, so a replay is refused with a line that says so.
+    ``record_root``: with ``game``, the game's record goes to
+    ``record_root/game-1`` as it is played, as :class:`GameRecipe`'s does.
     """
 
     params: ArmParams
@@ -122,6 +124,7 @@ class ArmRecipe:
     game: bool = False
     person: str = "simulated"
     built: bool = False
+    record_root: Path | None = None
 
     def build(self) -> Robot:
         if self.built:
@@ -132,8 +135,10 @@ class ArmRecipe:
             return Robot(self.params, seed=self.seed, arm=self.arm, truth=self.truth)
         if self.person not in ("simulated", "page"):
             raise ValueError(f"the person is 'simulated' or 'page', got {self.person!r}")
+        out_dir = None if self.record_root is None else self.record_root / "game-1"
         session = GameSession(self.params, seed=self.seed, person=RemotePerson() if self.person == "page" else None,
-                              camera="direct", record_trace=False, arm=self.arm, truth=self.truth)
+                              camera="direct", record_trace=out_dir is not None, arm=self.arm, truth=self.truth,
+                              out_dir=out_dir)
         session.drive()
         return session.robot
 

@@ -112,3 +112,45 @@ def test_reset_after_a_trip_initialises_the_drives_again_and_the_arm_draws_the_f
     # the new Control chart starts from the beginning: it draws the field
     assert robot.run_until(lambda: bool(robot.control.ready), 150.0)
     assert robot.safety.trips == 1 and not robot.tripped
+
+
+def test_the_monitor_block_feeds_what_the_arm_reports_every_chart_step() -> None:
+    """The compiled Monitor (app/_monitor.py) against its definitions, checked inside every chart step of
+    a robot initialising and then drawing the field: encoder angles (the arm's), encoder speeds from the
+    counts, currents' magnitudes, the tool's height by forward kinematics of the encoder angles."""
+    from ttt_sm.twin.kinematics import arm_chain_py
+
+    robot = Robot(P, seed=4)
+    arm, chart, g = robot.arm, robot.safety, P.geometry
+    rpc = [d.rad_per_count for d in P.drives]
+    dt = P.control.chart_dt
+
+    class Probe:
+        """A joint stage after the Safety stage: what the chart was fed, against the arm's readings now."""
+
+        def __init__(self) -> None:
+            self.counts = arm.sensors().counts
+            self.checked = self.moving = 0
+
+        def tick(self, signals: object) -> None:
+            sensors = arm.sensors()
+            enc = arm.encoder_angles()
+            assert [chart.q_1, chart.q_2, chart.q_3] == list(enc)
+            assert [chart.current_1, chart.current_2, chart.current_3] == [abs(i) for i in sensors.current_a]
+            speeds = [abs(c - k) * r / dt for c, k, r in zip(sensors.counts, self.counts, rpc, strict=True)]
+            assert [chart.speed_1, chart.speed_2, chart.speed_3] == pytest.approx(speeds, rel=1e-12, abs=1e-12)
+            z = arm_chain_py(*enc, arm.servo_setpoint, g.L1, g.L2, g.L3, g.L4, g.l_f)[2]
+            assert chart.Z_now == pytest.approx(z, abs=1e-12)
+            assert robot.safety_stage.err == [chart.err_1, chart.err_2, chart.err_3]
+            self.counts = sensors.counts
+            self.checked += 1
+            self.moving += any(abs(v) > 0.05 for v in (chart.cmd_speed_1, chart.cmd_speed_2, chart.cmd_speed_3))
+
+    probe = Probe()
+    stages = robot.sched.joint_stages
+    stages.insert(stages.index(robot.safety_stage) + 1, probe)
+    robot.run_for(30.0)
+    assert robot.initialised and not robot.tripped
+    assert probe.checked == robot.chart_ticks and probe.moving > 1000  # the init searches, then the field
+    # the model follows the setpoints: the following errors stay within the limit the chart applies
+    assert max(abs(chart.err_1), abs(chart.err_2), abs(chart.err_3)) < P.safety.max_following_error_rad

@@ -61,7 +61,11 @@ class GearPlayCompensation:
         tau23 = -g23 * math.sin(q2 + q3)  # as gravity_torques, on plain floats
         tau2 = -g2 * math.sin(q2) + tau23
         c2, k2, c3, k3 = self._play
-        q2 -= self.gain * _offset(tau2, c2, k2)
-        q3 -= self.gain * _offset(tau23, c3, k3)
+        gain = self.gain
+        # _offset written out (it runs every chart step): the play taken up towards the gravity torque
+        if tau2 != 0.0:
+            q2 -= gain * math.copysign(c2 / 2 + abs(tau2) / k2, tau2)
+        if tau23 != 0.0:
+            q3 -= gain * math.copysign(c3 / 2 + abs(tau23) / k3, tau23)
         signals.q_set = [float(q1), float(q2), float(q3), float(q4)]
 

@@ -39,8 +39,9 @@ from ..charts.safety import Safety
 from ..params import ArmParams
 from ..sched.scheduler import Scheduler, Signals
 from ..twin.control import max_joint_speed, setpoint_filter_row
-from ..twin.kinematics import IKError, arm_chain_py
-from .wiring import Wiring, not_wired
+from ..twin.kinematics import IKError
+from . import _monitor
+from .wiring import Wiring, WiringError, not_wired
 
 
 def _chart_step_row(row: np.ndarray, steps: int) -> tuple[float, ...]:
@@ -117,24 +118,30 @@ class SafetyStage:
         self._reinitialise = reinitialise
         c = params.control
         self._chart_dt = c.chart_dt
-        self._rows = {False: _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_hz, c.dt), c.chart_divider),
-                      True: _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt), c.chart_divider)}
-        self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
+        # the Monitor block's state, one buffer for its compiled functions (app/_monitor.py): the model
+        # of the controller's setpoint filters (angle and rate per drive, in encoder coordinates), and
+        # where the drive can be (the filter's angle followed no faster than the speed clamp)
+        self._m = m = np.zeros(_monitor.N_M)
+        # the same memory, read and written as plain numbers (numpy's stubs lack __buffer__)
+        self._mv: Any = memoryview(m)  # type: ignore[arg-type]
+        m[_monitor.M_ROW:_monitor.M_ROW + 6] = _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_hz, c.dt),
+                                                               c.chart_divider)
+        m[_monitor.M_ROW_SLOW:_monitor.M_ROW_SLOW + 6] = _chart_step_row(
+            setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt), c.chart_divider)
+        rpc = [float(d.rad_per_count) for d in params.drives]
         g = params.geometry
-        self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
+        m[_monitor.M_RPC:_monitor.M_RPC + 3] = rpc
+        m[_monitor.M_SPEED_PER_COUNT:_monitor.M_SPEED_PER_COUNT + 3] = [r / c.chart_dt for r in rpc]
+        m[_monitor.M_STEP_MAX:_monitor.M_STEP_MAX + 3] = [max_joint_speed(d) * c.chart_dt for d in params.drives]
+        m[_monitor.M_GEOMETRY:_monitor.M_GEOMETRY + 5] = [g.L1, g.L2, g.L3, g.L4, g.l_f]
+        m[_monitor.M_FAST_STEPS] = max(1, round(FAST_HOLD_S / c.chart_dt))
+        m[_monitor.M_CHART_DT] = c.chart_dt
+        enc = arm.encoder_angles()
+        m[_monitor.M_R:_monitor.M_R + 3] = enc
+        m[_monitor.M_P:_monitor.M_P + 3] = enc
+        m[_monitor.M_OFFSET:_monitor.M_OFFSET + 3] = arm.offset_estimates()
+        m[_monitor.M_COUNTS:_monitor.M_COUNTS + 3] = arm.sensors().counts
         self._tool = (0.0, 0.0, 0.0)
-        # the model of the controller's setpoint filters: angle and rate per drive (encoder coordinates),
-        # and where the drive can be: the filter's angle followed no faster than the speed clamp
-        self._r = list(arm.encoder_angles())
-        self._v = [0.0, 0.0, 0.0]
-        self._p = list(self._r)
-        self._dp = [0.0, 0.0, 0.0]
-        self._step_max = [max_joint_speed(d) * c.chart_dt for d in params.drives]
-        self._fast = [0, 0, 0]  # chart steps the drive still counts as at its speed clamp
-        self._fast_steps = max(1, round(FAST_HOLD_S / c.chart_dt))
-        self._offsets = arm.offset_estimates()
-        self._counts = arm.sensors().counts
-        self._speed_per_count = tuple(r / c.chart_dt for r in self._rpc)
         self._pose: list[float] | None = None  # what the drives hold while the chart trips
         self._lift_for = math.nan  # the lift_z the pose was solved for
         self._lift_from: list[float] = []
@@ -146,8 +153,8 @@ class SafetyStage:
         self._reinit = False
         #: Called with (kind, data) on every trip ("safety_trip") and reset ("safety_reset").
         self.listeners: list[Callable[[str, dict[str, Any]], object]] = []
-        # the Monitor block's outputs, one per drive, as this chart step computed them
-        self.err: list[float] = [0.0, 0.0, 0.0]
+        # the Monitor block's outputs as this chart step computed them (app/_monitor.py: OUT_*)
+        self._out: tuple[Any, ...] = (0.0,) * 22
         #: The ``Link`` block: the arm's own report of its link, where it has one (else True), read every tick.
         self.link_ok = True
         #: Inputs forced by a test or scenario (``Robot.set_input(..., force=True)``): name -> value.
@@ -157,7 +164,13 @@ class SafetyStage:
 
     def commanded_speed(self) -> list[float]:
         """Each drive's commanded speed, rad/s: the rate of the model of its setpoint filter."""
-        return [dp / self._chart_dt for dp in self._dp]
+        mv, dt = self._mv, self._chart_dt
+        return [mv[_monitor.M_DP + i] / dt for i in range(3)]
+
+    @property
+    def err(self) -> list[float]:
+        """The Monitor block's following errors, as this chart step computed them, rad."""
+        return list(self._out[_monitor.OUT_ERR:_monitor.OUT_ERR + 3])
 
     def blocks(self) -> dict[str, object]:
         """The objects holding the outputs of this stage's blocks (Link, Camera); Monitor and FK are arguments."""
@@ -165,32 +178,27 @@ class SafetyStage:
 
     def wire(self, wiring: Wiring) -> None:
         """Compile this stage's part of the wiring table."""
-        self._feed = wiring.feed([self.chart.chart_name], args=("Monitor", "FK"))
+        ports = tuple(f"{b}.{p.name}" for b in ("Monitor", "FK") for p in wiring.blocks[b].outputs)
+        if ports != _monitor.PORTS:
+            raise WiringError(f"the Monitor and FK blocks declare {', '.join(ports)}; the compiled monitor"
+                              f" (app/_monitor.py) returns {', '.join(_monitor.PORTS)}")
+        # the Monitor block's outputs, then the FK block's: the compiled monitor's tuple as it is (OUT_*)
+        self._feed = wiring.feed([self.chart.chart_name], args=("Monitor", "FK"), flat=True)
         self._outputs = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.lift_z",
                                        "SafeState.bridge_off", "SafeState.reinit")
 
     def tick(self, signals: Signals) -> None:
-        """Monitor in, chart ticked, the safe state out (written out drive by drive: it runs every chart step)."""
+        """Monitor in (one compiled call on the sensors this chart step read), chart ticked, the safe state out."""
         arm = self.arm
         sensors = signals.sensors
         assert sensors is not None
         self.link_ok = bool(getattr(arm, "link_ok", True))
-        e1, e2, e3 = enc = arm.encoder_angles()
-        offsets = arm.offset_estimates()
-        if offsets != self._offsets:  # the init chart moved the encoder coordinates: so do the setpoints
-            self._shift(offsets)
-        p = self._p
-        c1, c2, c3 = counts = sensors.counts
-        k1, k2, k3 = self._counts
-        s1, s2, s3 = self._speed_per_count
+        c1, c2, c3 = sensors.counts
         i1, i2, i3 = sensors.current_a
-        self._counts = counts
-        self.err = err = [p[0] - e1, p[1] - e2, p[2] - e3]
+        o1, o2, o3 = arm.offset_estimates()
         servo = arm.servo_setpoint
-        x, y, z, phi, _, _, _, _ = arm_chain_py(e1, e2, e3, servo, *self._geometry)
-        fast = self._fast
-        self._feed(err, [abs(c1 - k1) * s1, abs(c2 - k2) * s2, abs(c3 - k3) * s3], self.commanded_speed(),
-                   [abs(i1), abs(i2), abs(i3)], enc, [fast[0] > 0, fast[1] > 0, fast[2] > 0], x, y, z)
+        self._out = out = _monitor.monitor(self._m, c1, c2, c3, i1, i2, i3, o1, o2, o3, servo)
+        self._feed(out)
         if self.overrides:
             vars(self.chart).update(self.overrides)
         self.chart.tick()
@@ -205,8 +213,8 @@ class SafetyStage:
         self._reinit = bool(reinit)
         if hold:
             if self._pose is None:
-                self._pose = [*enc, servo]
-                self._tool = (x, y, phi)
+                self._pose = [out[12], out[13], out[14], servo]
+                self._tool = (out[18], out[19], out[21])
             if lift_z == lift_z and lift_z != self._lift_for:  # a lift to solve (not NaN, not solved yet)
                 self._lift_for = lift_z
                 self._lift_from = list(self._pose)
@@ -227,15 +235,17 @@ class SafetyStage:
             self._pose = None
             self._lift_for = math.nan
             self._lift_to = None
-        self._advance_model(signals.q_set, bool(signals.fr_sw))
+        q = signals.q_set
+        _monitor.advance(self._m, float(q[0]), float(q[1]), float(q[2]), bool(signals.fr_sw))
 
     def _shift(self, offsets: tuple[float, float, float]) -> None:
-        """The encoder offsets changed by this much: the model's angles move with them."""
+        """The encoder offsets changed to `offsets`: the model's angles move with them."""
+        mv = self._mv
         for i in range(3):
-            delta = offsets[i] - self._offsets[i]
-            self._r[i] += delta
-            self._p[i] += delta
-        self._offsets = offsets
+            delta = offsets[i] - mv[_monitor.M_OFFSET + i]
+            mv[_monitor.M_R + i] += delta
+            mv[_monitor.M_P + i] += delta
+            mv[_monitor.M_OFFSET + i] = offsets[i]
 
     def _lift_pose(self, lift_z: float) -> list[float]:
         """Joint setpoints with the tool where it was at the trip, at height `lift_z`; the held pose if out of reach."""
@@ -248,37 +258,17 @@ class SafetyStage:
         # IK answers joint angles; the drives take encoder coordinates (offsets applied: the same once initialised)
         return [float(q[0]), float(q[1]), float(q[2]), float(q[3])]
 
-    def _advance_model(self, q_set: Sequence[float] | np.ndarray, fr_sw: bool) -> None:
-        """Step the setpoint-filter model as the controller will, over the control steps of this chart step."""
-        a11, a12, b1, a21, a22, b2 = self._rows[fr_sw]  # the filter over the chart step's control steps
-        r, v, p, dp, fast, step_max = self._r, self._v, self._p, self._dp, self._fast, self._step_max
-        for i in (0, 1, 2):
-            u, ri, vi = q_set[i], r[i], v[i]
-            r[i] = rn = a11 * ri + a12 * vi + b1 * u
-            v[i] = a21 * ri + a22 * vi + b2 * u
-            step, d = step_max[i], rn - p[i]
-            if d > step:
-                d = step
-            elif d < -step:
-                d = -step
-            dp[i] = d
-            p[i] += d
-            # at the clamp, and for a while after, the drive lags its acceleration behind the model
-            if d == step or d == -step:
-                fast[i] = self._fast_steps
-            elif fast[i]:
-                fast[i] -= 1
-
     def _restart(self) -> None:
         """The chart asked to re-initialise: the init charts start again, every drive switched on holding."""
         self._reinitialise()
-        arm, r, v = self.arm, self._r, self._v
+        arm, mv = self.arm, self._mv
         self._shift(arm.offset_estimates())  # they changed: the setpoints moved with them
         enc = arm.encoder_angles()
         for i, on in enumerate(arm.enabled()):
             if not on:  # switched on, a drive holds where it stands, its filter reset there
                 arm.set_enabled(i + 1, True)
-                r[i], v[i], self._p[i], self._dp[i] = enc[i], 0.0, enc[i], 0.0
+                mv[_monitor.M_R + i], mv[_monitor.M_V + i] = enc[i], 0.0
+                mv[_monitor.M_P + i], mv[_monitor.M_DP + i] = enc[i], 0.0
         self._tell("safety_reset")
 
     def _tell(self, kind: str, **data: Any) -> None:

@@ -213,7 +213,8 @@ class Wiring:
         self.objects = dict(objects)
         self._used: set[int] = set()
 
-    def feed(self, charts: Sequence[str], skip: Iterable[str] = (), args: Sequence[str] = ()) -> Callable[..., None]:
+    def feed(self, charts: Sequence[str], skip: Iterable[str] = (), args: Sequence[str] = (),
+             flat: bool = False) -> Callable[..., None]:
         """A function that writes every wired input of `charts` from its source, now.
 
         Wires from the blocks named in `skip` are left out: their targets keep
@@ -221,12 +222,15 @@ class Wiring:
         The outputs of the blocks named in `args` are the function's arguments,
         every output port of each in declaration order (a vector as one
         sequence): the stage that computes them passes them straight in.
+        With `flat`, they are one argument instead: a sequence of every
+        element of those ports, in the same order (what a compiled function
+        returns in one tuple, passed without cutting it up).
         """
         unknown = [c for c in charts if c not in self.charts]
         if unknown:
             raise WiringError(f"no chart named {', '.join(unknown)} to feed; charts: {', '.join(self.charts)}")
         skipped = set(skip)
-        code = _Code(self, args)
+        code = _Code(self, args, flat)
         for i, row in enumerate(self.rows):
             if row.target.block in charts and row.source.block not in skipped:
                 target = code.chart(row.target.block)
@@ -271,15 +275,22 @@ class Wiring:
 class _Code:
     """Source text of one generated function, its arguments, and the objects it binds (as default arguments)."""
 
-    def __init__(self, wiring: Wiring, args: Sequence[str] = ()) -> None:
+    def __init__(self, wiring: Wiring, args: Sequence[str] = (), flat: bool = False) -> None:
         self.wiring = wiring
         self.args: dict[str, str] = {}  # "Block.port" -> argument name
+        self.offsets: dict[str, int] = {}  # with `flat`: "Block.port" -> where its elements start in `outputs`
+        start = 0
         for block in args:
             spec = wiring.blocks.get(block)
             if spec is None:
                 raise WiringError(f"no block named {block!r} to pass as arguments")
             for port in spec.outputs:
-                self.args[f"{block}.{port.name}"] = f"{block}_{port.name}"
+                if flat:
+                    self.offsets[f"{block}.{port.name}"] = start
+                    start += port.size
+                else:
+                    self.args[f"{block}.{port.name}"] = f"{block}_{port.name}"
+        self.flat = flat
         self.bound: dict[str, object] = {}
         self.prelude: list[str] = []
         self.body: list[str] = []
@@ -297,6 +308,9 @@ class _Code:
         arg = self.args.get(f"{s.block}.{s.port}")
         if arg is not None:
             return arg if s.index is None else f"{arg}[{s.index}]"
+        start = self.offsets.get(f"{s.block}.{s.port}")
+        if start is not None:
+            return f"outputs[{start + (s.index or 0)}]"
         obj = self.wiring.objects.get(s.block)
         attr = row.source_port.attribute
         if obj is None or not hasattr(obj, attr):
@@ -313,7 +327,7 @@ class _Code:
         return f"{self.hoisted[key]}[{s.index}]"
 
     def function(self, name: str, result: str) -> Callable[..., Any]:
-        args = ", ".join([*self.args.values(), *(f"{v}={v}" for v in self.bound)])
+        args = ", ".join([*(["outputs"] if self.flat else []), *self.args.values(), *(f"{v}={v}" for v in self.bound)])
         lines = [f"def {name}({args}):", *(f"    {line}" for line in (*self.prelude, *self.body))]
         lines.append(f"    return {result}" if result else "    return None")
         source = "\n".join(lines) + "\n"

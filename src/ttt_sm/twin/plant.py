@@ -216,12 +216,12 @@ class Plant:
 
     def sensors(self) -> Sensors:
         """The readings of the encoders, index switches and current sensors now."""
-        a, b, c = self.ints.tolist()
-        i1, i2, i3 = self.ps[:, P.PS_I_MEAS].tolist()
+        a, b, c = self.ints.tolist()  # one call for the integers of the three drives
+        ps, w, i = self.psv, P.WIDTH, P.PS_I_MEAS
         cn, ix, ic, ie = P.PI_COUNTS, P.PI_INDEX, P.PI_INDEX_COUNT, P.PI_INDEX_EDGES
-        return Sensors(counts=(a[cn], b[cn], c[cn]), index=(a[ix] == 1, b[ix] == 1, c[ix] == 1),
-                       index_count=(a[ic], b[ic], c[ic]), index_edges=(a[ie], b[ie], c[ie]),
-                       current_a=(i1, i2, i3), t=float(self.pgs[P.PGS_T]))
+        # positional: it runs every chart step, and a frozen dataclass's keywords cost ~0.4 µs more
+        return Sensors((a[cn], b[cn], c[cn]), (a[ix] == 1, b[ix] == 1, c[ix] == 1), (a[ic], b[ic], c[ic]),
+                       (a[ie], b[ie], c[ie]), (ps[i], ps[w + i], ps[2 * w + i]), self.pgsv[P.PGS_T])
 
 
 __all__ = ["Plant", "SimError", "REST_POSE", "SUBSTEPS", "CURRENT_NOISE_A", "G", "Angles",

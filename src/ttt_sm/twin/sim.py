@@ -115,6 +115,7 @@ class ArmSim:
         # set_setpoints runs every chart step: the controller's own method, bound here, spares
         # the call a delegating method would add (the method below documents it)
         self.set_setpoints = self.controller.set_setpoints  # type: ignore[method-assign]
+        self.sensors = self.plant.sensors  # type: ignore[method-assign]  # the Safety chart reads them every chart step
         # Load the compiled loop now (from numba's disk cache: ~0.3 s the first time in a
         # process), not in the first control step: zero steps change nothing.
         K.run_steps(0, self._cf, self._cm, self._pf, self._pi, self._no_rec)
@@ -163,7 +164,10 @@ class ArmSim:
     # ---- sensors (the Arm protocol) -----------------------------------------
 
     def sensors(self) -> Sensors:
-        """The readings of the encoders, index switches and current sensors now."""
+        """The readings of the encoders, index switches and current sensors now.
+
+        (Each arm binds :meth:`~ttt_sm.twin.plant.Plant.sensors` in its place, as :meth:`set_setpoints`.)
+        """
         return self.plant.sensors()
 
     def encoder_angles(self) -> tuple[float, float, float]:

@@ -31,6 +31,7 @@ from ttt_sm.app.game_record import ENDINGS, read_record
 from ttt_sm.app.game_replay import replay_record
 from ttt_sm.charts.game import RESULT_MESSAGES
 from ttt_sm.params import load_params
+from ttt_sm.twin.board_picture import save_board_picture
 
 P = load_params()
 TTT = Path(sys.executable).with_name("ttt-sm")
@@ -65,13 +66,28 @@ def _dark_pixels(png: str) -> int:
     return int(np.count_nonzero(image < 80))
 
 
-def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_has_its_own_name(tmp_path):
-    session = GameSession(P, seed=4, camera="direct", out_dir=tmp_path)
+def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_has_its_own_name(
+        tmp_path, monkeypatch):
+    import ttt_sm.app.game as game_module
+
+    titles: list[str] = []
+
+    def save_and_note_the_title(board, path, title, subtitle=""):
+        titles.append(title)
+        return save_board_picture(board, path, title, subtitle)
+
+    monkeypatch.setattr(game_module, "save_board_picture", save_and_note_the_title)
+    said: list[str] = []
+    session = GameSession(P, seed=4, camera="direct", out_dir=tmp_path, progress=said.append)
     try:
-        session.play()
+        report = session.play()
         files = session.save()
     finally:
         session.close()
+    # the picture's title and the terminal's line say who won in words, not a bare symbol
+    words = {"O": "the robot (O) won", "X": "the person (X) won"}[report["outcome"]]
+    assert titles[0].startswith(f"The whiteboard at the end of the game: {words},"), titles
+    assert f"result: {words}; erasing and turning off" in said, said
     assert Path(files["board_png"]).name == "board_final.png"
     assert Path(files["board_erased_png"]).name == "board_erased.png"
     # the person's black ink and the robot's dark blue are on the final board, not on the erased one

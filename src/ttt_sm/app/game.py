@@ -100,6 +100,14 @@ def result_of(board: str) -> str | None:
     return "draw" if is_full(b) else None
 
 
+def outcome_in_words(outcome: str | None, robot_symbol: str, person_symbol: str) -> str:
+    """How a game ended, for a person to read: who won, or why there is no winner."""
+    return {robot_symbol: f"the robot ({robot_symbol}) won", person_symbol: f"the person ({person_symbol}) won",
+            "draw": "a draw: the board is full", "given_up": "the person gave up",
+            "halted": "stopped before a result", "abandoned": "ended without a result"}.get(outcome or "abandoned",
+                                                                                           str(outcome))
+
+
 class SimulatedPerson:
     """A simulated person at the board, at one of :data:`PERSON_STRENGTHS`:
 
@@ -711,7 +719,8 @@ class GameSession:
         robot = self.robot
         ink = robot.board.ink_area_mm2()
         if which == "final":
-            how = {None: f"the game over ({self.outcome})", "interrupted": "the game interrupted",
+            how = {None: outcome_in_words(self.outcome, self.robot_symbol, self.person_symbol),
+                   "interrupted": "the game interrupted",
                    "error": "the game stopped by an error"}[ending]
             title = f"The whiteboard at the end of the game: {how}, {len(self.moves)} moves played"
         else:
@@ -760,7 +769,8 @@ class GameSession:
         self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3, "given_up": 4}.get(outcome, 3)
         self._event("result", outcome=outcome)
         self._save_board("final")  # the board as the game ended, before the sponge
-        self.say(f"result: {outcome}; erasing and turning off")
+        self.say(f"result: {outcome_in_words(outcome, self.robot_symbol, self.person_symbol)}; "
+                 "erasing and turning off")
         yield Wait(lambda: self.game.ended, 600.0, "erasing and turning off")
         self._save_board("erased")
 

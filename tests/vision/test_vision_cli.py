@@ -37,6 +37,17 @@ def test_render_then_detect_as_json(tmp_path: Path, capsys):
     assert cv2.imread(str(overlay)).shape == (480, 640, 3)
 
 
+def test_a_board_may_be_written_in_rows_as_the_other_commands_take_it(tmp_path: Path, capsys):
+    # `camera serve --board` and `ai move --board` take rows split by '/' (or spaces, '|'): so does vision
+    photo = tmp_path / "photo.png"
+    assert run(["vision", "render", str(photo), "--board", "X...O/.O.../..X../...../O...X", "--seed", "3",
+                "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["board"] == "X...O.O.....X.......O...X"
+    assert run(["vision", "detect", str(photo), "--robot-marks", "x.... | ..... | ..x.. | ..... | ....x",
+                "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["board"] == "X...O.O.....X.......O...X"
+
+
 def test_detect_prints_the_cells_both_ways(tmp_path: Path, capsys):
     photo = tmp_path / "p.png"
     assert run(["vision", "render", str(photo), "--seed", "5"]) == 0

@@ -140,6 +140,12 @@ def add_arm_option(sp: argparse.ArgumentParser) -> None:
                          " (a board, or ttt-sm arm serve's link)")
 
 
+def board_cells(text: str) -> str:
+    """The ``type`` of a board given as text: rows may be split by '/', '|' or spaces, as ``ttt-sm camera serve``
+    and ``ttt-sm ai move`` take them; the 25 cells are checked by the command that reads them."""
+    return "".join(ch for ch in text if ch not in " \t\r\n/|")
+
+
 def seed(text: str) -> int:
     """The ``type`` of every ``--seed``: a whole number 0 .. 2**63 - 1 (numpy's generators take no negative
     seed, and a run is reproducible from it)."""

@@ -28,7 +28,7 @@ import cv2
 
 from ..vision.errors import VisionError
 from ..vision.orientation import VIEW_NAMES, board_text, board_values, check_orientation, check_robot_marks
-from .common import print_json, seed
+from .common import board_cells, print_json, seed
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
@@ -42,8 +42,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
     d.add_argument("image", metavar="IMAGE", help="photo of the board (PNG, JPEG, ...)")
     d.add_argument("--view", choices=VIEW_NAMES, default="far_edge",
                    help="where the camera stands, for the board order (default far_edge: beyond the far edge)")
-    d.add_argument("--robot-marks", metavar="TEXT", default=None,
-                   help="the robot's marks, 25 characters in board order (X or O where it drew, . elsewhere):"
+    d.add_argument("--robot-marks", metavar="TEXT", type=board_cells, default=None,
+                   help="the robot's marks, 25 characters in board order (X or O where it drew, . elsewhere;"
+                        " rows may be split by /):"
                         " checks that the photo is neither turned nor mirrored")
     d.add_argument("--overlay", metavar="PNG", default=None, help="also save the photo with the located field")
     d.add_argument("--json", action="store_true", help="print one JSON document")
@@ -54,7 +55,8 @@ def register(sub: Any) -> argparse.ArgumentParser:
     r.add_argument("out", metavar="OUT.png", help="where to save the photo")
     r.add_argument("--seed", type=seed, default=0, help="seed of the board, the camera and the light (default 0)")
     r.add_argument("--board", metavar="TEXT", default=None,
-                   help="25 characters . X O in board order (row 1 first; default: a random board)")
+                   help="25 characters . X O in board order (row 1 first, rows may be split by /; default: a"
+                        " random board)")
     r.add_argument("--robot", choices=["X", "O"], default="X", help="the robot's symbol for --board (default X)")
     r.add_argument("--shadow", action="store_true", help="cast the arm's shadow over the board")
     r.add_argument("--dim", type=float, default=None,

@@ -111,12 +111,14 @@ def scene_from_text(params: ArmParams, text: str, robot_symbol: str = "X", seed:
                     resolution_mm: float = 0.2) -> Scene:
     """The field and the symbols of a 25-character board (board order, ``.``/``X``/``O``).
 
-    The robot's symbol is drawn as robot ink, the other by hand.
+    The robot's symbol is drawn as robot ink, the other by hand.  Rows may be split by '/', '|', spaces or
+    new lines (as ``ttt-sm camera serve --board`` and ``ttt-sm ai move --board`` take them).
     """
     n = params.board.cells
-    t = text.replace("\n", "").replace(" ", "").upper()
+    t = "".join(ch for ch in text if ch not in " \t\r\n/|").upper()
     if len(t) != n * n or set(t) - {".", "X", "O"}:
-        raise ValueError(f"board text must be {n * n} characters of '.', 'X', 'O' (row 1 first), got {text!r}")
+        raise ValueError(f"board text must be {n * n} characters of '.', 'X', 'O' (row 1 first; rows may be split"
+                         f" by '/'), got {text!r}")
     if robot_symbol not in ("X", "O"):
         raise ValueError(f"robot_symbol must be 'X' or 'O', got {robot_symbol!r}")
     board = Whiteboard(params, resolution_mm, seed=seed)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import threading
 import time
 
@@ -51,7 +52,9 @@ def test_read_prints_grids_and_a_summary(tmp_path, capsys):
         assert run("camera", "read", "--port", cam.port, "--count", "2") == 0
     captured = capsys.readouterr()
     assert captured.out.count("(percent of dark pixels per field)") == 2
-    assert "2 frames, rejected 0" in captured.err
+    # the summary counts every valid frame received: a busy machine may deliver a 3rd in the chunk holding the 2nd
+    summary = re.search(r"(\d+) frames, rejected 0,", captured.err)
+    assert summary is not None and int(summary.group(1)) >= 2, captured.err
 
 
 def test_read_shows_rejections_on_stderr(tmp_path, capsys):

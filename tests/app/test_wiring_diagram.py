@@ -52,3 +52,13 @@ def test_a_changed_table_makes_the_drawing_stale():
     assert stale_files(ALL_CHARTS, CHARTS, REPO_CHART_FORMATS, [wiring_diagram()]) == []
     fewer = ExtraDiagram("wiring", wiring_dot(ROBOT_WIRES[:-1]), wiring_diagram().section)
     assert stale_files(ALL_CHARTS, CHARTS, REPO_CHART_FORMATS, [fewer]) == [str(CHARTS / "wiring.svg")]
+
+
+def test_every_block_of_the_drawing_has_its_column_so_no_arrow_crosses_the_whole_picture():
+    # A block without a column is placed where Graphviz likes: the Safety chart's inputs then ran from its
+    # monitors at the far left across every other block to it.
+    from ttt_sm.app.wiring_diagram import COLUMNS
+
+    drawn = {end.block for r in check([*ROBOT_WIRES, *GAME_WIRES], all_blocks()) for end in (r.source, r.target)}
+    placed = {name for column in COLUMNS for name in column}
+    assert sorted(drawn - placed) == []

@@ -20,7 +20,9 @@ from .wiring import Block, CheckedWire, Wire, chart_block, check
 
 #: Left to right, the order of one chart step: the game, the Control chart, inverse
 #: kinematics and the Encoder blocks, the init charts, the drives (and whether they
-#: are initialised).  Blocks in one
+#: are initialised), then the Safety chart, its monitors beside it and what it asks
+#: of the drives.  Every block has a column (a test checks it): one Graphviz places
+#: at will can end up far from its wires.  Blocks in one
 #: column share a rank; arrows that run back (a chart's output read at the next
 #: step) are drawn back.
 COLUMNS: tuple[tuple[str, ...], ...] = (
@@ -34,6 +36,9 @@ COLUMNS: tuple[tuple[str, ...], ...] = (
     ("DriveInit2",),
     ("DriveInit3",),
     ("Drives", "Homing"),
+    ("Monitor", "Link", "Camera"),
+    ("Safety",),
+    ("SafeState",),
 )
 
 _CHART_STYLE = 'shape=box, style="rounded,filled", fillcolor="#d6e6f5", color="#3b6ea8", penwidth=1.4'

@@ -160,8 +160,15 @@ class Robot:
         initialisation charts and a new Control chart take the place of the
         old ones (their clocks going on from the old ones' chart tick), the
         whole table is wired again and :attr:`charts_replaced` is told.  The
-        init charts search their switches from where the arm stands.
+        init charts search their switches from where the arm stands.  An arm
+        with a link first re-arms it (``rearm``, the :class:`~ttt_sm.arm.Arm`
+        protocol's optional surface): a firmware that stopped the drives takes
+        ``START`` again once the link answers; while it does not, the Safety
+        chart trips on the link again.
         """
+        rearm = getattr(self.arm, "rearm", None)
+        if rearm is not None:
+            rearm()
         counts = self.arm.sensors().counts
         offsets = [-c * d.rad_per_count for c, d in zip(counts, self.params.drives, strict=True)]
         for drive in (1, 2, 3):

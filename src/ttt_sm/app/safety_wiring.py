@@ -155,7 +155,8 @@ class SafetyStage:
         self.listeners: list[Callable[[str, dict[str, Any]], object]] = []
         # the Monitor block's outputs as this chart step computed them (app/_monitor.py: OUT_*)
         self._out: tuple[Any, ...] = (0.0,) * 22
-        #: The ``Link`` block: the arm's own report of its link, where it has one (else True), read every tick.
+        #: The ``Link`` block: the arm's own report of its link, where it has one (else True), read every tick
+        #: (``link_ok``, the :class:`~ttt_sm.arm.Arm` protocol's optional surface).
         self.link_ok = True
         #: Inputs forced by a test or scenario (``Robot.set_input(..., force=True)``): name -> value.
         self.overrides: dict[str, object] = {}
@@ -204,7 +205,7 @@ class SafetyStage:
         self.chart.tick()
         tripped, hold, lift_z, off, reinit = self._outputs()
         if tripped and not self._tripped:
-            self._tell("safety_trip", reason=self.chart.reason, drive=self.chart.fault_drive)
+            self._tell("safety_trip", reason=self.chart.reason, drive=self.chart.fault_drive, **self._link_detail())
         self._tripped = bool(tripped)
         if reinit and not self._reinit:
             self._restart()
@@ -237,6 +238,11 @@ class SafetyStage:
             self._lift_to = None
         q = signals.q_set
         _monitor.advance(self._m, float(q[0]), float(q[1]), float(q[2]), bool(signals.fr_sw))
+
+    def _link_detail(self) -> dict[str, str]:
+        """A lost link's own words (the arm backend's ``link_fault``), for the trip's record."""
+        fault = None if self.link_ok else getattr(self.arm, "link_fault", None)
+        return {} if fault is None else {"link": str(fault)}
 
     def _shift(self, offsets: tuple[float, float, float]) -> None:
         """The encoder offsets changed to `offsets`: the model's angles move with them."""

@@ -18,6 +18,21 @@ fused with the plant, for the simulation (:class:`ttt_sm.twin.sim.ArmSim`);
 in the microcontroller for a hardware backend.  Ground truth is not part of
 this protocol: the simulated arm keeps it behind its ``truth`` attribute.
 
+An arm behind a link may offer more; the application asks with
+``getattr`` and does without when it is absent (the simulated arm has none):
+
+* ``link_ok`` (bool property): the link to the arm is alive and its
+  firmware runs the drives; read every chart step as the Safety chart's
+  ``Link`` block (docs/safety.md); absent means always true;
+* ``link_fault`` (``str | None`` property): why ``link_ok`` is false, in one
+  line, for the record of the trip;
+* ``rearm() -> bool``: after a lost link, make the arm run its drives again
+  if it answers (the Safety chart's ``reset`` calls it before the drives
+  initialise again); whether it does;
+* ``close()``: release the port.
+
+:class:`ttt_sm.hardware.serial_arm.SerialArm` offers all four (docs/hardware.md).
+
 Every accessor is cheap and returns plain numbers: the scheduler and the
 wiring call some of them every chart step.  Drives are numbered 1, 2, 3 as in
 the thesis where a method takes a drive number; tuples of three are drive 1

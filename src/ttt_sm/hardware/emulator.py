@@ -30,7 +30,7 @@ import select
 import threading
 import time
 from pathlib import Path
-from typing import Literal
+from typing import Literal, Protocol
 
 import numpy as np
 
@@ -47,6 +47,21 @@ Pace = Literal["realtime", "gated"]
 PACES: tuple[Pace, ...] = ("realtime", "gated")
 
 _LOG = logging.getLogger(__name__)
+
+
+class WireTap(Protocol):
+    """What stands between the pty and the firmware's UART: a fault injector (``ttt_sm.faults.link``).
+
+    Each is called with the bytes that came (maybe none: the emulator calls
+    both every turn of its loop, so that frames held back can go on) and the
+    ``time.monotonic`` of the call; it returns the bytes to pass on.
+    """
+
+    def to_firmware(self, data: bytes, now: float) -> bytes:
+        """Bytes from the PC, on their way into the firmware."""
+
+    def to_pc(self, data: bytes, now: float) -> bytes:
+        """Bytes from the firmware, on their way to the PC."""
 
 
 class ArmEmulatorError(RuntimeError):
@@ -159,6 +174,12 @@ class ArmEmulator:
         self._true_offsets = (c0[0], c0[1], c0[2])
         self._gate = 0  # setpoints frames seen by the gated clock
         self._until = 0  # ... which let it run to this step
+        #: Tampers with the bytes between the pty and the firmware (fault injection); None passes them all.
+        self.tap: WireTap | None = None
+        #: The firmware's state changes as they happened: (its step, its new state, ``time.monotonic``).
+        self.state_changes: list[tuple[int, int, float]] = []
+        self._state = self.firmware.state
+        self._rejections: dict[int, int] = {}
 
     @property
     def port(self) -> str:
@@ -213,10 +234,15 @@ class ArmEmulator:
             readable, _, _ = select.select([fd], [], [], 0.0005)
             if readable:
                 self._receive(fd)
+            elif self.tap is not None:  # frames the tap held back may be due
+                self._deliver(self.tap.to_firmware(b"", time.monotonic()))
             if self.pace == "realtime":
                 due = int((time.monotonic() - t0) / self.dt)
                 while fw.steps < due and not self._stop.is_set():
                     self.bench.step()
+                    self._note_state()
+                    self._send(fd)
+                if self.tap is not None:
                     self._send(fd)
             else:
                 if fw.setpoints_ok != self._gate:  # new setpoints: one more chart step past their step
@@ -224,7 +250,14 @@ class ArmEmulator:
                     self._until = fw.last_setpoint_step + fw.board.status_every
                 while fw.state == 1 and fw.steps < self._until:
                     self.bench.step()
+                self._note_state()
                 self._send(fd)
+
+    def _note_state(self) -> None:
+        state = self.firmware.state
+        if state != self._state:
+            self._state = state
+            self.state_changes.append((self.firmware.steps, state, time.monotonic()))
 
     def _receive(self, fd: int) -> None:
         try:
@@ -235,12 +268,36 @@ class ArmEmulator:
             time.sleep(0.001)
             return
         self.bytes_in += len(data)
+        if self.tap is not None:
+            data = self.tap.to_firmware(data, time.monotonic())
+        self._deliver(data)
+
+    def _deliver(self, data: bytes) -> None:
+        if not data:
+            return
         if self.pace == "gated" and self.firmware.state != 1:
             self.bench.sense()  # no control step runs before START here: the readings a board would have
-        self.firmware.rx(data)
+        fw = self.firmware
+        ok = fw.frames_ok
+        fw.rx(data)
+        self._note_state()
+        if fw.frames_ok - ok < data.count(0):  # a frame ended and was not taken: say which reason counted it
+            self._log_rejections()
+
+    def _log_rejections(self) -> None:
+        """One log line per reason the firmware counted since the last look (a board's debug output)."""
+        now = self.firmware.rejections()
+        for reason, n in now.items():
+            new = n - self._rejections.get(reason, 0)
+            if new > 0:
+                self._log.warning("link (firmware): rejected %d frame(s): %s (%d so far)", new,
+                                  L.Reason(reason).name.lower(), n)
+        self._rejections = now
 
     def _send(self, fd: int) -> None:
         data = self.firmware.tx()
+        if self.tap is not None:
+            data = self.tap.to_pc(data, time.monotonic())
         if data and self.truth:  # before the firmware's frames: the PC has it when it reads their status
             ps, pgs = self.plant.ps, self.plant.pgs
             frame = self._truth_tx.frame(L.EmuTruth(self.firmware.steps, int(self.pace == "gated"), (
@@ -264,4 +321,4 @@ class ArmEmulator:
             self._out.clear()
 
 
-__all__ = ["ArmEmulator", "ArmEmulatorError", "FirmwareOnPlant", "PACES"]
+__all__ = ["ArmEmulator", "ArmEmulatorError", "FirmwareOnPlant", "PACES", "WireTap"]

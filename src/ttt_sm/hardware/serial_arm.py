@@ -10,16 +10,27 @@ like the twin: ``set_setpoints`` once per chart step, ``step(n)`` sends them
 (one ``SETPOINTS`` frame per chart step) and waits for the firmware's
 ``STATUS`` of the step it asked for; the sensors are that status's.
 
-The link is declared lost (:class:`LinkLost`) when no valid status arrives
-within :data:`LINK_TIMEOUT_S` of wall-clock time while waiting for one.
-While the PC has nothing to send (the charts paused, a debugger at a
-breakpoint), a background thread keeps the link watched: every
-:data:`HEARTBEAT_PERIOD_S` it sends a ``HEARTBEAT`` (the firmware answers
-with a ``HEARTBEAT_REPLY``; on its own clock it also goes on sending its
-``STATUS``), and when no valid frame has come for the link's timeout it
-records a :class:`LinkLoss` (:attr:`SerialArm.lost`, and the
-``on_link_lost`` callback).  Rejected frames are counted and logged by its
-:class:`~ttt_sm.hardware.link.Receiver`.
+The link is declared lost when no valid status arrives within
+:data:`LINK_TIMEOUT_S` of wall-clock time while waiting for one, or the
+port fails.  While the PC has nothing to send (the charts paused, a
+debugger at a breakpoint), a background thread keeps the link watched:
+every :data:`HEARTBEAT_PERIOD_S` it sends a ``HEARTBEAT`` (the firmware
+answers with a ``HEARTBEAT_REPLY``; on its own clock it also goes on
+sending its ``STATUS``), and when no valid frame has come for the link's
+timeout it declares the loss.  A loss is a :class:`LinkLoss`
+(:attr:`SerialArm.lost`, and the ``on_link_lost`` callback); it stays
+until :meth:`SerialArm.rearm`.  Rejected frames are counted and logged by
+its :class:`~ttt_sm.hardware.link.Receiver`.
+
+A lost link does not raise out of ``step``: :attr:`SerialArm.link_ok`
+turns false (the ``Link`` block the Safety chart reads, docs/safety.md),
+the PC stops streaming setpoints, so that the firmware's watchdog stops the
+drives 50 ms later whichever way the link broke, and ``step`` goes on at
+the wall clock's pace (one chart step per chart period) with the last
+sensors.  A firmware that stopped the drives itself (``safe_stop``) makes
+:attr:`~SerialArm.link_ok` false too.  :meth:`SerialArm.rearm` (the Safety
+chart's ``reset``: ``Robot.reinitialise``) sends ``START`` again once the
+firmware answers.
 """
 
 from __future__ import annotations
@@ -127,7 +138,7 @@ class SerialArmError(RuntimeError):
 
 
 class LinkLost(SerialArmError):
-    """No valid frame from the firmware within the link's timeout."""
+    """No valid frame from the firmware within the link's timeout (while opening it, or asked for a reply)."""
 
 
 class SerialArm:
@@ -187,6 +198,14 @@ class SerialArm:
         #: When (``time.monotonic``) the last new STATUS came, and its firmware step.
         self.status_at = 0.0
         self.status_step = 0
+        #: When (``time.monotonic``) the PC first saw the firmware out of ``running`` (its watchdog tripped),
+        #: None while it runs.
+        self.stop_seen_at: float | None = None
+        #: When the last STATUS frame came, new or not (``time.monotonic``).
+        self.status_seen_at = 0.0
+        #: The link's timeout against a gated emulator (:data:`GATED_TIMEOUT_S`).
+        self.gated_timeout_s = GATED_TIMEOUT_S
+        self.rearms = 0
         self._closing = threading.Event()
         self._keeper: threading.Thread | None = None
         # The keeper runs at its maker's scheduling priority: one that ran lower could be held off the
@@ -279,10 +298,13 @@ class SerialArm:
             messages = self.rx.feed(data)
             if messages:
                 self.last_frame_at = time.monotonic()
-                self.lost = None
             for m in messages:
                 if isinstance(m, L.Status):
+                    self.status_seen_at = self.last_frame_at
                     if self._status is None or m.step > self._status.step or m.state != self._status.state:
+                        if m.state != 1 and self.stop_seen_at is None and self._status is not None \
+                                and self._status.state == 1:
+                            self.stop_seen_at = self.last_frame_at
                         self._status = m
                         self.status_at, self.status_step = self.last_frame_at, m.step
                 elif isinstance(m, L.HeartbeatReply):
@@ -314,7 +336,7 @@ class SerialArm:
             self._poll(min(0.005, max(0.0, give_up - time.monotonic())))
 
     def _timeout(self) -> float:
-        return max(self.link_timeout_s, GATED_TIMEOUT_S) if self.gated else self.link_timeout_s
+        return max(self.link_timeout_s, self.gated_timeout_s) if self.gated else self.link_timeout_s
 
     def _keep(self) -> None:
         """The link's keeper: a HEARTBEAT when nothing was sent for a while; a loss declared on silence.
@@ -353,6 +375,8 @@ class SerialArm:
                 self._io.release()
 
     def _declare_lost(self, reason: str, now: float, checked_before: float) -> None:
+        if self.lost is not None:
+            return
         loss = LinkLoss(reason, self.last_frame_at, now, checked_before, self._timeout())
         self.lost = loss
         self.losses.append(loss)
@@ -372,20 +396,96 @@ class SerialArm:
                     return reply
 
     def _wait_step(self, target: int) -> None:
+        """Wait for the status of step `target`; declare the link lost (no exception) when none comes in time."""
         timeout = self._timeout()
-        give_up = time.monotonic() + timeout
+        checked = time.monotonic()
+        give_up = checked + timeout
         while True:
             status = self._status
-            if status is not None and status.state != 1:
-                raise LinkLost(f"the firmware is in {status.state_name} at step {status.step}")
-            if status is not None and status.step >= target:
-                return
+            if status is not None and (status.state != 1 or status.step >= target):
+                return  # a stopped firmware: link_ok says so
             self._poll(min(0.005, timeout))
+            now = time.monotonic()
             if self._status is not status:
-                give_up = time.monotonic() + timeout
-            if time.monotonic() > give_up:
-                raise LinkLost(f"no status from the firmware for {timeout * 1000:.0f} ms "
-                               f"(waiting for step {target}; {self.rx.rejected} frames rejected)")
+                give_up = now + timeout
+            elif now > give_up:
+                self._declare_lost(f"no status from the firmware for {timeout * 1000:.0f} ms (waiting for step"
+                                   f" {target}; {self.rx.rejected} frames rejected)", now, checked)
+                return
+            checked = now
+
+    def _idle_chart_step(self) -> None:
+        """A chart step without the firmware: read what comes for one chart period of the wall clock."""
+        until = time.monotonic() + self.dt * self.divider
+        while True:
+            left = until - time.monotonic()
+            try:
+                self._poll(max(0.0, left))
+                if self._fd is None:  # no descriptor to wait on (a pyserial URL): do not spin
+                    time.sleep(max(0.0, min(left, 0.001)))
+            except LinkLost:
+                time.sleep(max(0.0, left))  # the port is gone: only the clock goes on
+            if left <= 0:
+                return
+
+    # ---- the link's state -----------------------------------------------------------
+
+    @property
+    def link_ok(self) -> bool:
+        """The ``Link`` block (docs/safety.md): the link is not lost and the firmware runs the drives.
+
+        False from the loss (no valid status for the link's timeout, or a port
+        that failed) or from the firmware's own safe stop, until :meth:`rearm`.
+        """
+        s = self._status
+        return self.lost is None and (s is None or s.state == 1)
+
+    @property
+    def link_fault(self) -> str | None:
+        """Why :attr:`link_ok` is false, in one line; None while it is true."""
+        if self.lost is not None:
+            return self.lost.reason
+        s = self._status
+        if s is not None and s.state != 1:
+            return (f"the firmware stopped the drives ({s.state_name} at step {s.step}: no setpoints reached"
+                    " it for 50 ms)")
+        return None
+
+    def rearm(self, timeout_s: float = 0.5) -> bool:
+        """After a loss or the firmware's safe stop, ``START`` again: whether the firmware runs the drives now.
+
+        Tried only when a valid frame came after the loss (the link answers
+        again); the firmware takes ``START`` with its gains kept and holds every
+        drive where it stands (docs/hardware.md).  The loss is then forgotten
+        and the PC streams setpoints again, from the firmware's step (its clock
+        ran on).  Nothing is sent, and False returned, while the link is silent.
+        """
+        with self._io:
+            if self.link_ok:
+                return True
+            if self.lost is not None and self.last_frame_at <= self.lost.declared_at:
+                try:
+                    self._poll()
+                except LinkLost:
+                    return False
+                if self.last_frame_at <= self.lost.declared_at:
+                    return False
+            sent = time.monotonic()
+            try:
+                self._send(L.Start())
+                give_up = sent + timeout_s
+                while not (self._status is not None and self._status.state == 1 and self.status_seen_at >= sent):
+                    if time.monotonic() > give_up:
+                        return False
+                    self._poll(0.005)
+            except LinkLost:
+                return False
+            self.lost = None
+            self.stop_seen_at = None
+            self.rearms += 1
+            self._steps = max(self._steps, self._status.step)
+            self._sent_for = -1
+            return True
 
     # ---- the Arm protocol ---------------------------------------------------------------
 
@@ -414,15 +514,34 @@ class SerialArm:
         target = self._steps + n
         d = self.divider
         while self._steps < target:
-            if self._steps % d == 0 and self._sent_for != self._steps:
-                self._send(L.Setpoints(self._steps, (self._q[0], self._q[1], self._q[2], self._q[3]), self._fr_sw))
+            ok = self.link_ok
+            if ok and self._steps % d == 0 and self._sent_for != self._steps:
                 self._sent_for = self._steps
+                if not self._try(L.Setpoints(self._steps, (self._q[0], self._q[1], self._q[2], self._q[3]),
+                                             self._fr_sw)):
+                    ok = False
             nxt = min(target, (self._steps // d + 1) * d)
             if nxt % d == 0:
-                self._wait_step(nxt)
-                assert self._status is not None  # _wait_step returns with one
-                nxt = max(nxt, self._status.step)  # on its own clock, the firmware may be further on
+                if ok:
+                    try:
+                        self._wait_step(nxt)
+                    except LinkLost as exc:  # the port failed
+                        self._declare_lost(str(exc), time.monotonic(), self.last_frame_at)
+                if self.link_ok:
+                    assert self._status is not None  # _wait_step returns with one
+                    nxt = max(nxt, self._status.step)  # on its own clock, the firmware may be further on
+                else:  # no setpoints go out: the firmware's watchdog stops the drives; the PC's clock runs on
+                    self._idle_chart_step()
             self._steps = nxt
+
+    def _try(self, message: L.Message) -> bool:
+        """Send `message`; a port that fails declares the link lost (False) instead of raising."""
+        try:
+            self._send(message)
+        except LinkLost as exc:
+            self._declare_lost(str(exc), time.monotonic(), self.last_frame_at)
+            return False
+        return True
 
     def set_setpoints(self, q_des: Sequence[float], fr_sw: bool = False) -> None:
         q = [float(v) for v in q_des[:4]]
@@ -456,7 +575,7 @@ class SerialArm:
         self._offsets[d] = float(offset_rad)
         self._q[d] += shift  # the firmware moves its setpoint with the offset: keep ours with it
         with self._io:
-            self._send(L.Drive(d, L.Op.OFFSET, float(offset_rad)))
+            self._try(L.Drive(d, L.Op.OFFSET, float(offset_rad)))
 
     def enabled(self) -> tuple[bool, bool, bool]:
         m = 0 if self._status is None else self._status.modes
@@ -465,7 +584,7 @@ class SerialArm:
     def set_enabled(self, drive: int, enabled: bool) -> None:
         d = check_drive(drive) - 1
         with self._io:
-            self._send(L.Drive(d, L.Op.CLOSED if enabled else L.Op.OFF, 0.0))
+            self._try(L.Drive(d, L.Op.CLOSED if enabled else L.Op.OFF, 0.0))
 
     @property
     def link_stats(self) -> dict[str, int]:

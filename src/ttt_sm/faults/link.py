@@ -210,8 +210,15 @@ class LinkCell:
     rearmed: bool
     recovered: bool
     """After the fault (and the re-arm when the link was lost) the firmware runs and takes setpoints."""
-    disturbed_before: bool
-    """The link was lost before the fault began (a loaded machine holding up the PC): the cell is not clean."""
+    pc_max_stall_ms: float
+    """The longest chart step of the PC's loop that found the link sound, wall clock (one is 2 ms)."""
+    emulator_max_behind_ms: float
+    """The longest the emulator's thread fell behind the wall clock (it then runs the steps in a burst)."""
+    disturbed: bool
+    """The machine held up the PC or the emulator for half the watchdog's 50 ms or more, or the link was lost
+    before the fault began: what the cell saw may be the machine's doing, not the fault's."""
+    onset_time: float
+    """When the fault began, ``time.time()`` (the log's clock): the log lines it caused come after."""
     wall_s: float
 
 
@@ -224,17 +231,23 @@ class _Streamer:
         self.servo = arm.servo_setpoint
         self.t0 = time.monotonic()
         self.not_ok_at: float | None = None
+        self.max_stall_s = 0.0
 
     def run(self, seconds: float) -> None:
         arm, divider = self.arm, self.arm.divider
-        end = time.monotonic() + seconds
+        end = last = time.monotonic()
+        end += seconds
         while time.monotonic() < end:
             t = time.monotonic() - self.t0
             arm.set_setpoints([self.q0[0] + 0.2 * math.sin(2 * math.pi * 0.5 * t), self.q0[1], self.q0[2],
                                self.servo])
             arm.step(divider)
-            if self.not_ok_at is None and not arm.link_ok:
-                self.not_ok_at = time.monotonic()
+            now = time.monotonic()
+            if arm.link_ok:  # a step that found the link lost waited for it: the fault's doing
+                self.max_stall_s = max(self.max_stall_s, now - last)
+            elif self.not_ok_at is None:
+                self.not_ok_at = now
+            last = now
 
 
 def _reasons(counts: dict[int, int], before: dict[int, int]) -> dict[str, int]:
@@ -257,18 +270,20 @@ def run_link_cell(params: ArmParams, fault: str, seed: int = 0, gains: Gains | N
         arm = SerialArm(emu.port, params, gains, servo_angle=REST_POSE[3])
         try:
             pc = _Streamer(arm)
+            emu.max_behind_steps = 0  # (opening the link held the emulator's thread up: that is no fault)
             pc.run(WARMUP_S)
-            disturbed = not arm.link_ok or bool(arm.losses)
             if not arm.link_ok:
                 arm.rearm()
                 pc.run(WARMUP_S)
+            # the machine held an end up before the onset: the firmware stopped, or the PC lost the link
+            lost_before = fw.state != 1 or not arm.link_ok or bool(arm.losses) or any(
+                state == 2 for _, state, _ in emu.state_changes)
             pc.not_ok_at = None
             fw_rej, pc_rej = dict(fw.rejections()), dict(arm.rx.rejections)
             fw_lost, pc_lost = fw.lost, arm.rx.seq.lost
-            fw_ok, pc_ok = fw.frames_ok, arm.rx.frames_ok
             losses = len(arm.losses)
             changes = len(emu.state_changes)
-            onset_step, onset = fw.steps, time.monotonic()
+            onset_step, onset, onset_time = fw.steps, time.monotonic(), time.time()
             tap.inject(fault)
             pc.run(FAULT_S)
             tap.clear()
@@ -289,6 +304,7 @@ def run_link_cell(params: ArmParams, fault: str, seed: int = 0, gains: Gains | N
             taken = fw.setpoints_ok
             pc.run(AFTER_S)
             recovered = arm.link_ok and fw.state == 1 and fw.setpoints_ok > taken
+            stall_ms, behind_ms = pc.max_stall_s * 1e3, emu.max_behind_steps * params.control.dt * 1e3
         finally:
             arm.close()
         # every bad frame is either rejected by its receiver or taken as valid; taken ones were acted on
@@ -318,8 +334,10 @@ def run_link_cell(params: ArmParams, fault: str, seed: int = 0, gains: Gains | N
             pc_detect_ms=round((not_ok_at - onset) * 1e3, 1) if not_ok_at is not None else None,
             pc_silence_ms=round(loss.silence_s * 1e3, 1) if loss is not None else None,
             pc_reason=fault_text if pc_declared else "",
-            as_expected=as_expected, rearmed=rearmed, recovered=bool(recovered), disturbed_before=disturbed,
-            wall_s=round(time.perf_counter() - wall0, 2),
+            as_expected=as_expected, rearmed=rearmed, recovered=bool(recovered),
+            pc_max_stall_ms=round(stall_ms, 1), emulator_max_behind_ms=round(behind_ms, 1),
+            disturbed=lost_before or max(stall_ms, behind_ms) >= LINK_LIMIT_S * 1e3 / 2,
+            onset_time=onset_time, wall_s=round(time.perf_counter() - wall0, 2),
         )
 
 
@@ -343,7 +361,7 @@ def link_fault_matrix(params: ArmParams, faults: Sequence[str] = LINK_FAULTS, se
             "max_firmware_stop_ms": max((c.firmware_stop_ms or 0.0) for c in stopping) if stopping else None,
             "max_pc_detect_ms": max((c.pc_detect_ms or 0.0) for c in stopping) if stopping else None,
             "recovered": sum(c.recovered for c in cells),
-            "disturbed": [c.fault for c in cells if c.disturbed_before],
+            "disturbed": [c.fault for c in cells if c.disturbed],
         },
         "seed": seed,
         "wall_time_s": round(time.perf_counter() - wall0, 2),

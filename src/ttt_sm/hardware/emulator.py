@@ -180,6 +180,9 @@ class ArmEmulator:
         self.state_changes: list[tuple[int, int, float]] = []
         self._state = self.firmware.state
         self._rejections: dict[int, int] = {}
+        #: In real time: the most control steps the thread was ever behind the wall clock (held up by the
+        #: machine, it runs them in a burst; a board never is).
+        self.max_behind_steps = 0
 
     @property
     def port(self) -> str:
@@ -238,6 +241,8 @@ class ArmEmulator:
                 self._deliver(self.tap.to_firmware(b"", time.monotonic()))
             if self.pace == "realtime":
                 due = int((time.monotonic() - t0) / self.dt)
+                if due - fw.steps > self.max_behind_steps:
+                    self.max_behind_steps = due - fw.steps
                 while fw.steps < due and not self._stop.is_set():
                     self.bench.step()
                     self._note_state()

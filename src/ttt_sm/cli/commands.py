@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import logging
 import sys
 from typing import TYPE_CHECKING, Any
 
@@ -326,6 +327,8 @@ def cmd_faults(args: argparse.Namespace) -> int:
     from ..faults.matrix import fault_matrix
     from ..faults.twin import TWIN_FAULTS
 
+    if args.link:
+        return _link_faults(args)
     faults = _choices(args.only, TWIN_FAULTS, "--only") if args.only else list(TWIN_FAULTS)
     phases = [FAULT_PHASES[p] for p in _choices(args.phases, FAULT_PHASES, "--phases")] if args.phases \
         else list(FAULT_PHASES.values())
@@ -350,6 +353,46 @@ def cmd_faults(args: argparse.Namespace) -> int:
     ok = summary["detected_within_100_ms"] == summary["cells"] and not summary["limit_violations"] \
         and not summary["records_lost"]
     return 0 if ok else 1
+
+
+def _link_faults(args: argparse.Namespace) -> int:
+    """``ttt-sm faults --link``: each fault of the serial link against the firmware emulator in real time."""
+    from ..faults.link import LINK_FAULTS, link_fault_matrix
+    from ..hardware.firmware import FirmwareError
+
+    if args.phases:
+        raise CliError("--phases: the link's faults have no phases (the link carries the same frames in each);"
+                       " drop --phases or --link")
+    faults = _choices(args.only, LINK_FAULTS, "--only") if args.only else list(LINK_FAULTS)
+    params = load_arm(args.params)
+    # each rejection's log line (hundreds a cell) is counted in the report instead: quiet, and no terminal to slow
+    quiet = [logging.getLogger(name) for name in ("ttt_sm.link", "ttt_sm.hardware.emulator")]
+    levels = [log.level for log in quiet]
+    for log in quiet:
+        log.setLevel(logging.ERROR)
+    try:
+        report = link_fault_matrix(params, faults, seed=args.seed, status=status_line())
+    except (FirmwareError, OSError) as exc:
+        raise CliError(f"the firmware emulator cannot run: {exc}") from None
+    finally:
+        clear_status()
+        for log, level in zip(quiet, levels, strict=True):
+            log.setLevel(level)
+    lines = [f"{'fault':20} {'expected':>8} {'rejected fw / pc':>16} {'gaps fw / pc':>12} {'acted on':>8}"
+             f" {'fw stop':>8} {'pc lost':>8} {'recovered':>9}"]
+    for c in report["cells"]:
+        fw_rej, pc_rej = sum(c["rejected_by_firmware"].values()), sum(c["rejected_by_pc"].values())
+        stop = f"{c['firmware_stop_ms']:.0f} ms" if c["firmware_stopped"] else "-"
+        lost = f"{c['pc_detect_ms']:.0f} ms" if c["pc_declared"] else "-"
+        flag = "" if c["as_expected"] else "  NOT AS EXPECTED" + (" (machine held up)" if c["disturbed"] else "")
+        gaps = f"{c['lost_frames_firmware']} / {c['lost_frames_pc']}"
+        lines.append(f"{c['fault']:20} {c['expected']:>8} {f'{fw_rej} / {pc_rej}':>16} {gaps:>12}"
+                     f" {c['bad_frames_acted_on']:>8} {stop:>8} {lost:>8} {str(c['recovered']):>9}{flag}")
+    summary = report["summary"]
+    lines.append(f"{summary['as_expected']} of {summary['cells']} as expected; {summary['bad_frames_acted_on']} bad"
+                 f" frames acted on; {summary['recovered']} recovered ({report['wall_time_s']:.0f} s)")
+    emit(report, args.json, "\n".join(lines))
+    return 0 if summary["as_expected"] == summary["cells"] and not summary["bad_frames_acted_on"] else 1
 
 
 #: What `charts export` writes by default: what charts/ in the repository holds.
@@ -449,6 +492,9 @@ def register(sub: Any) -> None:
                          "current_spike,servo_stuck,power_cut,camera_lost")
     sp.add_argument("--phases", default=None, metavar="PHASES",
                     help="comma-separated phases (default all): init,field,symbol,erase")
+    sp.add_argument("--link", action="store_true",
+                    help="the faults of the serial link instead (frames_lost,frames_garbled,frames_duplicated,"
+                         "frames_late,frames_out_of_order,link_cut), against the firmware emulator in real time")
     sp = add_command(sub, "charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
     sp.add_argument("action", choices=["export", "check"])
     sp.add_argument("--format", default=None,

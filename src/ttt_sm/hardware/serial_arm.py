@@ -25,10 +25,12 @@ its :class:`~ttt_sm.hardware.link.Receiver`.
 A lost link does not raise out of ``step``: :attr:`SerialArm.link_ok`
 turns false (the ``Link`` block the Safety chart reads, docs/safety.md),
 the PC stops streaming setpoints, so that the firmware's watchdog stops the
-drives 50 ms later whichever way the link broke, and ``step`` goes on at
-the wall clock's pace (one chart step per chart period) with the last
-sensors.  A firmware that stopped the drives itself (``safe_stop``) makes
-:attr:`~SerialArm.link_ok` false too.  :meth:`SerialArm.rearm` (the Safety
+drives 50 ms later whichever way the link broke, and ``step`` returns at
+the wall clock's pace (``n`` control periods) with the last sensors; the
+arm's time (:attr:`SerialArm.t`, the firmware's steps) stands until the
+link is re-armed, then goes on from the firmware's step.  A firmware that
+stopped the drives itself (``safe_stop``) makes :attr:`~SerialArm.link_ok`
+false too.  :meth:`SerialArm.rearm` (the Safety
 chart's ``reset``: ``Robot.reinitialise``) sends ``START`` again once the
 firmware answers.
 """
@@ -67,6 +69,8 @@ HEARTBEAT_PERIOD_S = 0.010
 KEEPER_TICK_S = 0.002
 """How often the idle link's keeper looks at the clock."""
 HANDSHAKE_TIMEOUT_S = 2.0
+REARM_SETTLE_S = 0.2
+"""After a re-arm, the drives hold where they stand this long before the charts command them again, s."""
 BAUD = 921_600
 
 
@@ -414,11 +418,14 @@ class SerialArm:
                 return
             checked = now
 
-    def _idle_chart_step(self) -> None:
-        """A chart step without the firmware: read what comes for one chart period of the wall clock."""
-        until = time.monotonic() + self.dt * self.divider
+    def _idle(self, steps: int) -> None:
+        """`steps` control steps of the wall clock without the firmware, reading what comes meanwhile."""
+        until = time.monotonic() + self.dt * steps
         while True:
             left = until - time.monotonic()
+            if time.monotonic() - self._last_tx >= HEARTBEAT_PERIOD_S:  # the keeper's work, the wire being ours
+                if self._try(L.Heartbeat(next(self._tokens) & 0xFFFFFFFF)):
+                    self.heartbeats_sent += 1
             try:
                 self._poll(max(0.0, left))
                 if self._fd is None:  # no descriptor to wait on (a pyserial URL): do not spin
@@ -456,9 +463,13 @@ class SerialArm:
 
         Tried only when a valid frame came after the loss (the link answers
         again); the firmware takes ``START`` with its gains kept and holds every
-        drive where it stands (docs/hardware.md).  The loss is then forgotten
-        and the PC streams setpoints again, from the firmware's step (its clock
-        ran on).  Nothing is sent, and False returned, while the link is silent.
+        drive where it stands (docs/hardware.md); the PC sends its encoder
+        offsets again (any sent while the link was down were lost) and holds them there
+        for :data:`REARM_SETTLE_S` so that the arm is at rest when the charts
+        take over again.  The loss is then forgotten
+        and the PC streams setpoints again, from the firmware's step (on its
+        own clock it ran on; a gated emulator's stood still too).  Nothing is
+        sent, and False returned, while the link is silent.
         """
         with self._io:
             if self.link_ok:
@@ -473,6 +484,8 @@ class SerialArm:
             sent = time.monotonic()
             try:
                 self._send(L.Start())
+                for d in range(3):  # the PC's offsets are the ones: any sent while the link was down were lost
+                    self._send(L.Drive(d, L.Op.OFFSET, self._offsets[d]))
                 give_up = sent + timeout_s
                 while not (self._status is not None and self._status.state == 1 and self.status_seen_at >= sent):
                     if time.monotonic() > give_up:
@@ -485,7 +498,10 @@ class SerialArm:
             self.rearms += 1
             self._steps = max(self._steps, self._status.step)
             self._sent_for = -1
-            return True
+            # hold where the drives stand while they come to rest (a gated emulator froze the plant moving)
+            self._q[:3] = list(self.encoder_angles())
+            self._step(max(1, round(REARM_SETTLE_S / self.dt)))
+            return self.link_ok
 
     # ---- the Arm protocol ---------------------------------------------------------------
 
@@ -514,24 +530,24 @@ class SerialArm:
         target = self._steps + n
         d = self.divider
         while self._steps < target:
-            ok = self.link_ok
-            if ok and self._steps % d == 0 and self._sent_for != self._steps:
+            if not self.link_ok:  # nothing goes out: the firmware's watchdog stops the drives; the arm's
+                self._idle(target - self._steps)  # time (the firmware's) stands until the link is re-armed
+                return
+            if self._steps % d == 0 and self._sent_for != self._steps:
                 self._sent_for = self._steps
                 if not self._try(L.Setpoints(self._steps, (self._q[0], self._q[1], self._q[2], self._q[3]),
                                              self._fr_sw)):
-                    ok = False
+                    continue
             nxt = min(target, (self._steps // d + 1) * d)
             if nxt % d == 0:
-                if ok:
-                    try:
-                        self._wait_step(nxt)
-                    except LinkLost as exc:  # the port failed
-                        self._declare_lost(str(exc), time.monotonic(), self.last_frame_at)
-                if self.link_ok:
-                    assert self._status is not None  # _wait_step returns with one
-                    nxt = max(nxt, self._status.step)  # on its own clock, the firmware may be further on
-                else:  # no setpoints go out: the firmware's watchdog stops the drives; the PC's clock runs on
-                    self._idle_chart_step()
+                try:
+                    self._wait_step(nxt)
+                except LinkLost as exc:  # the port failed
+                    self._declare_lost(str(exc), time.monotonic(), self.last_frame_at)
+                if not self.link_ok:
+                    continue
+                assert self._status is not None  # _wait_step returns with one
+                nxt = max(nxt, self._status.step)  # on its own clock, the firmware may be further on
             self._steps = nxt
 
     def _try(self, message: L.Message) -> bool:

@@ -80,7 +80,7 @@ CONTRACT: tuple[Component, ...] = (
     Component("app", 3, ("ttt_sm.app",), "the application: wires charts, scheduler, twin, camera and game"),
     Component("debug", 4, ("ttt_sm.debug",), "the step-through debugger"),
     Component("scenario", 4, ("ttt_sm.scenario",), "scenario tests of event sequences (YAML)"),
-    Component("faults", 4, ("ttt_sm.faults",), "faults injected into the twin; the Safety chart's fault matrix"),
+    Component("faults", 4, ("ttt_sm.faults",), "faults injected into the twin and the serial link; the Safety chart's fault matrices"),
     Component("web", 5, ("ttt_sm.web",),
               "the browser cockpit (ttt-sm gui): a session over the debugger, its protocol, server and pages"),
     Component("bench", 6, ("ttt_sm.bench",), "the speed and quality targets",

@@ -27,7 +27,7 @@ from ttt_sm.twin.workspace import load_arm
 
 P = load_arm(None)
 #: How long the PC waits for a silent gated emulator here (5 s by default).
-GATED_S = 0.3
+GATED_S = 1.0
 
 
 @pytest.fixture
@@ -55,7 +55,7 @@ def test_a_cut_link_stops_the_robot_with_its_reason_and_reset_rearms_the_firmwar
         assert not arm.link_ok and arm.lost is not None and arm.lost.silence_s > GATED_S
         (kind, data), = events
         assert kind == "safety_trip" and data["drive"] == 0 and data["reason"] == robot.safety.reason
-        assert data["link"].startswith("no status from the firmware for 300 ms")
+        assert data["link"].startswith("no status from the firmware for 1000 ms")
         # the firmware saw nothing more: the cut held every setpoint back, and no step ran past them
         assert tapped.firmware.steps - steps <= P.control.chart_divider
         t_lost = robot.t
@@ -73,7 +73,8 @@ def test_a_cut_link_stops_the_robot_with_its_reason_and_reset_rearms_the_firmwar
         setpoints = tapped.firmware.setpoints_ok
         robot.post("Safety", "reset")
         robot.run_for(0.2)
-        assert arm.rearms == 1 and arm.link_ok and arm.lost is None and tapped.firmware.state == 1
+        assert arm.rearms == 1 and arm.link_ok, arm.link_fault
+        assert arm.lost is None and tapped.firmware.state == 1
         assert robot.active("Safety") == {"reinitialising"}, robot.safety.reason  # the drives initialise again
         assert tapped.firmware.setpoints_ok - setpoints >= 90 and robot.t > t_lost + 0.15
         # the reset on a cut link restarted the init charts and tripped on the link again
@@ -105,5 +106,5 @@ def test_a_game_whose_link_is_cut_ends_with_one_error_line_and_the_reason_in_its
     records = [json.loads(line) for line in (tmp_path / "play" / "game.jsonl").read_text().splitlines()]
     trips = [r for r in records if r.get("event") == "safety_trip"]
     assert len(trips) == 1 and trips[0]["reason"].startswith("link lost")
-    assert trips[0]["link"].startswith("no status from the firmware for 300 ms")
+    assert trips[0]["link"].startswith("no status from the firmware for 1000 ms")
     assert 1.0 <= records[-1]["t"] < 60

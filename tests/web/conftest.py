@@ -11,6 +11,7 @@ import socket
 import threading
 import time
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,17 @@ def text_of(page: Any, role: str) -> str:
     return str(page.locator(f'[data-role="{role}"]').text_content()).strip()
 
 
+@contextmanager
+def served(session: Session) -> Iterator[Cockpit]:
+    """``session`` served on a free loopback port while the block runs (the session with the app); stopped after."""
+    server, thread, url = serve(session)
+    try:
+        yield Cockpit(url, session, server)
+    finally:
+        server.should_exit = True
+        thread.join(30)
+
+
 def serve(session: Session, token: str | None = None) -> tuple[uvicorn.Server, threading.Thread, str]:
     sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
     sock.bind(("127.0.0.1", 0))
@@ -65,9 +77,5 @@ def cockpit(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cockpit]:
     dbg = Debugger.build(load_params(), seed=0)
     trace = tmp_path_factory.mktemp("cockpit") / "trace.jsonl"
     session = Session(dbg, speed=None, running=False, scenarios=scenario_dir_files(SCENARIOS), trace_path=trace)
-    server, thread, url = serve(session)
-    try:
-        yield Cockpit(url, session, server)
-    finally:
-        server.should_exit = True
-        thread.join(30)
+    with served(session) as cockpit:
+        yield cockpit

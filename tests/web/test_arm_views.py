@@ -24,7 +24,7 @@ from ttt_sm.web.arm_view import POINT_NAMES
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
 
-from .conftest import Cockpit, serve
+from .conftest import Cockpit, served
 from .test_protocol import Page
 
 #: Where the page draws the tip may differ from forward kinematics by this much, mm:
@@ -37,12 +37,8 @@ def arm_cockpit() -> Iterator[Cockpit]:
     """A game (person at the page), paused at power-on, as fast as it goes when run."""
     dbg = Debugger.build(load_params(), seed=0, game=True, person="page")
     session = Session(dbg, speed=None, running=False)
-    server, thread, url = serve(session)
-    try:
-        yield Cockpit(url, session, server)
-    finally:
-        server.should_exit = True
-        thread.join(30)
+    with served(session) as cockpit:
+        yield cockpit
 
 
 def truth_now(d: Debugger) -> dict[str, Any]:

@@ -32,7 +32,7 @@ from ttt_sm.web.camera_feed import CameraFeedError, open_feed
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
 
-from .conftest import Cockpit, serve
+from .conftest import Cockpit, served
 from .test_protocol import Page
 
 #: The boards the folder's two pictures show, by file name (board order, row 1 first).
@@ -143,12 +143,8 @@ def test_the_frames_carry_the_cameras_reading_and_its_picture(picture_folder: Pa
 def feed_cockpit(picture_folder: Path) -> Iterator[Cockpit]:
     session = Session(Debugger.build(load_params(), seed=0, game=True, person="page"), speed=None, running=False,
                       camera_feed=open_feed(str(picture_folder), rate_hz=4.0))
-    server, thread, url = serve(session)
-    try:
-        yield Cockpit(url, session, server)
-    finally:
-        server.should_exit = True
-        thread.join(30)
+    with served(session) as cockpit:
+        yield cockpit
 
 
 def test_the_game_page_shows_the_folders_pictures_and_what_was_read(browser: Any, feed_cockpit: Cockpit) -> None:

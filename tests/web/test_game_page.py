@@ -27,7 +27,7 @@ from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params
 from ttt_sm.web.session import Session
 
-from .conftest import Cockpit, serve
+from .conftest import Cockpit, served, text_of
 
 SHOT = "gui_game.png"
 #: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
@@ -39,16 +39,8 @@ def game_cockpit(tmp_path: Path) -> Iterator[Cockpit]:
     """A game with the person at the page, paused at power-on, as fast as it goes when run."""
     dbg = Debugger.build(load_params(), seed=0, game=True, person="page", record_root=tmp_path / "gui")
     session = Session(dbg, speed=None, running=False, trace_path=tmp_path / "trace.jsonl")
-    server, thread, url = serve(session)
-    try:
-        yield Cockpit(url, session, server)
-    finally:
-        server.should_exit = True
-        thread.join(30)
-
-
-def text_of(page: Any, role: str) -> str:
-    return str(page.locator(f'[data-role="{role}"]').text_content()).strip()
+    with served(session) as cockpit:
+        yield cockpit
 
 
 def wait_text(page: Any, role: str, text: str, timeout: int = LONG) -> None:

@@ -28,7 +28,7 @@ from ttt_sm.params import load_params
 from ttt_sm.web.operate import MSG_DRAWING, MSG_INITIALISING, MSG_READY, MSG_TURNING_OFF, SAMPLE_PERIOD_S
 from ttt_sm.web.session import Session
 
-from .conftest import Cockpit, serve
+from .conftest import Cockpit, served, text_of
 
 SHOT = "gui_operate.png"
 #: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
@@ -41,16 +41,8 @@ def operate_cockpit(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cockpi
     dbg = Debugger.build(load_params(), seed=0)
     trace = tmp_path_factory.mktemp("operate") / "trace.jsonl"
     session = Session(dbg, speed=None, running=False, trace_path=trace)
-    server, thread, url = serve(session)
-    try:
-        yield Cockpit(url, session, server)
-    finally:
-        server.should_exit = True
-        thread.join(30)
-
-
-def text_of(page: Any, role: str) -> str:
-    return str(page.locator(f'[data-role="{role}"]').text_content()).strip()
+    with served(session) as cockpit:
+        yield cockpit
 
 
 def wait_status(page: Any, text: str, timeout: int = LONG) -> None:
@@ -181,7 +173,8 @@ def test_an_o_of_6_cm_at_speed_3_is_a_circle_of_60_mm_on_the_whiteboard(
         assert download.suggested_filename == "x_axis.csv"
         rows = list(csv.reader(io.StringIO(Path(download.path()).read_text(encoding="utf-8"))))
         assert rows[0] == ["t_s", "x_desired_mm", "x_fk_mm"]
-        table = [[float(v) for v in r] for r in rows[1:]]
+        # a sample the arm has no value for yet (before its drives are initialised) is an empty field
+        table = [[float(v) if v else math.nan for v in r] for r in rows[1:]]
         times = [r[0] for r in table]
         assert all(math.isclose(b - a, SAMPLE_PERIOD_S, abs_tol=1e-6) for a, b in zip(times, times[1:], strict=False))
         during = [r for r in table if t0 <= r[0] <= t1]
@@ -193,6 +186,86 @@ def test_an_o_of_6_cm_at_speed_3_is_a_circle_of_60_mm_on_the_whiteboard(
         assert max(r[1] for r in during) - min(r[1] for r in during) >= 59.0
     finally:
         charts.close()
+        page.close()
+
+
+def draw_from_page(page: Any, session: Session, symbol: str, magnitude_cm: str, speed: str) -> list[np.ndarray]:
+    """Choose ``symbol`` (the list's value), type the magnitude and speed, Trigger, wait until the arm waits
+    again; the robot's ink strokes of that drawing (x, y rows, m), read on the twin's whiteboard."""
+    run = page.get_by_role("button", name="Run_simulation", exact=True)
+    if run.is_enabled():  # run alone (-k), before the O's test has started the session
+        run.click()
+    page.wait_for_function("!document.querySelector('[data-cmd=trigger]').disabled", timeout=LONG)
+    page.get_by_label("Symbol", exact=True).select_option(symbol)
+    page.get_by_role("spinbutton", name="Magnitude (cm)", exact=True).fill(magnitude_cm)
+    page.get_by_role("spinbutton", name="Speed (0 to 5)", exact=True).fill(speed)
+    drawings, strokes_before = session.call(lambda d: (len(session.operate.results), len(d.robot.board.strokes)))
+    trigger(page).click()
+    page.wait_for_function("document.querySelector('[data-role=reply]').textContent.startsWith('Trigger:')",
+                           timeout=30_000)
+    while session.call(lambda d: len(session.operate.results)) == drawings:
+        page.wait_for_timeout(100)
+    wait_status(page, MSG_READY)
+    return [s.points[:, :2] for s in session.call(lambda d: d.robot.board.strokes[strokes_before:])
+            if s.author == "robot"]
+
+
+def shown_precision(page: Any, session: Session) -> dict[str, Any]:
+    """The last drawing's precision as the session measured it; the page shows the same numbers."""
+    precision: dict[str, Any] = session.call(lambda d: session.operate.results[-1])
+    page.wait_for_function("(rms) => document.querySelector('[data-key=rms_error_mm]').textContent === rms",
+                           arg=f"{precision['rms_error_mm']:.3f} mm", timeout=30_000)
+    assert text_of(page, "precision").count(f"{precision['max_error_mm']:.3f} mm") == 1
+    return precision
+
+
+def test_a_sine_wave_of_4_cm_at_speed_4_is_4_cm_peak_to_peak_on_the_whiteboard(
+        browser: Any, operate_cockpit: Cockpit) -> None:
+    session = operate_cockpit.session
+    page = browser.new_page(viewport={"width": 1500, "height": 1000})
+    try:
+        open_operate(page, operate_cockpit)
+        page.get_by_label("Symbol", exact=True).select_option("sine")
+        assert text_of(page, "magnitude-means") == "the sine wave's peak to peak"
+        strokes = draw_from_page(page, session, "sine", "4", "4")
+        assert text_of(page, "reply") == "Trigger: a sine wave, 4 cm peak to peak, speed 4 (25 mm/s)"
+        assert len(strokes) == 1  # one stroke, the pen down from end to end
+        ink = strokes[0]
+        length = session.call(lambda d: float(d.robot.control.sine_length))
+        # along X the wave's length; across, its peak to peak: the Magnitude
+        assert abs(np.ptp(ink[:, 0]) - length) <= 0.0005, np.ptp(ink[:, 0])
+        assert abs(np.ptp(ink[:, 1]) - 0.040) <= 0.0005, np.ptp(ink[:, 1])
+        precision = shown_precision(page, session)
+        assert precision["symbol"] == "sine" and precision["closure_gap_mm"] is None
+        assert precision["rms_error_mm"] < 0.5
+        assert page.locator('[data-key="what"]').text_content() == "a sine wave, 4 cm, speed 4 (25 mm/s)"
+    finally:
+        page.close()
+
+
+def test_an_x_of_5_cm_at_speed_5_is_two_5_cm_diagonals_on_the_whiteboard(
+        browser: Any, operate_cockpit: Cockpit) -> None:
+    session = operate_cockpit.session
+    page = browser.new_page(viewport={"width": 1500, "height": 1000})
+    try:
+        open_operate(page, operate_cockpit)
+        strokes = draw_from_page(page, session, "X", "5", "5")
+        assert text_of(page, "reply") == "Trigger: an X, 5 cm side, speed 5 (30 mm/s)"
+        assert len(strokes) == 2  # two lines, the pen lifted between
+        for line, slope in zip(strokes, (1.0, -1.0), strict=True):
+            # each a straight line at 45 degrees spanning the X's side along X and along Y
+            assert abs(np.ptp(line[:, 0]) - 0.050) <= 0.0005 and abs(np.ptp(line[:, 1]) - 0.050) <= 0.0005
+            fit = np.polyfit(line[:, 0], line[:, 1], 1)
+            assert abs(fit[0] - slope) < 0.02, fit
+        both = np.vstack(strokes)
+        assert abs(np.ptp(both[:, 0]) - 0.050) <= 0.0005 and abs(np.ptp(both[:, 1]) - 0.050) <= 0.0005
+        # the two lines cross in their middles: the X's centre
+        middles = [line.mean(axis=0) for line in strokes]
+        assert np.hypot(*(middles[0] - middles[1])) < 0.001
+        precision = shown_precision(page, session)
+        assert precision["symbol"] == "X" and precision["rms_error_mm"] < 0.5
+        assert page.locator('[data-key="what"]').text_content() == "an X, 5 cm, speed 5 (30 mm/s)"
+    finally:
         page.close()
 
 

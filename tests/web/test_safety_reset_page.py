@@ -26,7 +26,7 @@ from ttt_sm.params import load_params
 from ttt_sm.twin.sim import ArmSim
 from ttt_sm.web.session import Session
 
-from .conftest import Cockpit, serve, text_of
+from .conftest import Cockpit, served, text_of
 
 SHOT = "gui_safety.png"
 #: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
@@ -41,12 +41,8 @@ def faulty(tmp_path: Path) -> Iterator[tuple[Cockpit, FaultyArm]]:
     arm = FaultyArm(sim)
     dbg = Debugger.build(params, seed=0, arm=arm, truth=sim.truth)
     session = Session(dbg, speed=None, running=False, trace_path=tmp_path / "trace.jsonl")
-    server, thread, url = serve(session)
-    try:
-        yield Cockpit(url, session, server), arm
-    finally:
-        server.should_exit = True
-        thread.join(30)
+    with served(session) as cockpit:
+        yield cockpit, arm
 
 
 def run_to_pen_down(page: Any, session: Session, run: str = "Run") -> None:

@@ -15,7 +15,9 @@ frame photographed after the last change.  Between readings the camera waits:
 a frame photographed while the game thread takes the board back would only
 cost it time.  So the reader's silence watchdog runs only while a reading
 waits for its frame: a link idle while the person thinks is not a camera
-that stopped.
+that stopped.  A camera silent for ``silence_s`` while a reading waits is
+:class:`CameraLost` at once (the game's Safety chart lifts the pen and
+holds, docs/safety.md), not a reading that waits on.
 """
 
 from __future__ import annotations
@@ -36,6 +38,10 @@ from ..vision.simulated import SimulatedCamera
 
 #: A reading asks the camera for another photo when none arrived for this long, s.
 REASK_S = 0.5
+
+
+class CameraLost(RuntimeError):
+    """The camera sent no valid frame for the link's ``silence_s`` while a reading waited for a photo."""
 
 
 class CameraLink:
@@ -61,6 +67,7 @@ class CameraLink:
         self._emulator: Any = None
         self._reader: Any = None
         self._tmp: tempfile.TemporaryDirectory[str] | None = None
+        self.silence_s = silence_s
         if mode == "serial":
             self._start_serial(rate_hz, silence_s)
 
@@ -92,6 +99,11 @@ class CameraLink:
         self._reader.expect_frames(False)  # the camera sends only when a reading asks
 
     @property
+    def emulator(self) -> Any:
+        """The camera's emulator on its pseudo-terminal (serial mode; None in direct): its faults are injected here."""
+        return self._emulator
+
+    @property
     def port(self) -> str | None:
         """The serial port the camera is read from (None in direct mode)."""
         return self._emulator.port if self._emulator is not None else None
@@ -121,6 +133,9 @@ class CameraLink:
                 left = deadline - time.monotonic()
                 frame = self._reader.read_frame(max(0.0, min(left, REASK_S)))
                 if frame is None:
+                    if self._reader.silent:  # its watchdog: silence while this reading waited for a photo
+                        raise CameraLost(f"the camera sent no frame for {self.silence_s:g} s while a photo was"
+                                         f" asked ({self._reader.port_name})")
                     if left <= REASK_S:
                         raise TimeoutError("the camera sent no fresh frame for 10 s")
                     self._wanted.set()  # the photo may have been lost on the line: ask again

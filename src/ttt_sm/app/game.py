@@ -44,7 +44,7 @@ from ..sched.scheduler import Signals
 from ..twin.board_picture import save_board_picture
 from ..twin.truth import GroundTruth
 from ..vision import MoveError, percent_process
-from .camera_link import CameraLink
+from .camera_link import CameraLink, CameraLost
 from .game_record import GameRecord, params_digest
 from .robot import Robot
 from .wires import GAME_WIRES
@@ -59,6 +59,9 @@ PERSON_WAIT_S = 24 * 3600.0
 #: Longest a game may run, in simulated seconds, unless told otherwise: a whole game of 25 moves
 #: takes about 450 s (a usual one about 190 s), so only a game that is stuck reaches it.
 DEFAULT_TIME_LIMIT_S = 1200.0
+#: Longest the game waits, once the camera is lost, for the Safety chart to lift the pen and hold, s of simulated
+#: time (its lift gives up after 2 s).
+CAMERA_LIFT_S = 3.0
 
 #: The strengths of the simulated person (``ttt-sm play --person``).
 PERSON_STRENGTHS = ("random", "greedy", "thesis", "perfect")
@@ -587,10 +590,30 @@ class GameSession:
         self.board = self.board[:i] + symbol + self.board[i + 1:]
 
     def _look(self) -> tuple[tuple[float, ...], str | None]:
-        view = self.camera.read()
+        try:
+            view = self.camera.read()
+        except CameraLost as exc:
+            raise self._camera_lost(exc) from None
+        self.robot.camera_status.ok = True  # the Camera block: it answers
         self.last_view = view
         self.photos += 1
         return view
+
+    def _camera_lost(self, exc: CameraLost) -> GameError:
+        """The camera stopped answering while the game waited for a photo: the Safety chart's Camera block.
+
+        The Safety chart lifts the pen off the board and holds (docs/safety.md).
+        Played by :meth:`play`, the chart steps are this thread's: they run
+        until the chart holds (at most :data:`CAMERA_LIFT_S`), and the game
+        ends with the chart's reason; driven from the chart steps (the GUI), the
+        game ends now and the chart lifts in the steps that follow.
+        """
+        robot = self.robot
+        robot.camera_status.ok = False
+        self._event("camera_lost", message=str(exc))
+        if self.driver is None:
+            robot.run_until(lambda: bool({"hold", "stopped"} & robot.active("Safety")), CAMERA_LIFT_S)
+        return GameError(f"safety stop: {robot.safety.reason}" if robot.tripped else f"camera lost: {exc}")
 
     # -- a person at a GUI (RemotePerson): their clicks, checked against where the game stands --
 

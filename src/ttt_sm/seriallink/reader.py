@@ -210,6 +210,12 @@ class SerialCameraReader:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
+    @property
+    def silent(self) -> bool:
+        """The silence watchdog fired: no valid frame for ``silence_s`` while frames were expected (until the
+        next valid frame)."""
+        return self._silent
+
     def expect_frames(self, expected: bool) -> None:
         """Say whether frames should be arriving now: the silence watchdog only runs while they should.
 

@@ -26,6 +26,9 @@ from typing import Any
 
 import pytest
 
+from ttt_sm import cli
+from ttt_sm.cli import commands
+from ttt_sm.cli.common import Interrupted
 from ttt_sm.runtime.listeners import Trace
 from ttt_sm.runtime.recordfile import ENDINGS, RecordFile, read_lines
 
@@ -232,3 +235,33 @@ def test_unwritable_record_paths_are_refused_before_the_run(tmp_path: Path) -> N
         assert proc.returncode == 2, (cmd, proc.stderr)
         lines = proc.stderr.strip().splitlines()
         assert len(lines) == 1 and "error" in lines[0] and ("--trace" in lines[0] or "--out" in lines[0]), lines
+
+
+def _import_broken_by(signal_name: str) -> None:
+    """What CPython raises when a signal lands while a C extension initialises: the import fails,
+    the interruption only its context (seen once: SIGINT during matplotlib's first import)."""
+    interrupt = KeyboardInterrupt() if signal_name == "SIGINT" else Interrupted(signal_name)
+    try:
+        raise interrupt
+    except KeyboardInterrupt:
+        raise ImportError("initialization failed")  # noqa: B904  (as CPython leaves it: the context only)
+
+
+@pytest.mark.parametrize("signal_name", ["SIGINT", "SIGTERM"])
+def test_a_signal_inside_an_import_ends_the_record_and_the_command_as_interrupted(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], signal_name: str) -> None:
+    path = tmp_path / "r.jsonl"
+    with pytest.raises(ImportError), RecordFile(path) as record:
+        record.add({"event": "head"})
+        _import_broken_by(signal_name)
+    assert read_lines(path)[-1] == {"event": "interrupted", "signal": signal_name}
+
+    def broken(args: Any) -> int:
+        _import_broken_by(signal_name)
+        return 0
+
+    monkeypatch.setattr(commands, "cmd_params", broken)
+    status = cli.main(["params"])
+    err = capsys.readouterr().err
+    assert status == 128 + (signal.SIGINT if signal_name == "SIGINT" else signal.SIGTERM)
+    assert err.strip() == "ttt-sm params: interrupted" + ("" if signal_name == "SIGINT" else f" ({signal_name})")

@@ -40,6 +40,7 @@ from ..game.rules import is_full, parse_board, winner
 from ..params import ArmParams
 from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
+from ..runtime.recordfile import interruption
 from ..sched.scheduler import Signals
 from ..twin.board_picture import save_board_picture
 from ..twin.truth import GroundTruth
@@ -707,8 +708,12 @@ class GameSession:
             self._end("interrupted", signal="SIGINT", boundary=False)
             raise
         except Exception as exc:
-            self._end("error", message=str(exc) if isinstance(exc, GameError) else f"{type(exc).__name__}: {exc}",
-                      boundary=isinstance(exc, GameError))
+            interrupt = interruption(exc)  # the signal landed in a C extension's import, say
+            if interrupt is not None:
+                self._end("interrupted", signal=str(getattr(interrupt, "signal", "SIGINT")), boundary=False)
+            else:
+                self._end("error", message=str(exc) if isinstance(exc, GameError)
+                          else f"{type(exc).__name__}: {exc}", boundary=isinstance(exc, GameError))
             raise
         finally:
             gc.unfreeze()

@@ -34,6 +34,7 @@ import sys
 from collections.abc import Sequence
 
 from ..params import shown_path
+from ..runtime.recordfile import interruption
 from . import ai, arm, camera, commands, debug, docs, gui, scenario, vision
 from .common import join_negative_values, terminate_interrupts
 
@@ -108,6 +109,13 @@ def _ignore_late_signals() -> None:
         pass
 
 
+def _interrupted(command: str, exc: KeyboardInterrupt) -> int:
+    """Ctrl-C or SIGTERM stopped `command`: one line, and the status a shell expects (130, 143)."""
+    name = str(getattr(exc, "signal", "SIGINT"))
+    print(f"ttt-sm {command}: interrupted" + (f" ({name})" if name != "SIGINT" else ""), file=sys.stderr)
+    return 128 + (signal.SIGTERM if name == "SIGTERM" else signal.SIGINT)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `ttt-sm` console script: run the subcommand, turn every error into one line."""
     command = "?"
@@ -127,10 +135,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         _quiet_stdout()
         return 141  # as if killed by SIGPIPE (128 + 13), what `head` expects of a writer
     except KeyboardInterrupt as exc:
-        name = str(getattr(exc, "signal", "SIGINT"))
-        print(f"ttt-sm {command}: interrupted" + (f" ({name})" if name != "SIGINT" else ""), file=sys.stderr)
-        return 128 + (signal.SIGTERM if name == "SIGTERM" else signal.SIGINT)
+        return _interrupted(command, exc)
     except Exception as exc:
+        interrupt = interruption(exc)  # e.g. the signal landed in a C extension's import
+        if interrupt is not None:
+            return _interrupted(command, interrupt)
         if os.environ.get("TTT_SM_TRACEBACK"):
             raise
         line, status = error_line(command, exc)

@@ -96,15 +96,35 @@ class RecordFile:
             self.end(how, **data)
 
 
+def interruption(exc: BaseException) -> KeyboardInterrupt | None:
+    """The Ctrl-C or SIGTERM behind `exc`: `exc` itself, or one it was raised while handling; else None.
+
+    A signal that lands while a C extension initialises (numpy, OpenCV and
+    matplotlib are imported when first needed) comes out of the import as
+    ``ImportError: initialization failed``, the interruption only its context:
+    the run was still interrupted, not broken.
+    """
+    seen: set[int] = set()
+    link: BaseException | None = exc
+    while link is not None and id(link) not in seen:
+        if isinstance(link, KeyboardInterrupt):
+            return link
+        seen.add(id(link))
+        link = link.__cause__ or link.__context__
+    return None
+
+
 def ending_of(exc: BaseException) -> tuple[str, dict[str, Any]]:
     """How an exception ends a record: ``("interrupted", {"signal": ...})`` or ``("error", {"message": ...})``.
 
-    A :class:`KeyboardInterrupt` is an interruption; its ``signal``
+    A :class:`KeyboardInterrupt` is an interruption (also as the context of
+    another exception: :func:`interruption`); its ``signal``
     attribute (``"SIGTERM"``, set by the command line's handler) names the
     signal, else it was Ctrl-C (``"SIGINT"``).
     """
-    if isinstance(exc, KeyboardInterrupt):
-        return "interrupted", {"signal": str(getattr(exc, "signal", "SIGINT"))}
+    interrupt = interruption(exc)
+    if interrupt is not None:
+        return "interrupted", {"signal": str(getattr(interrupt, "signal", "SIGINT"))}
     text = " ".join(str(exc).split())[:300]
     return "error", {"message": f"{type(exc).__name__}: {text}" if text else type(exc).__name__}
 

@@ -613,7 +613,8 @@ class GameSession:
         robot.camera_status.ok = False
         self._event("camera_lost", message=str(exc))
         if self.driver is None:
-            robot.run_until(lambda: bool({"hold", "stopped"} & robot.active("Safety")), CAMERA_LIFT_S)
+            # held or stopped: tripped, and no lift under way (the chart's outputs, not its state names)
+            robot.run_until(lambda: robot.tripped and math.isnan(robot.safety.lift_z), CAMERA_LIFT_S)
         return GameError(f"safety stop: {robot.safety.reason}" if robot.tripped else f"camera lost: {exc}")
 
     # -- a person at a GUI (RemotePerson): their clicks, checked against where the game stands --

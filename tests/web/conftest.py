@@ -38,6 +38,13 @@ class Cockpit:
         return self.url + path
 
 
+def open_page(page: Any, cockpit: Cockpit, path: str = "/charts", timeout_ms: int = 30_000) -> None:
+    """Open one of the cockpit's pages and wait until its socket is connected (the mode no longer 'connecting')."""
+    page.goto(cockpit.page_url(path))
+    page.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'",
+                           timeout=timeout_ms)
+
+
 def text_of(page: Any, role: str) -> str:
     """The text of the page's element ``data-role=role``, trimmed."""
     return str(page.locator(f'[data-role="{role}"]').text_content()).strip()

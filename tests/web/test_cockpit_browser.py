@@ -18,16 +18,15 @@ from ttt_sm.params import load_params
 from ttt_sm.scenario.loader import load_scenario
 from ttt_sm.scenario.suite import coverage_dict, run_scenarios
 
-from .conftest import SCENARIOS, Cockpit
+from .conftest import SCENARIOS, Cockpit, open_page
 
 TIMEOUT_MS = 60_000
 
 
 def open_cockpit(page: Any, cockpit: Cockpit) -> None:
     page.set_default_timeout(TIMEOUT_MS)
-    page.goto(cockpit.page_url("/charts"))
+    open_page(page, cockpit, "/charts", timeout_ms=TIMEOUT_MS)
     page.wait_for_selector("[data-state]")
-    page.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'")
 
 
 def show(page: Any, chart: str) -> None:

@@ -28,7 +28,7 @@ from ttt_sm.params import load_params
 from ttt_sm.web.operate import MSG_DRAWING, MSG_INITIALISING, MSG_READY, MSG_TURNING_OFF, SAMPLE_PERIOD_S
 from ttt_sm.web.session import Session
 
-from .conftest import Cockpit, served, text_of
+from .conftest import Cockpit, open_page, served, text_of
 
 SHOT = "gui_operate.png"
 #: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
@@ -51,9 +51,7 @@ def wait_status(page: Any, text: str, timeout: int = LONG) -> None:
 
 
 def open_operate(page: Any, cockpit: Cockpit) -> None:
-    page.goto(cockpit.page_url("/operate"))
-    page.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'",
-                           timeout=30_000)
+    open_page(page, cockpit, "/operate")
 
 
 def trigger(page: Any) -> Any:
@@ -125,9 +123,7 @@ def test_an_o_of_6_cm_at_speed_3_is_a_circle_of_60_mm_on_the_whiteboard(
         box.fill("6")
         page.get_by_role("spinbutton", name="Speed (0 to 5)", exact=True).fill("3")
         assert text_of(page, "speed-mm-s") == "20.0 mm/s"
-        charts.goto(operate_cockpit.page_url("/charts"))
-        charts.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'",
-                                 timeout=30_000)
+        open_page(charts, operate_cockpit, "/charts")
         strokes_before, t0 = session.call(lambda d: (len(d.robot.board.strokes), d.robot.t))
         trigger(page).click()
         # the same session in the chart cockpit: Trigger's inputs and event, within a frame

@@ -26,7 +26,7 @@ from ttt_sm.params import load_params
 from ttt_sm.twin.sim import ArmSim
 from ttt_sm.web.session import Session
 
-from .conftest import Cockpit, served, text_of
+from .conftest import Cockpit, open_page, served, text_of
 
 SHOT = "gui_safety.png"
 #: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
@@ -70,9 +70,7 @@ def test_a_blocked_drive_trips_the_safety_chart_the_cockpit_says_why_and_reset_r
     session = cockpit.session
     page = browser.new_page(viewport={"width": 1400, "height": 900})
     try:
-        page.goto(cockpit.page_url("/charts"))
-        page.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'",
-                               timeout=30_000)
+        open_page(page, cockpit, "/charts")
         reset = page.get_by_role("button", name="Reset", exact=True)
         page.wait_for_function("document.querySelector('[data-role=safety-state]').dataset.state === 'monitoring'",
                                timeout=30_000)
@@ -147,9 +145,7 @@ def test_operate_refuses_trigger_while_the_safety_chart_holds_the_arm_and_resets
     session = cockpit.session
     page = browser.new_page(viewport={"width": 1400, "height": 900})
     try:
-        page.goto(cockpit.page_url("/operate"))
-        page.wait_for_function("document.querySelector('[data-role=mode]').textContent !== 'connecting'",
-                               timeout=30_000)
+        open_page(page, cockpit, "/operate")
         run_to_pen_down(page, session, "Run_simulation")
         session.call(lambda d: arm.inject("motor_blocked", 1))
         page.get_by_role("button", name="Run_simulation", exact=True).click()

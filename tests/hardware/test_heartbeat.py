@@ -42,7 +42,9 @@ def emulator(tmp_path, firmware_libs):
 
 
 def test_an_idle_pc_sends_heartbeats_and_the_firmware_answers_each(emulator):
-    arm = SerialArm(emulator.port, P, servo_angle=REST_POSE[3])
+    # what is asserted is the heartbeat, not the 50 ms limit (the next test's): a machine loaded by other
+    # work can stall a process past 50 ms, so the limit here is one no stall reaches
+    arm = SerialArm(emulator.port, P, servo_angle=REST_POSE[3], link_timeout_s=5.0)
     try:
         arm.step(2)
         frames = emulator.firmware.frames_ok

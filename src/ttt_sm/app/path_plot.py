@@ -228,10 +228,15 @@ def _touching(d: PathData) -> np.ndarray:
 
 
 def _state_colours(labels: list[str]) -> dict[str, tuple[float, float, float, float]]:
-    """One colour per state, in order of first appearance: ten distinct hues, then their light tints."""
+    """One colour per state, in order of first appearance: eight distinct hues, then their light tints.
+
+    Blue (C0) and orange (C1) are left out: they are the lines drawn over the states' shading
+    (``TRUE_INK``, ``ENCODERS``), which would vanish on a state of their own colour.
+    """
     from matplotlib import colormaps
 
-    palette = [colormaps["tab10"](i) for i in range(10)] + [colormaps["tab20"](2 * i + 1) for i in range(10)]
+    hues = (2, 3, 4, 5, 6, 7, 8, 9)  # tab10 without C0 and C1
+    palette = [colormaps["tab10"](i) for i in hues] + [colormaps["tab20"](2 * i + 1) for i in hues]
     order = list(dict.fromkeys(labels))
     return {label: palette[i % len(palette)] for i, label in enumerate(order)}
 

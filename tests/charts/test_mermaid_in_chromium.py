@@ -102,7 +102,7 @@ def test_every_guard_and_event_is_drawn(chart, rendered):
     for t in structure_of(chart).transitions:
         # a transition that leaves no state is listed in its state's box, not drawn as an edge
         texts = edge_text if t.target is not None else box_text
-        wanted = [f"[{' && '.join(t.guards)}]"] if t.guards else []
+        wanted = [f"[{' and '.join(t.guards)}]"] if t.guards else []
         wanted += list(t.events)
         for piece in wanted:
             if not any(piece in text for text in texts):

@@ -75,7 +75,7 @@ def edge_text(t: TransitionInfo, structure: ChartStructure) -> tuple[str, str]:
         trigger = " ".join(t.events)
     elif len(structure.tick_by_state[t.source]) > 1:
         trigger = f"{t.priority}:"
-    guard = f"[{' && '.join(t.guards)}]" if t.guards else ""
+    guard = f"[{' and '.join(t.guards)}]" if t.guards else ""
     first = " ".join(p for p in (trigger, guard) if p)
     action = f"/ {', '.join(t.actions)}" if t.actions else ""
     return first, action
@@ -245,7 +245,7 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
     for t in structure.transitions:
         target = f"`{t.target}`" if t.target else "(none)"
         out.append(f"| `{t.source}` | {target} | {_cell(t.trigger)} |"
-                   f" {t.priority or '—'} | {_cell(' && '.join(t.guards))} | {_cell(', '.join(t.actions))} |")
+                   f" {t.priority or '—'} | {_cell(' and '.join(t.guards))} | {_cell(', '.join(t.actions))} |")
     conflicts = priority_conflicts(structure)
     if conflicts:
         out += ["", "## Priority notes", ""] + [f"- {c}" for c in conflicts]

@@ -219,7 +219,7 @@ def build_structure(cls: type[StateChart]) -> ChartStructure:
             kind: Literal["tick", "event"] = "tick" if tick_event else "event"
             target = t.target.id if t.target is not None else None
             trigger = TICK_EVENT_NAME if kind == "tick" else " ".join(events)
-            guard_text = f" [{' && '.join(guards)}]" if guards else ""
+            guard_text = f" [{' and '.join(guards)}]" if guards else ""
             label = f"{state.id} -> {target or '(none)'}: {trigger}{guard_text}"
             labels[label] = labels.get(label, 0) + 1
             if labels[label] > 1:

@@ -64,6 +64,10 @@ class ControlStage:
         self._inputs = vars(chart)  # plain attribute writes: this runs every chart step
         g = params.geometry
         self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
+        # the last forward kinematics, (q1, q2, q3, servo) -> (x, y, z): an arm that stands still (waiting
+        # for the person, holding a pose) reads the same encoder angles chart step after chart step
+        self._fk_in: tuple[float, float, float, float] = (math.nan,) * 4
+        self._fk_out: tuple[float, float, float] = (math.nan,) * 3
         self._feed: Callable[[float, float, float], None] = not_wired
         self._outputs: Callable[[], tuple[float, float, float, float, bool, bool]] = not_wired  # type: ignore
 
@@ -88,7 +92,12 @@ class ControlStage:
             # no setpoint yet (the first chart step): the servo has no sensor, so
             # its pose is the angle it was last commanded
             servo = arm.servo_setpoint
-        x, y, z, _, _, _, _, _ = arm_chain_py(q1, q2, q3, servo, *self._geometry)
+        fk_in = (q1, q2, q3, servo)
+        if fk_in == self._fk_in:
+            x, y, z = self._fk_out
+        else:
+            x, y, z, _, _, _, _, _ = arm_chain_py(q1, q2, q3, servo, *self._geometry)
+            self._fk_in, self._fk_out = fk_in, (x, y, z)
         self._feed(x, y, z)
         if self.overrides:
             self._inputs.update(self.overrides)

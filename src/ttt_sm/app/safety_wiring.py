@@ -162,6 +162,10 @@ class SafetyStage:
         self.overrides: dict[str, object] = {}
         self._feed: Callable[..., None] = not_wired
         self._outputs: Callable[[], Any] = not_wired
+        self._quiet: Callable[[], tuple[bool, bool, bool]] = not_wired  # type: ignore[assignment]
+        # read every chart step: bound once (an arm without a link has no link_ok: its link is always up)
+        self._offset_estimates = arm.offset_estimates
+        self._has_link = hasattr(arm, "link_ok")
 
     def commanded_speed(self) -> list[float]:
         """Each drive's commanded speed, rad/s: the rate of the model of its setpoint filter."""
@@ -187,22 +191,34 @@ class SafetyStage:
         self._feed = wiring.feed([self.chart.chart_name], args=("Monitor", "FK"), flat=True)
         self._outputs = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.lift_z",
                                        "SafeState.bridge_off", "SafeState.reinit")
+        # whether there is anything to carry out: the three outputs that say so (every chart step)
+        self._quiet = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.reinit")
 
     def tick(self, signals: Signals) -> None:
         """Monitor in (one compiled call on the sensors this chart step read), chart ticked, the safe state out."""
         arm = self.arm
         sensors = signals.sensors
         assert sensors is not None
-        self.link_ok = bool(getattr(arm, "link_ok", True))
+        if self._has_link:
+            self.link_ok = bool(arm.link_ok)  # type: ignore[attr-defined]
         c1, c2, c3 = sensors.counts
         i1, i2, i3 = sensors.current_a
-        o1, o2, o3 = arm.offset_estimates()
+        o1, o2, o3 = self._offset_estimates()
         servo = arm.servo_setpoint
         self._out = out = _monitor.monitor(self._m, c1, c2, c3, i1, i2, i3, o1, o2, o3, servo)
         self._feed(out)
         if self.overrides:
             vars(self.chart).update(self.overrides)
         self.chart.tick()
+        tripped, hold, reinit = self._quiet()
+        if tripped or hold or reinit or self._tripped or self._reinit or self._pose is not None:
+            self._carry_out(signals, servo)  # a trip, a hold, a reset, or the end of one
+        q = signals.q_set
+        _monitor.advance(self._m, float(q[0]), float(q[1]), float(q[2]), bool(signals.fr_sw))
+
+    def _carry_out(self, signals: Signals, servo: float) -> None:
+        """What the chart's outputs ask for this chart step: tell a trip, restart, hold or lift the pose."""
+        arm, out = self.arm, self._out
         tripped, hold, lift_z, off, reinit = self._outputs()
         if tripped and not self._tripped:
             self._tell("safety_trip", reason=self.chart.reason, drive=self.chart.fault_drive, **self._link_detail())
@@ -236,8 +252,6 @@ class SafetyStage:
             self._pose = None
             self._lift_for = math.nan
             self._lift_to = None
-        q = signals.q_set
-        _monitor.advance(self._m, float(q[0]), float(q[1]), float(q[2]), bool(signals.fr_sw))
 
     def _link_detail(self) -> dict[str, str]:
         """A lost link's own words (the arm backend's ``link_fault``), for the trip's record."""

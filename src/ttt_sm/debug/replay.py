@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Protocol
@@ -184,7 +184,7 @@ def fingerprint(robot: Robot, forced: Mapping[tuple[str, str], Any] = MappingPro
                         "pending": c.pending_events}
     twin = {name: getattr(sim, name).tolist() for name in TWIN_FIELDS}
     twin.update({f"truth.{name}": getattr(sim.truth, name).tolist() for name in TRUTH_FIELDS})
-    twin["sensors"] = asdict(sim.sensors())
+    twin["sensors"] = sim.sensors()._asdict()
     out = {"steps": robot.steps, "chart_ticks": robot.chart_ticks, "t": sim.t, "charts": charts,
            "forced": sorted(forced.items()), "twin": twin}
     game = game_of(robot)

@@ -29,7 +29,7 @@ _KEY_TYPES = (str, int, float, bool, type(None))
 def jsonable(value: Any) -> Any:
     """A copy of ``value`` that :func:`json.dumps` writes as strict JSON.
 
-    Dataclass instances become dicts, numpy arrays and scalars lists and
+    Dataclass instances and named tuples become dicts, numpy arrays and scalars lists and
     numbers (anything with ``tolist``), paths strings, tuples lists; NaN and
     ±infinity become ``None`` (``null``).  Anything else becomes its
     ``repr``, so a chart's data of any type can be traced.
@@ -40,6 +40,8 @@ def jsonable(value: Any) -> Any:
         return float(value) if math.isfinite(value) else None
     if isinstance(value, Mapping):
         return {(k if isinstance(k, _KEY_TYPES) else str(k)): jsonable(v) for k, v in value.items()}
+    if isinstance(value, tuple) and hasattr(value, "_asdict"):  # a named tuple (the arm's Sensors)
+        return jsonable(value._asdict())
     if isinstance(value, (list, tuple)):
         return [jsonable(v) for v in value]
     if dataclasses.is_dataclass(value) and not isinstance(value, type):

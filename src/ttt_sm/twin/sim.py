@@ -116,6 +116,7 @@ class ArmSim:
         # the call a delegating method would add (the method below documents it)
         self.set_setpoints = self.controller.set_setpoints  # type: ignore[method-assign]
         self.sensors = self.plant.sensors  # type: ignore[method-assign]  # the Safety chart reads them every chart step
+        self.offset_estimates = self.controller.offset_estimates  # type: ignore[method-assign]  # so does its Monitor
         # Load the compiled loop now (from numba's disk cache: ~0.3 s the first time in a
         # process), not in the first control step: zero steps change nothing.
         K.run_steps(0, self._cf, self._cm, self._pf, self._pi, self._no_rec)

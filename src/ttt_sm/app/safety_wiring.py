@@ -212,13 +212,20 @@ class SafetyStage:
         self.chart.tick()
         tripped, hold, reinit = self._quiet()
         if tripped or hold or reinit or self._tripped or self._reinit or self._pose is not None:
-            self._carry_out(signals, servo)  # a trip, a hold, a reset, or the end of one
+            # a trip, a hold, a reset, or the end of one
+            q_safe = self._carry_out(servo)
+            if q_safe is not None:
+                signals.q_set = q_safe
         q = signals.q_set
         _monitor.advance(self._m, float(q[0]), float(q[1]), float(q[2]), bool(signals.fr_sw))
 
-    def _carry_out(self, signals: Signals, servo: float) -> None:
-        """What the chart's outputs ask for this chart step: tell a trip, restart, hold or lift the pose."""
+    def _carry_out(self, servo: float) -> list[float] | None:
+        """What the chart's outputs ask for this chart step: tell a trip, restart, hold or lift the pose.
+
+        Returns the setpoints to send instead of this chart step's, or None.
+        """
         arm, out = self.arm, self._out
+        q_safe: list[float] | None = None
         tripped, hold, lift_z, off, reinit = self._outputs()
         if tripped and not self._tripped:
             self._tell("safety_trip", reason=self.chart.reason, drive=self.chart.fault_drive, **self._link_detail())
@@ -226,7 +233,7 @@ class SafetyStage:
         if reinit and not self._reinit:
             self._restart()
             # this step's setpoints were made in the old coordinates: hold where the drives stand instead
-            signals.q_set = [*arm.encoder_angles(), servo]
+            q_safe = [*arm.encoder_angles(), servo]
         self._reinit = bool(reinit)
         if hold:
             if self._pose is None:
@@ -247,11 +254,12 @@ class SafetyStage:
             for k in range(3):
                 if off[k] and enabled[k]:
                     arm.set_enabled(k + 1, False)
-            signals.q_set = list(self._pose)
+            q_safe = list(self._pose)
         else:
             self._pose = None
             self._lift_for = math.nan
             self._lift_to = None
+        return q_safe
 
     def _link_detail(self) -> dict[str, str]:
         """A lost link's own words (the arm backend's ``link_fault``), for the trip's record."""

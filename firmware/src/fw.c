@@ -82,7 +82,7 @@ static void send_heartbeat_reply(ttt_fw *fw, uint32_t token)
 
 static void send_status(ttt_fw *fw)
 {
-    uint8_t b[43];
+    uint8_t b[45];
     const ttt_sensors *s = &fw->sensors;
     int d;
     uint8_t modes = 0;
@@ -99,6 +99,7 @@ static void send_status(ttt_fw *fw)
         ttt_put_u16(b + 31 + 2 * d, s->index_edges[d]);
         ttt_put_u16(b + 37 + 2 * d, (uint16_t)(int16_t)i);
     }
+    ttt_put_u16(b + 43, s->servo_adc); /* raw counts: the PC holds the calibration (docs/hardware.md) */
     send(fw, TTT_MSG_STATUS, b, sizeof b);
 }
 

@@ -68,7 +68,7 @@ int ttt_body_length(uint8_t type)
     case TTT_MSG_START: return 0;
     case TTT_MSG_HANDSHAKE: return 70;
     case TTT_MSG_GAINS_READBACK: return -2;
-    case TTT_MSG_STATUS: return 43;
+    case TTT_MSG_STATUS: return 45;
     case TTT_MSG_HEARTBEAT_REPLY: return 16 + 4 * TTT_N_REJ;
     default: return -1;
     }

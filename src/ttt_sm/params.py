@@ -102,6 +102,27 @@ class Servo:
     rate_rad_s: float
     time_constant_s: float
     clearance_rad: float
+    feedback_bits: int
+    feedback_cal_a_rad: float
+    feedback_cal_a_counts: float
+    feedback_cal_b_rad: float
+    feedback_cal_b_counts: float
+    feedback_noise_lsb: float
+    feedback_tau_s: float
+
+    @property
+    def feedback_counts_per_rad(self) -> float:
+        """ADC counts per radian of the feedback potentiometer (the two-point calibration's slope)."""
+        return (self.feedback_cal_b_counts - self.feedback_cal_a_counts) / (self.feedback_cal_b_rad
+                                                                            - self.feedback_cal_a_rad)
+
+    def feedback_angle(self, counts: float) -> float:
+        """The servo angle (rad) an ADC reading of the feedback wire means, by the two-point calibration."""
+        return self.feedback_cal_a_rad + (counts - self.feedback_cal_a_counts) / self.feedback_counts_per_rad
+
+    def feedback_counts(self, angle_rad: float) -> float:
+        """The ADC reading (counts, not rounded) of the feedback wire at `angle_rad`, by the calibration."""
+        return self.feedback_cal_a_counts + (angle_rad - self.feedback_cal_a_rad) * self.feedback_counts_per_rad
 
     def duty_for_angle(self, angle_rad: float) -> float:
         """PWM duty (0..1) that commands `angle_rad` (clipped to the range)."""
@@ -177,6 +198,8 @@ class SafetyParams:
     limit_margin_rad: float
     lift_height_m: float
     lift_speed_m_s: float
+    max_servo_error_rad: float
+    servo_error_s: float
 
 
 @dataclass(frozen=True)
@@ -262,6 +285,10 @@ LIMITS: dict[str, tuple[float, float]] = {
     "servo.pulse_min_s": (1e-5, 0.1), "servo.pulse_max_s": (1e-5, 0.1), "servo.period_s": (1e-3, 0.1),
     "servo.rate_rad_s": (math.radians(1.0), math.radians(6000.0)), "servo.time_constant_s": (1e-4, 1.0),
     "servo.clearance_rad": (0.0, math.radians(5.0)),
+    "servo.feedback_bits": (8, 16), "servo.feedback_cal_a_rad": (-2 * math.pi, 2 * math.pi),
+    "servo.feedback_cal_b_rad": (-2 * math.pi, 2 * math.pi), "servo.feedback_cal_a_counts": (0.0, 65535.0),
+    "servo.feedback_cal_b_counts": (0.0, 65535.0), "servo.feedback_noise_lsb": (0.0, 100.0),
+    "servo.feedback_tau_s": (0.0, 1.0),
     "masses.link2_kg": (0.0, 50.0), "masses.link2_com": (0.0, 2.0), "masses.link3_kg": (0.0, 50.0),
     "masses.link3_com": (0.0, 2.0), "masses.tool_kg": (0.0, 50.0),
     "control.rate_hz": (100.0, 20_000.0), "control.chart_divider": (1, 100),
@@ -275,7 +302,8 @@ LIMITS: dict[str, tuple[float, float]] = {
     "safety.max_speed_rad_s": (0.1, 1000.0), "safety.moving_speed_rad_s": (1e-4, 10.0),
     "safety.stall_ratio": (0.0, 1.0),
     "safety.silent_s": (1e-3, 1.0), "safety.limit_margin_rad": (0.0, 0.5), "safety.lift_height_m": (0.0, 0.1),
-    "safety.lift_speed_m_s": (0.001, 1.0),
+    "safety.lift_speed_m_s": (0.001, 1.0), "safety.max_servo_error_rad": (1e-4, 1.0),
+    "safety.servo_error_s": (1e-3, 1.0),
     "drive.supply_v": (0.1, 100.0), "drive.resistance_ohm": (1e-3, 1e3), "drive.inductance_h": (1e-7, 1.0),
     "drive.torque_constant": (1e-4, 10.0), "drive.rotor_inertia": (1e-9, 1.0), "drive.motor_viscous": (0.0, 1.0),
     "drive.motor_coulomb": (0.0, 10.0), "drive.gear_ratio": (1.0, 10_000.0), "drive.load_inertia": (1e-6, 100.0),
@@ -394,6 +422,14 @@ def _check(params: ArmParams, where: _Where) -> None:
     if not s.pulse_min_s < s.pulse_max_s <= s.period_s:
         raise ParameterError(f"{where.at('servo', 'pulse_max_s')}: [servo] needs pulse_min_s < pulse_max_s <="
                              f" period_s, got {s.pulse_min_s:g} s, {s.pulse_max_s:g} s, {s.period_s:g} s")
+    full = 2 ** s.feedback_bits - 1
+    for key in ("feedback_cal_a_counts", "feedback_cal_b_counts"):
+        if getattr(s, key) > full:
+            raise ParameterError(f"{where.at('servo', key)}: [servo] {key} = {getattr(s, key):g} is beyond a"
+                                 f" {s.feedback_bits}-bit ADC's {full} counts")
+    if s.feedback_cal_a_rad == s.feedback_cal_b_rad or s.feedback_cal_a_counts == s.feedback_cal_b_counts:
+        raise ParameterError(f"{where.at('servo', 'feedback_cal_b_deg')}: [servo] the feedback's two calibration"
+                             f" points need different angles and different counts")
     nyquist = c.rate_hz / 2
     for key in ("setpoint_cutoff_hz", "setpoint_cutoff_slow_hz", "speed_filter_hz", "inner_crossover_hz",
                 "outer_crossover_hz"):

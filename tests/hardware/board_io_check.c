@@ -54,6 +54,16 @@ int main(void)
     CHECK(fabsf(ttt_bio_current_a(1390u, 4095u, 3.3f, 2490.0f, 450e-6f, 1) - 1.0f) < 0.002f);
     CHECK(ttt_bio_current_a(1390u, 4095u, 3.3f, 2490.0f, 450e-6f, 0) < -0.99f);
 
+    {   /* the servo's feedback: the mean of its conversions, rounded */
+        const uint16_t s[4] = {2000u, 2001u, 2001u, 2001u};
+        const uint16_t full[16] = {4095u, 4095u, 4095u, 4095u, 4095u, 4095u, 4095u, 4095u,
+                                   4095u, 4095u, 4095u, 4095u, 4095u, 4095u, 4095u, 4095u};
+        CHECK(ttt_bio_servo_feedback(s, 4) == 2001u);
+        CHECK(ttt_bio_servo_feedback(s, 2) == 2001u);  /* 2000.5 rounds up */
+        CHECK(ttt_bio_servo_feedback(s, 1) == 2000u);
+        CHECK(ttt_bio_servo_feedback(full, 16) == 4095u);
+        CHECK(ttt_bio_servo_feedback(s, 0) == 0u);
+    }
     if (failures) return 1;
     printf("ok\n");
     return 0;

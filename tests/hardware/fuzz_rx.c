@@ -18,7 +18,7 @@ int main(void)
     static ttt_fw fw;
     ttt_board board = {{2e-5, 2e-5, 2.6e-5}, {-3.0f, -3.0f, -3.0f}, {3.0f, 3.0f, 3.0f}, -2.0f, 2.5f, 0.9f,
                        1000u, 50u, 2u, 2u};
-    ttt_sensors in = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, 0, {0.0f, 0.0f, 0.0f}};
+    ttt_sensors in = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, 0, {0.0f, 0.0f, 0.0f}, 2048u};
     unsigned char head[5];
     while (fread(head, 1, 5, stdin) == 5) {
         size_t n = (size_t)head[0] | ((size_t)head[1] << 8) | ((size_t)head[2] << 16) | ((size_t)head[3] << 24);

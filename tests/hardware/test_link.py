@@ -336,7 +336,7 @@ def test_the_documented_examples_are_the_bytes_on_both_sides(firmware_libs):
     lib = firmware_libs["float"]
     assert c_frame(lib, L.Msg.HEARTBEAT, 0x0102, bytes.fromhex("78563412")) == heartbeat
     assert c_frame(lib, L.Msg.START, 7, b"") == start
-    wire = {L.Msg.SETPOINTS: 28, L.Msg.STATUS: 50}  # "On the wire at the chart rate"
+    wire = {L.Msg.SETPOINTS: 28, L.Msg.STATUS: 52}  # "On the wire at the chart rate"
     assert len(L.Sender().frame(L.Setpoints(123456, (0.1, 0.2, 0.3, 0.4), True))) == wire[L.Msg.SETPOINTS]
     assert len(L.Sender().frame(L.Status(1000, 1, 5, 21, (100000, -5, 7), (1, 2, 3), (1, 0, 2),
-                                         (100, -200, 30)))) == wire[L.Msg.STATUS]
+                                         (100, -200, 30), 2048))) == wire[L.Msg.STATUS]

@@ -30,5 +30,5 @@ def test_the_bytes_each_way_are_the_frames_of_the_chart_steps(result):
     # one SETPOINTS frame (28 bytes on the wire) per chart step the PC ran, a few heartbeats at most
     per_step = result["link_bytes_per_s_pc_to_fw"] * seconds / steps
     assert 27.5 <= per_step <= 31
-    # the firmware sends a STATUS (50 bytes) every chart step of its own clock, whether the PC keeps up or not
-    assert result["link_bytes_per_s_fw_to_pc"] * seconds >= 50 * steps * 0.95
+    # the firmware sends a STATUS (52 bytes) every chart step of its own clock, whether the PC keeps up or not
+    assert result["link_bytes_per_s_fw_to_pc"] * seconds >= 52 * steps * 0.95

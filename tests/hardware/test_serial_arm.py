@@ -88,8 +88,8 @@ def test_the_arm_behind_the_link_moves_as_the_twin_does(emulator, gains):
         assert arm.sensors().counts == tuple(int(c) for c in emulator.plant.ints[:, PL.PI_COUNTS])
         stats = arm.link_stats
         assert stats["rejected"] == 0 and stats["lost"] == 0 and emulator.firmware.rejections()[L.Reason.LATE] == 0
-        # bytes each way per chart step: one SETPOINTS (28) out, one STATUS (50) back
-        assert stats["bytes_received"] / (2 * 400) == pytest.approx(50, abs=1)
+        # bytes each way per chart step: one SETPOINTS (28) out, one STATUS (52) back
+        assert stats["bytes_received"] / (2 * 400) == pytest.approx(52, abs=1)
     finally:
         arm.close()
 

@@ -57,6 +57,15 @@ uint32_t ttt_bio_servo_compare(ttt_real duty, uint32_t period_ticks)
     return (uint32_t)(duty * (ttt_real)period_ticks + TTT_R(0.5));
 }
 
+uint16_t ttt_bio_servo_feedback(const uint16_t *samples, int n)
+{
+    uint32_t sum = 0;
+    int k;
+    if (n < 1) return 0;
+    for (k = 0; k < n; k++) sum += samples[k];
+    return (uint16_t)((sum + (uint32_t)n / 2u) / (uint32_t)n);
+}
+
 float ttt_bio_current_a(uint16_t adc, uint16_t adc_full, float vref, float r_ipropi, float a_ipropi, int phase)
 {
     float volts = (float)adc * vref / (float)adc_full;

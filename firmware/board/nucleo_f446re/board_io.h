@@ -51,4 +51,8 @@ uint32_t ttt_bio_servo_compare(ttt_real duty, uint32_t period_ticks);
  * r_ipropi ohms, a_ipropi amps out per amp in (450e-6); signed by the bridge's direction. */
 float ttt_bio_current_a(uint16_t adc, uint16_t adc_full, float vref, float r_ipropi, float a_ipropi, int phase);
 
+/* The pen servo's feedback reading: the mean of n (1..16) conversions of its wiper, rounded (ADC counts).
+ * The PC turns it into an angle with its two-point calibration ([servo] of the parameter file). */
+uint16_t ttt_bio_servo_feedback(const uint16_t *samples, int n);
+
 #endif

@@ -41,6 +41,9 @@ static const uint32_t PIN_FAULT = PC8;                /* DRV8874 nFAULT, open dr
 static const uint32_t PIN_IPROPI[3] = {PA4, PB0, PC1};/* DRV8874 IPROPI across 2.49 kOhm: ADC1 */
 static const uint32_t PIN_INDEX[3] = {PC10, PC11, PC12};  /* index switches (open collector, pull-up) */
 static const uint32_t PIN_SERVO = PC7;                /* the pen's servo, 50 Hz */
+static const uint32_t PIN_SERVO_FB = PC0;             /* A5: its feedback wire (the pot's wiper) through
+                                                         10 kOhm / 100 nF to ground: ADC1 IN10 */
+static const int SERVO_FB_SAMPLES = 16;               /* conversions averaged per control step */
 /* encoders: TIM2 (PA0, PA1), TIM3 (PA6, PA7), TIM4 (PB6, PB7) in encoder mode, x4 decoding */
 
 static const uint32_t PWM_HZ = 20000;
@@ -140,6 +143,9 @@ static void control_step(void)
                                                  450e-6f, digitalRead(PIN_PH[d]));
     }
     sensors.index = levels;
+    uint16_t fb[SERVO_FB_SAMPLES];
+    for (int k = 0; k < SERVO_FB_SAMPLES; k++) fb[k] = (uint16_t)analogRead(PIN_SERVO_FB);
+    sensors.servo_adc = ttt_bio_servo_feedback(fb, SERVO_FB_SAMPLES);
     ttt_fw_control_step(&fw, &sensors);
 
     const ttt_real *act = fw.cascade.act;

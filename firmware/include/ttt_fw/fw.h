@@ -21,7 +21,7 @@
 #include "link.h"
 
 #define TTT_FW_VERSION_MAJOR 0
-#define TTT_FW_VERSION_MINOR 1
+#define TTT_FW_VERSION_MINOR 2
 #define TTT_FW_VERSION_PATCH 0
 
 #define TTT_STATE_IDLE 0
@@ -56,6 +56,7 @@ typedef struct ttt_sensors {
     uint16_t index_edges[TTT_DRIVES];
     uint8_t index;            /* bit d: drive d's index switch level */
     float current_a[TTT_DRIVES];
+    uint16_t servo_adc;       /* the pen servo's feedback wire (its potentiometer's wiper), ADC counts */
 } ttt_sensors;
 
 typedef struct ttt_fw {

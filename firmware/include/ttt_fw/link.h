@@ -13,7 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define TTT_PROTOCOL_VERSION 1
+#define TTT_PROTOCOL_VERSION 2
 
 #define TTT_HEADER 3                              /* type, seq (u16 LE) */
 #define TTT_CRC 2                                 /* CRC-16/CCITT-FALSE, MSB first */

@@ -9,7 +9,8 @@ wiring, the debugger's signals) runs unchanged on any backend:
   simulation integrates them; a hardware backend waits for them);
 * ``set_setpoints(q, fr_sw)``: the joint setpoints and the setpoint
   filters' switch, once per chart step;
-* encoder angles and counts, index switches, motor currents (``sensors()``);
+* encoder angles and counts, index switches, motor currents, the pen
+  servo's feedback (``sensors()``);
 * the encoder offset estimates the init charts set, and enabling or
   disabling a drive's controller.
 
@@ -52,6 +53,9 @@ class Sensors(NamedTuple):
     levels (True above the switch angle).  index_count: counts latched at the
     last index edge (0 before any).  index_edges: edges seen since power-on.
     current_a: measured motor currents (with noise), A.  t: the arm's time, s.
+    servo_rad: the pen servo's angle as its feedback wire reads it (the ADC's counts through the
+    two-point calibration of ``[servo]``, docs/hardware.md), rad: an angle, not counts, so that code typed
+    on the protocol needs no calibration; each backend converts what its board measures.
 
     An immutable record (``_asdict()`` gives its fields by name): a named
     tuple rather than a frozen dataclass, because the simulated arm builds
@@ -65,6 +69,7 @@ class Sensors(NamedTuple):
     index_edges: tuple[int, int, int]
     current_a: tuple[float, float, float]
     t: float
+    servo_rad: float
 
 
 @runtime_checkable
@@ -94,10 +99,10 @@ class Arm(Protocol):
 
     @property
     def servo_setpoint(self) -> float:
-        """The servo angle last commanded (rad): the servo has no sensor, so this is all the PC knows of q4."""
+        """The servo angle last commanded (rad); what the servo did is ``sensors().servo_rad``."""
 
     def sensors(self) -> Sensors:
-        """The encoders, index switches and current sensors now."""
+        """The encoders, index switches, current sensors and the servo's feedback now."""
 
     def encoder_angles(self) -> tuple[float, float, float]:
         """Drive angles the controllers see, ``counts * rad_per_count + offset estimate`` (rad)."""

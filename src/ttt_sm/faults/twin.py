@@ -13,7 +13,8 @@ fault would change, in the plant or in the readings, never in the charts:
   the way): its hard stops close in on it;
 - ``current_spike``: a drive's current sensor reads ``SPIKE_A`` more for
   ``SPIKE_S`` (a short in the motor's wiring);
-- ``servo_stuck``: the pen servo stops turning (its slew rate 0);
+- ``servo_stuck``: the pen servo stops turning (its slew rate 0); its
+  feedback wire reads where it stopped;
 - ``power_cut``: the H-bridges' supply falls to 0 V (the motors are
   shorted through the bridges, which brakes them) and the servo stops;
 - ``camera_lost`` is no fault of the arm: the robot's ``Camera`` block says
@@ -92,7 +93,8 @@ class FaultyArm:
         if self.fault == "current_spike" and s.t < self._spike_until:
             current = list(s.current_a)
             current[self.drive - 1] += SPIKE_A
-            return Sensors(s.counts, s.index, s.index_count, s.index_edges, tuple(current), s.t)  # type: ignore
+            return Sensors(s.counts, s.index, s.index_count, s.index_edges, tuple(current), s.t,  # type: ignore
+                           s.servo_rad)
         return s
 
     def encoder_angles(self) -> tuple[float, float, float]:

@@ -90,6 +90,7 @@ class FirmwareOnPlant:
             s.index_count[d] = int(ints[d, PL.PI_INDEX_COUNT])
             s.index_edges[d] = int(ints[d, PL.PI_INDEX_EDGES]) & 0xFFFF
             s.current_a[d] = float(self._ps[d, PL.PS_I_MEAS])
+        s.servo_adc = self.plant.feedback_counts  # the twin's ADC reading of the servo's feedback wire
         s.index = sum(1 << d for d in range(3) if ints[d, PL.PI_INDEX] == 1)
 
     def sense(self) -> None:

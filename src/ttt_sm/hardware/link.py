@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import ClassVar
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
 HEADER = 3
 CRC_BYTES = 2
 MAX_BODY = 160
@@ -451,10 +451,11 @@ STATE_NAMES = ("idle", "running", "safe_stop")
 
 @dataclass(frozen=True)
 class Status(Message):
-    """The firmware's sensors and state after control step `step` (currents in mA)."""
+    """The firmware's sensors and state after control step `step` (currents in mA, the servo's feedback in
+    ADC counts: the PC converts it with the ``[servo]`` calibration)."""
 
     KIND: ClassVar[Msg] = Msg.STATUS
-    FORMAT: ClassVar[str] = "<IBBB3i3i3H3h"
+    FORMAT: ClassVar[str] = "<IBBB3i3i3H3hH"
     step: int
     state: int
     index: int  # bit d: drive d's index switch level
@@ -463,15 +464,16 @@ class Status(Message):
     index_count: tuple[int, int, int]
     index_edges: tuple[int, int, int]
     current_ma: tuple[int, int, int]
+    servo_adc: int
 
     def values(self) -> tuple[int, ...]:
         return (self.step, self.state, self.index, self.modes, *self.counts, *self.index_count,
-                *self.index_edges, *self.current_ma)
+                *self.index_edges, *self.current_ma, self.servo_adc)
 
     @classmethod
     def unpack(cls, body: bytes) -> Status:
         v = struct.unpack(cls.FORMAT, body)
-        return cls(v[0], v[1], v[2], v[3], v[4:7], v[7:10], v[10:13], v[13:16])
+        return cls(v[0], v[1], v[2], v[3], v[4:7], v[7:10], v[10:13], v[13:16], v[16])
 
     @property
     def state_name(self) -> str:

@@ -67,6 +67,7 @@ class SensorsIn(ctypes.Structure):
         ("index_edges", ctypes.c_uint16 * 3),
         ("index", ctypes.c_uint8),
         ("current_a", ctypes.c_float * 3),
+        ("servo_adc", ctypes.c_uint16),
     ]
 
 

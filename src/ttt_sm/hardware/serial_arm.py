@@ -171,6 +171,7 @@ class SerialArm:
         self.gains = design_gains(params) if gains is None else gains
         self.link_timeout_s = link_timeout_s
         self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
+        self._servo = params.servo  # its feedback's calibration turns the STATUS's ADC counts into an angle
         self._offsets = [0.0, 0.0, 0.0]
         self._q: list[float] = [0.0, 0.0, 0.0, float(servo_angle)]
         self._fr_sw = False
@@ -575,7 +576,8 @@ class SerialArm:
         assert s is not None  # the handshake waited for one
         return Sensors(counts=s.counts, index=tuple(bool(s.index >> d & 1) for d in range(3)),  # type: ignore[arg-type]
                        index_count=s.index_count, index_edges=s.index_edges,
-                       current_a=tuple(i / 1000.0 for i in s.current_ma), t=self.t)  # type: ignore[arg-type]
+                       current_a=tuple(i / 1000.0 for i in s.current_ma), t=self.t,  # type: ignore[arg-type]
+                       servo_rad=self._servo.feedback_angle(s.servo_adc))
 
     def encoder_angles(self) -> tuple[float, float, float]:
         c = (0, 0, 0) if self._status is None else self._status.counts

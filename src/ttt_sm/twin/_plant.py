@@ -7,9 +7,11 @@ servo's PWM duty: the layout of ``_cascade.ACT_*``) and integrates over
 each sub-step), motor with implicit viscous and Coulomb friction (stick
 without chattering), gear clearance as a dead-zone spring with contact
 damping, load with gravity, hard stops, the index switch; then the servo
-(first-order position loop, slew-rate limit, gear play).  At the end it
-quantizes the motor angles into integer encoder counts and samples the
-currents with noise: what the controller reads next.
+(first-order position loop, slew-rate limit, gear play) and its feedback
+wire (the potentiometer on its output shaft, through an RC filter to the
+board's ADC).  At the end it quantizes the motor angles into integer encoder
+counts, samples the currents with noise and the feedback wire into ADC
+counts with noise: what the controller reads next.
 
 Memory: per-drive parameter rows ``pp[d, PP_*]``, global parameters
 ``pg[PG_*]``, per-drive float state ``ps[d, PS_*]``, global state
@@ -76,7 +78,12 @@ PG_SV_CLEAR = 11
 PG_I_NOISE = 12  # standard deviation of the current measurement noise (A)
 PG_SV_INV_TAU = 13  # 1 / PG_SV_TAU
 PG_H = 14  # the sub-step, PG_DT / PG_NSUB (s)
-N_PG = 15
+PG_FB_K = 15  # servo feedback: ADC counts per rad of the output shaft (the calibration's slope)
+PG_FB_C0 = 16  #                 ADC counts at 0 rad
+PG_FB_NOISE = 17  #              rms noise of one reading (counts)
+PG_FB_ALPHA = 18  #              the RC filter's step over one sub-step, 1 - exp(-h / tau) (1: no filter)
+PG_FB_FULL = 19  #               the ADC's full scale, 2^bits - 1 (counts)
+N_PG = 20
 
 # ---- per-drive float state ps[d, PS_*] ----------------------------------------
 PS_I = 0  # armature current (A)
@@ -92,7 +99,9 @@ PGS_T = 0  # simulated time (s)
 PGS_SV_CMD = 1  # angle the servo's PWM duty commands (rad)
 PGS_SV_TH = 2  # servo's internal (motor-side) angle (rad)
 PGS_SV_Q = 3  # servo output angle q4 after its gear clearance (rad)
-N_PGS = 4
+PGS_FB_V = 4  # the feedback wire after the RC filter, as the angle it stands for (rad)
+PGS_FB_COUNTS = 5  # the ADC's reading of it (integer counts, stored as a float)
+N_PGS = 6
 
 # ---- per-drive integer state pi[d, PI_*] -----------------------------------------
 PI_C0 = 0  # counter value of the motor angle at power-on (counts are relative to it)
@@ -102,7 +111,8 @@ PI_INDEX_COUNT = 3  # counts latched at the last index edge
 PI_INDEX_EDGES = 4  # number of index edges seen
 PI_AT_LIMIT = 5  # -1 / +1 when the load rests on its lower / upper hard stop, else 0
 PI_RNG = 6  # state of the current-noise generator (31-bit LCG)
-N_PI = 7
+PI_FB_RNG = 7  # row 0 only: state of the servo feedback's noise generator (31-bit LCG)
+N_PI = 8
 
 # ---- one float buffer pf[PR_*, :WIDTH]: each block is a row or three -----------------
 PR_PP = 0  # 3 rows: pp
@@ -123,14 +133,14 @@ def _clip(x: float, lo: float, hi: float) -> float:
 
 
 @njit(cache=True)
-def _gauss(pi: np.ndarray, d: int) -> float:
-    """Approximately normal N(0, 1) from four uniforms of drive d's generator."""
+def _gauss(pi: np.ndarray, d: int, column: int = PI_RNG) -> float:
+    """Approximately normal N(0, 1) from four uniforms of the generator in ``pi[d, column]``."""
     acc = 0.0
-    s = pi[d, PI_RNG]
+    s = pi[d, column]
     for _ in range(4):
         s = (s * _LCG_A + _LCG_C) & LCG_MASK
         acc += s * (1.0 / 2147483648.0)
-    pi[d, PI_RNG] = s
+    pi[d, column] = s
     return (acc - 2.0) * 1.7320508075688772  # the sum of 4 uniforms has variance 1/3
 
 
@@ -240,16 +250,28 @@ def servo_angle_for_duty(duty: float, pg: np.ndarray) -> float:
 
 @njit(cache=True)
 def _integrate_servo(cmd: float, n_sub: int, h: float, pg: np.ndarray, pgs: np.ndarray) -> None:
-    """Hobby servo over one control step: first-order position loop, slew-rate limit, gear play."""
+    """Hobby servo over one control step: first-order position loop, slew-rate limit, gear play.
+
+    The feedback wire's RC filter follows the output angle (the potentiometer sits on the output shaft).
+    """
     inv_tau, rate_max, half = pg[PG_SV_INV_TAU], pg[PG_SV_RATE], 0.5 * pg[PG_SV_CLEAR]
-    th, q = pgs[PGS_SV_TH], pgs[PGS_SV_Q]
+    alpha = pg[PG_FB_ALPHA]
+    th, q, v = pgs[PGS_SV_TH], pgs[PGS_SV_Q], pgs[PGS_FB_V]
     for _ in range(n_sub):
         th += h * _clip((cmd - th) * inv_tau, -rate_max, rate_max)
         if th - q > half:
             q = th - half
         elif th - q < -half:
             q = th + half
-    pgs[PGS_SV_TH], pgs[PGS_SV_Q] = th, q
+        v += alpha * (q - v)
+    pgs[PGS_SV_TH], pgs[PGS_SV_Q], pgs[PGS_FB_V] = th, q, v
+
+
+@njit(cache=True)
+def feedback_counts(pg: np.ndarray, pgs: np.ndarray, pi: np.ndarray) -> float:
+    """The ADC's reading of the servo's feedback wire now: the filtered angle in counts, noisy, rounded, clipped."""
+    c = math.floor(pg[PG_FB_C0] + pg[PG_FB_K] * pgs[PGS_FB_V] + pg[PG_FB_NOISE] * _gauss(pi, 0, PI_FB_RNG) + 0.5)
+    return _clip(c, 0.0, pg[PG_FB_FULL])
 
 
 @njit(cache=True, inline="always")  # inlined into the fused loop
@@ -280,4 +302,5 @@ def plant_step(pp: np.ndarray, pg: np.ndarray, ps: np.ndarray, pgs: np.ndarray, 
         # the quadrature counter: integer edges at fixed motor angles, relative to power-on
         pi[d, PI_COUNTS] = int(math.floor(ps[d, PS_TH] / pp[d, PP_DTH_M])) - pi[d, PI_C0]
         ps[d, PS_I_MEAS] = ps[d, PS_I] + pg[PG_I_NOISE] * _gauss(pi, d)
+    pgs[PGS_FB_COUNTS] = feedback_counts(pg, pgs, pi)
     pgs[PGS_T] += pg[PG_DT]

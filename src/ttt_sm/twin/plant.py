@@ -7,7 +7,9 @@ back: per DC drive an armature circuit with back-EMF, a motor with viscous
 and Coulomb friction, a gear with ratio, clearance and stiffness, a load
 with inertia, viscous friction and gravity, hard stops, a relative
 quadrature encoder on the motor shaft with an index switch; a hobby servo
-with a slew-rate limit, a lag and gear play (docs/model.md).  It reads the
+with a slew-rate limit, a lag and gear play, and the wiper of its position
+potentiometer read by the board's ADC (docs/model.md; docs/hardware.md,
+"The pen servo's feedback").  It reads the
 actuator commands (H-bridge duties, the servo's PWM duty) and nothing of the
 controller.  The simulated arm (:class:`ttt_sm.twin.sim.ArmSim`) fuses it
 with the cascade controller.
@@ -176,7 +178,13 @@ class Plant:
         pg[P.PG_I_NOISE] = noise
         pg[P.PG_SV_INV_TAU] = 1.0 / s.time_constant_s
         pg[P.PG_H] = params.control.dt / substeps
-
+        k = s.feedback_counts_per_rad
+        pg[P.PG_FB_K] = k
+        pg[P.PG_FB_C0] = s.feedback_counts(0.0)
+        pg[P.PG_FB_NOISE] = s.feedback_noise_lsb
+        pg[P.PG_FB_ALPHA] = 1.0 if s.feedback_tau_s == 0.0 else -math.expm1(-pg[P.PG_H] / s.feedback_tau_s)
+        pg[P.PG_FB_FULL] = 2.0 ** s.feedback_bits - 1.0
+        self._fb = (s.feedback_cal_a_rad, s.feedback_cal_a_counts, 1.0 / k)  # the PC's calibration
     def _power_on(self, q0: np.ndarray, rng: np.random.Generator) -> None:
         ps, pi, pp = self.ps, self.ints, self.pp
         tau = gravity_torques(self.params, q0)
@@ -189,10 +197,13 @@ class Plant:
             pi[d, P.PI_C0] = math.floor(ps[d, P.PS_TH] / pp[d, P.PP_DTH_M])
             pi[d, P.PI_INDEX] = int(ps[d, P.PS_TH] > pp[d, P.PP_TH_IDX])
             pi[d, P.PI_RNG] = int(rng.integers(0, P.LCG_MASK))
+        pi[0, P.PI_FB_RNG] = int(rng.integers(0, P.LCG_MASK))  # drawn after the drives': their noise is as it was
         servo = self.params.servo
         self.pgs[P.PGS_SV_CMD] = servo.angle_for_duty(servo.duty_for_angle(q0[3]))
         self.pgs[P.PGS_SV_TH] = q0[3]
         self.pgs[P.PGS_SV_Q] = q0[3]
+        self.pgs[P.PGS_FB_V] = q0[3]
+        self.pgs[P.PGS_FB_COUNTS] = P.feedback_counts(self.pg, self.pgs, self.ints)
 
     # ---- stepping and sensors ---------------------------------------------------
 
@@ -214,16 +225,22 @@ class Plant:
         """Encoder counts of drives 1..3 since power-on (a view: what the controller reads)."""
         return self.ints[:, P.PI_COUNTS]
 
+    @property
+    def feedback_counts(self) -> int:
+        """The ADC's last reading of the servo's feedback wire, counts (what a board's STATUS carries)."""
+        return int(self.pgsv[P.PGS_FB_COUNTS])
+
     def sensors(self) -> Sensors:
-        """The readings of the encoders, index switches and current sensors now."""
-        v, n, ps, w, i = self.intsv, P.N_PI, self.psv, P.WIDTH, P.PS_I_MEAS
+        """The readings of the encoders, index switches, current sensors and the servo's feedback now."""
+        v, n, ps, w, i, g = self.intsv, P.N_PI, self.psv, P.WIDTH, P.PS_I_MEAS, self.pgsv
         cn, ix, ic, ie = P.PI_COUNTS, P.PI_INDEX, P.PI_INDEX_COUNT, P.PI_INDEX_EDGES
+        a0, c0, inv_k = self._fb
         # plain reads of the flat views, and the named tuple made as a tuple (its generated __new__ is
         # a Python call more): it runs every chart step
         return tuple.__new__(Sensors, (  # type: ignore[type-var]
             (v[cn], v[n + cn], v[2 * n + cn]), (v[ix] == 1, v[n + ix] == 1, v[2 * n + ix] == 1),
             (v[ic], v[n + ic], v[2 * n + ic]), (v[ie], v[n + ie], v[2 * n + ie]),
-            (ps[i], ps[w + i], ps[2 * w + i]), self.pgsv[P.PGS_T]))
+            (ps[i], ps[w + i], ps[2 * w + i]), g[P.PGS_T], a0 + (g[P.PGS_FB_COUNTS] - c0) * inv_k))
 
 
 __all__ = ["Plant", "SimError", "REST_POSE", "SUBSTEPS", "CURRENT_NOISE_A", "G", "Angles",

@@ -135,7 +135,7 @@ def test_every_row_that_feeds_a_chart_copies_its_source_into_the_input(game_robo
     values, arguments = _plant(robot)
     robot.wiring.feed(list(robot.charts), args=ARGUMENT_BLOCKS)(*arguments)
     rows = [r for r in robot.wiring.rows if r.target.block in robot.charts]
-    assert len(rows) == 53  # 30 into the thesis' charts and the game's, 23 into the Safety chart
+    assert len(rows) == 55  # 30 into the thesis' charts and the game's, 25 into the Safety chart
     for row in rows:
         assert getattr(robot.charts[row.target.block], row.target.port) == values[str(row.source)], row.wire
 

@@ -1,5 +1,5 @@
-"""The pen servo's feedback over the link: the C firmware's STATUS carries it, the PC reads it
-(docs/hardware.md, "The pen servo's feedback").
+"""The pen servo's feedback over the link: the C firmware's STATUS carries it, the PC reads it, the Safety
+chart trips on a stuck servo over the firmware emulator (docs/hardware.md, "The pen servo's feedback").
 
 The firmware reports the ADC's counts as the board read them (``ttt_sensors.servo_adc``, the last two
 bytes of ``STATUS``, protocol 2); the PC turns them into an angle with the ``[servo]`` calibration.
@@ -11,10 +11,12 @@ import dataclasses
 
 import pytest
 
+from ttt_sm.app.robot import Robot
 from ttt_sm.hardware import link as L
 from ttt_sm.hardware.emulator import ArmEmulator, FirmwareOnPlant
 from ttt_sm.hardware.serial_arm import SerialArm, SerialArmError
 from ttt_sm.twin import _cascade as C
+from ttt_sm.twin import _plant as PL
 from ttt_sm.twin.cascade import CascadeController
 from ttt_sm.twin.plant import REST_POSE
 from ttt_sm.twin.tuning import design_gains
@@ -78,6 +80,37 @@ def test_a_firmware_of_another_protocol_is_refused_at_the_handshake(tmp_path, fi
         emu.tap = _OldFirmware()
         with pytest.raises(SerialArmError, match="the firmware speaks protocol 1, this PC 2"):
             SerialArm(emu.port, P)
+
+
+def test_a_servo_stuck_while_initialising_trips_the_safety_chart_over_the_emulator_at_its_next_move(
+        tmp_path, firmware_libs):
+    """The C firmware on a real pty; the emulated servo sticks 0.5 s after power-on, while the drives
+    initialise (the servo is not commanded to move: nothing trips).  Then the Control chart turns the pen:
+    the feedback stays where the servo stuck, and the Safety chart lifts the pen with the drives."""
+    with ArmEmulator(P, pace="gated", link=tmp_path / "arm", truth=True,
+                     cache=firmware_libs["float"].path.parent) as emu:
+        arm = SerialArm(emu.port, P, servo_angle=REST_POSE[3], link_timeout_s=5.0)
+        try:
+            robot = Robot(P, arm=arm, truth=arm.truth)
+            moved: list[float] = []
+            robot.safety_stage.listeners.append(lambda kind, data: moved.append(arm.servo_setpoint))
+            robot.run_for(0.5)  # the servo turns to the angle the init charts hold it at
+            emu.plant.pg[PL.PG_SV_RATE] = 0.0  # the servo's gears stuck (the twin's servo_stuck)
+            stuck = float(emu.plant.pgs[PL.PGS_SV_Q])
+            t_stuck = robot.t
+            assert robot.run_until(lambda: robot.tripped, 120.0)
+            # no trip while the servo was held still (the drives initialising, 10 s and more): a stuck servo
+            # is harmless until its next commanded move, and found there
+            assert robot.t > t_stuck + 5.0
+            assert robot.initialised and arm.link_ok, (robot.t, robot.safety.reason, moved)
+            assert robot.safety.reason.startswith("servo stuck: pen servo at ")
+            assert robot.active("Safety") == {"safe", "lift"}
+            # what the PC read is where the servo stuck; the setpoint had moved on by more than the limit
+            assert abs(arm.sensors().servo_rad - stuck) < 0.005
+            assert abs(moved[0] - stuck) > P.safety.max_servo_error_rad
+            assert emu.firmware.rejections()[L.Reason.CRC] == 0
+        finally:
+            arm.close()
 
 
 def test_the_serial_arm_reads_the_servo_through_its_own_calibration(tmp_path, firmware_libs):

@@ -9,14 +9,17 @@ against a model of the controller's setpoint filter (the same filter,
 ``twin.control.setpoint_filter_row``, stepped with the same setpoints,
 followed no faster than the controller's speed clamp
 ``twin.control.max_joint_speed``), the encoder speed from the counts, the
-commanded speed (the model's) and the current.  It
+commanded speed (the model's) and the current; and the pen servo's error:
+a model of the servo (its lag and slew rate, ``[servo]``) stepped with the
+servo's setpoints, minus the angle its feedback wire reads.  It
 feeds the Safety chart, ticks it, and carries out what the chart outputs:
 
 - ``SafeState.hold``: the setpoints become the pose the arm had when the
   chart tripped (encoder angles and the servo's last setpoint), or, while
   the chart lifts the pen, a ramp at ``[safety] lift_speed_m_s`` to that
   pose solved by inverse kinematics at the tool height ``lift_z`` (a step
-  of the setpoints would ask the drives for a current beyond the limit);
+  of the setpoints would ask the drives for a current beyond the limit):
+  the drives lift the tool, which a stuck pen servo cannot;
 - ``SafeState.bridge_off``: that drive's bridge is switched off (``Arm.set_enabled``);
 - ``SafeState.reinit`` rising: the robot restarts its drive-initialisation charts
   (:meth:`~ttt_sm.app.robot.Robot.reinitialise`) and switches the drives on again.
@@ -73,6 +76,7 @@ def make_safety_chart(params: ArmParams, listeners: Sequence[object] = ()) -> Sa
         "moving_speed": s.moving_speed_rad_s, "stall_ratio": s.stall_ratio, "silent_s": s.silent_s,
         "limit_margin": s.limit_margin_rad,
         "lift_height": s.lift_height_m,
+        "max_servo_error": s.max_servo_error_rad, "servo_error_s": s.servo_error_s,
     }
     for k, d in enumerate(params.drives, start=1):
         data[f"q_min_{k}"] = d.limit_min_rad
@@ -140,7 +144,11 @@ class SafetyStage:
         m[_monitor.M_R:_monitor.M_R + 3] = enc
         m[_monitor.M_P:_monitor.M_P + 3] = enc
         m[_monitor.M_OFFSET:_monitor.M_OFFSET + 3] = arm.offset_estimates()
-        m[_monitor.M_COUNTS:_monitor.M_COUNTS + 3] = arm.sensors().counts
+        sensors = arm.sensors()
+        m[_monitor.M_COUNTS:_monitor.M_COUNTS + 3] = sensors.counts
+        m[_monitor.M_SV] = sensors.servo_rad
+        m[_monitor.M_SV_RATE] = params.servo.rate_rad_s
+        m[_monitor.M_SV_INV_TAU] = 1.0 / params.servo.time_constant_s
         self._tool = (0.0, 0.0, 0.0)
         self._pose: list[float] | None = None  # what the drives hold while the chart trips
         self._lift_for = math.nan  # the lift_z the pose was solved for
@@ -154,7 +162,7 @@ class SafetyStage:
         #: Called with (kind, data) on every trip ("safety_trip") and reset ("safety_reset").
         self.listeners: list[Callable[[str, dict[str, Any]], object]] = []
         # the Monitor block's outputs as this chart step computed them (app/_monitor.py: OUT_*)
-        self._out: tuple[Any, ...] = (0.0,) * 22
+        self._out: tuple[Any, ...] = (0.0,) * _monitor.N_OUT
         #: The ``Link`` block: the arm's own report of its link, where it has one (else True), read every tick
         #: (``link_ok``, the :class:`~ttt_sm.arm.Arm` protocol's optional surface).
         self.link_ok = True
@@ -205,7 +213,7 @@ class SafetyStage:
         i1, i2, i3 = sensors.current_a
         o1, o2, o3 = self._offset_estimates()
         servo = arm.servo_setpoint
-        self._out = out = _monitor.monitor(self._m, c1, c2, c3, i1, i2, i3, o1, o2, o3, servo)
+        self._out = out = _monitor.monitor(self._m, c1, c2, c3, i1, i2, i3, o1, o2, o3, servo, sensors.servo_rad)
         self._feed(out)
         if self.overrides:
             vars(self.chart).update(self.overrides)
@@ -217,7 +225,7 @@ class SafetyStage:
             if q_safe is not None:
                 signals.q_set = q_safe
         q = signals.q_set
-        _monitor.advance(self._m, float(q[0]), float(q[1]), float(q[2]), bool(signals.fr_sw))
+        _monitor.advance(self._m, float(q[0]), float(q[1]), float(q[2]), bool(signals.fr_sw), float(q[3]))
 
     def _carry_out(self, servo: float) -> list[float] | None:
         """What the chart's outputs ask for this chart step: tell a trip, restart, hold or lift the pose.
@@ -238,7 +246,7 @@ class SafetyStage:
         if hold:
             if self._pose is None:
                 self._pose = [out[12], out[13], out[14], servo]
-                self._tool = (out[18], out[19], out[21])
+                self._tool = (out[_monitor.OUT_TOOL], out[_monitor.OUT_TOOL + 1], out[_monitor.OUT_TOOL + 3])
             if lift_z == lift_z and lift_z != self._lift_for:  # a lift to solve (not NaN, not solved yet)
                 self._lift_for = lift_z
                 self._lift_from = list(self._pose)
@@ -291,6 +299,7 @@ class SafetyStage:
         self._reinitialise()
         arm, mv = self.arm, self._mv
         self._shift(arm.offset_estimates())  # they changed: the setpoints moved with them
+        mv[_monitor.M_SV] = arm.sensors().servo_rad  # the servo's model starts again where the servo stands
         enc = arm.encoder_angles()
         for i, on in enumerate(arm.enabled()):
             if not on:  # switched on, a drive holds where it stands, its filter reset there

@@ -18,7 +18,8 @@ loop has these blocks (what each declares, the table reads):
 - ``Session``: the game around the charts (the Tic-tac-toe GUI, the engine,
   the camera's moves): the result, the person's moves, the algorithm's answer;
 - ``Monitor``: what the Safety chart watches of each drive (following error,
-  encoder speed, commanded speed, current, angle), from the arm's readings;
+  encoder speed, commanded speed, current, angle) and of the pen servo (its
+  feedback against a model of it), from the arm's readings;
 - ``Link``, ``Camera``: whether the arm's link and the camera answer;
 - ``SafeState``: what the Safety chart asks of the drives (hold, lift, a
   bridge off, re-initialise).
@@ -90,6 +91,8 @@ MONITOR = Block("Monitor", "what the Safety chart watches of each drive, from th
     Port("current", "A", "measured motor current, magnitude", size=3),
     Port("q", "rad", "encoder angle", size=3),
     Port("fast", "bool", "the setpoints move the drive at its speed clamp (or did within 0.1 s)", size=3),
+    Port("servo_err", "rad", "pen servo: the model of the servo following its setpoints minus its feedback angle"),
+    Port("servo_q", "rad", "pen servo: the angle its feedback wire reads"),
 ))
 LINK = Block("Link", "the arm's link, where the backend has one", outputs=(
     Port("ok", "bool", "valid status keeps arriving (always true for the simulated arm)", attr="link_ok"),
@@ -160,6 +163,8 @@ SAFETY_WIRES: tuple[Wire, ...] = (
     *_per_drive("Monitor.current[{i}]", "Safety.current_{k}"),
     *_per_drive("Monitor.q[{i}]", "Safety.q_{k}"),
     *_per_drive("Monitor.fast[{i}]", "Safety.fast_{k}"),
+    Wire("Monitor.servo_err", "Safety.servo_err"),
+    Wire("Monitor.servo_q", "Safety.servo_q"),
     Wire("FK.Z", "Safety.Z_now"),
     Wire("Link.ok", "Safety.link_ok"),
     Wire("Camera.ok", "Safety.camera_ok"),

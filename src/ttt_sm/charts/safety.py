@@ -18,7 +18,10 @@ reports and what the PC commanded (docs/safety.md, "What trips it"):
   `stall_ratio` of it, or not counting at all while the drives initialise:
   a frozen encoder, a blocked motor): `still_k`;
 - the **joint angle** `q_k` against the joint limits (once initialised);
-- the **link** to the arm, where the backend reports one, and the **camera**.
+- the **link** to the arm, where the backend reports one, and the **camera**;
+- the **pen servo** `servo_err`: a model of the servo following its
+  setpoints (its lag and slew rate) minus the angle its feedback wire reads;
+  off by more than `max_servo_error` for `servo_error_s`, the servo is stuck.
 
 A fault takes it out of `monitoring`:
 
@@ -30,7 +33,10 @@ A fault takes it out of `monitoring`:
   bridge off);
 - the camera lost, while the drives are sound, goes to `lift`: the pen is
   lifted (`lift_z`, the tool's height plus `lift_height`), then `hold`
-  keeps the arm there; a drive fault while lifting or holding still stops.
+  keeps the arm there; a drive fault while lifting or holding still stops;
+- the pen servo stuck, while the drives are sound, goes to `lift` too: the
+  servo cannot lift the pen, the drives can (before the drives are
+  initialised there is no inverse kinematics to lift with: `hold`).
 
 `reason` says why, in one line; `tripped` is the one output the rest of the
 application needs.  The `reset` event (a person's, after the cause is
@@ -89,6 +95,8 @@ class Safety(TickChart):
         Data("Z_now", "m", 0.0, "tool z by forward kinematics of the encoders"),
         Data("link_ok", "bool", True, "the arm's link is alive (always true for an arm without one)"),
         Data("camera_ok", "bool", True, "the camera answers (always true without a camera)"),
+        Data("servo_err", "rad", 0.0, "pen servo: the model of the servo following its setpoints minus its feedback"),
+        Data("servo_q", "rad", 0.0, "pen servo: the angle its feedback wire reads"),
     )
     outputs = (
         Data("tripped", "bool", False, "in the safe state: the setpoints are the Safety chart's"),
@@ -121,6 +129,9 @@ class Safety(TickChart):
         *_per_drive("still", "s", 0.0, "how long drive {k}'s encoder has lagged its commanded speed"),
         Data("lift_height", "m", 0.015, "how far the pen is lifted when the arm can still move"),
         Data("lift_tol", "m", 0.001, "the lift is done within this distance"),
+        Data("max_servo_error", "rad", 0.015, "the pen servo's feedback may be this far off its model ..."),
+        Data("servo_error_s", "s", 0.02, "... for at most this long"),
+        Data("servo_off", "s", 0.0, "how long the pen servo's feedback has been off its model by more than that"),
     )
 
     monitoring = State(initial=True)
@@ -140,6 +151,8 @@ class Safety(TickChart):
     monitoring.to(safe.stopped, cond="arm_fault", on="note_arm_fault")
     monitoring.to(safe.lift, cond="not camera_ok and initialised", on="note_camera_lost")
     monitoring.to(safe.hold, cond="not camera_ok", on="note_camera_lost")
+    monitoring.to(safe.lift, cond="servo_stuck and initialised", on="note_servo_stuck")
+    monitoring.to(safe.hold, cond="servo_stuck", on="note_servo_stuck")
     reset = safe.to(reinitialising)
     # after(1): the init charts restart after the tick that entered; `initialised` is theirs from the next
     reinitialising.to(monitoring, cond=[after(1), "initialised"])
@@ -175,6 +188,10 @@ class Safety(TickChart):
                         and d["q_min_2"] - m <= d["q_2"] <= d["q_max_2"] + m
                         and d["q_min_3"] - m <= d["q_3"] <= d["q_max_3"] + m)
         return False
+
+    def servo_stuck(self) -> bool:
+        """The pen servo's feedback has been off its model too long."""
+        return self.servo_off >= self.servo_error_s
 
     def lifted(self) -> bool:
         """The tool is up at `lift_z`."""
@@ -230,6 +247,11 @@ class Safety(TickChart):
         if k and any(reason.startswith(text) for text, off in _KINDS.values() if off):
             setattr(self, f"off_{k}", True)
 
+    def note_servo_stuck(self) -> None:
+        q = self.servo_q
+        self.reason = f"servo stuck: pen servo at {q:.3f} rad, commanded {q + self.servo_err:.3f} rad"
+        self.fault_drive = 0
+
     def note_camera_lost(self) -> None:
         self.reason = "camera lost: no frame from the camera"
         self.fault_drive = 0
@@ -250,6 +272,7 @@ class Safety(TickChart):
         self.holding = False
         self.off_1 = self.off_2 = self.off_3 = False
         self.still_1 = self.still_2 = self.still_3 = 0.0
+        self.servo_off = 0.0
 
     def on_exit_reinitialising(self) -> None:
         self.reinit = False
@@ -257,7 +280,7 @@ class Safety(TickChart):
     def on_exit_safe(self) -> None:
         self.tripped = False
 
-    # the encoder-still timers run wherever a drive fault can still trip the chart
+    # the encoder-still timers (and the servo's) run wherever a drive fault can still trip the chart
     def during_monitoring(self) -> None:
         self._count_still()
 
@@ -272,7 +295,7 @@ class Safety(TickChart):
 
     def _count_still(self) -> None:
         """still_k: how long drive k's encoder has run at most stall_ratio of its commanded speed (0 while
-        initialising)."""
+        initialising); servo_off: how long the servo's feedback has been off its model."""
         d = self.__dict__
         # while initialising, only a silent encoder counts: the searches push their stops on purpose
         dt, moving, ratio = self.tick_period_s, d["moving_speed"], d["stall_ratio"] if d["initialised"] else 0.0
@@ -280,6 +303,7 @@ class Safety(TickChart):
         d["still_1"] = d["still_1"] + dt if c1 > moving and d["speed_1"] <= ratio * c1 else 0.0
         d["still_2"] = d["still_2"] + dt if c2 > moving and d["speed_2"] <= ratio * c2 else 0.0
         d["still_3"] = d["still_3"] + dt if c3 > moving and d["speed_3"] <= ratio * c3 else 0.0
+        d["servo_off"] = d["servo_off"] + dt if abs(d["servo_err"]) > d["max_servo_error"] else 0.0
 
 
 __all__ = ["Safety"]

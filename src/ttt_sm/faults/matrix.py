@@ -164,7 +164,7 @@ def _sponge_down(robot: Robot, sim: ArmSim) -> bool:
                 and z < p.board.surface_z + p.sponge.offset)
 
 
-def _reach(robot: Robot, sim: ArmSim, phase: str) -> None:
+def reach_phase(robot: Robot, sim: ArmSim, phase: str) -> None:
     """Run the robot to the moment the phase's fault begins."""
     c = robot.control
     if phase == "initialising":
@@ -213,7 +213,7 @@ def run_cell(params: ArmParams, fault: str, phase: str, seed: int = 0, gains: Ga
         record = GameRecord.open(Path(tmp) / "game.jsonl")
         robot.safety_stage.listeners.append(lambda kind, data: record.add(robot.t, kind, tick=robot.chart_ticks,
                                                                           **data))
-        _reach(robot, sim, phase)
+        reach_phase(robot, sim, phase)
         drive = _fastest_drive(robot) if fault in DRIVE_FAULTS else 0
         t0 = robot.t
         record.add(t0, "fault", tick=robot.chart_ticks, fault=fault, phase=phase, drive=drive)

@@ -89,8 +89,8 @@ class ControlStage:
         q1, q2, q3 = arm.encoder_angles()
         servo = float(signals.q_set[3])
         if not math.isfinite(servo):
-            # no setpoint yet (the first chart step): the servo has no sensor, so
-            # its pose is the angle it was last commanded
+            # no setpoint yet (the first chart step): the pose is the angle the
+            # servo was last commanded (as FK reads it everywhere: docs/safety.md)
             servo = arm.servo_setpoint
         fk_in = (q1, q2, q3, servo)
         if fk_in == self._fk_in:

@@ -549,12 +549,16 @@ class GameSession:
             raise GameError(f"the game did not end within {self.time_limit_s:g} s of simulated time (its time"
                             f" limit), while waiting for {wait.what}")
         status, every = self.status, max(1, robot.sched.ticks_for(1.0))
+        safety = robot.safety
 
         def until() -> bool:
             # A stop is honoured here only, right after a chart step and before the game goes on with what
-            # it waited for: a state a replay to the same chart tick reaches again.
-            self._check_stop()
-            self._check_safety()
+            # it waited for: a state a replay to the same chart tick reaches again.  (The checks' own
+            # conditions first: this runs after every chart step.)
+            if self._stop_request is not None or self.stop_at_tick is not None:
+                self._check_stop()
+            if safety.tripped:
+                self._check_safety()
             if status is not None and robot.chart_ticks % every == 0:
                 status(f"t = {robot.t:.0f} s simulated: {wait.what}")
             return self.watch(wait)

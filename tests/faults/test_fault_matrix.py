@@ -114,7 +114,7 @@ def test_a_servo_stuck_mid_line_is_found_once_its_model_leaves_it_and_the_drives
     sim = ArmSim(P, gains=GAINS, seed=0)
     arm = FaultyArm(sim)
     robot = Robot(P, seed=0, arm=arm, truth=sim.truth)
-    reach_phase(robot, sim, "drawing the field")
+    reach_phase(robot, sim.truth, "drawing the field")
     assert robot.board.contact.pen_touching
     arm.inject("servo_stuck")
     stuck = sim.truth.angles()[3]

@@ -1,7 +1,17 @@
-"""The fault matrix: every fault of the twin in every phase of the robot's work (``ttt-sm faults``).
+"""The fault matrix: every fault of the arm in every phase of the robot's work (``ttt-sm faults``).
 
-One cell is one fault (:mod:`.twin`) injected in one phase, on a new robot
-built on a :class:`~.twin.FaultyArm`:
+One cell is one fault (:mod:`.plant`, and ``camera_lost``) injected in one
+phase, on a new robot built on a new arm (``arm``):
+
+- ``"sim"``: the in-process twin, a :class:`~.twin.FaultyArm`;
+- ``"emulator"`` (``ttt-sm faults --arm emulator``): the C firmware on the
+  twin's plant (:class:`~ttt_sm.hardware.emulator.ArmEmulator`, gated: the
+  PC's setpoints are its clock) behind a real pseudo-terminal, the robot on
+  :class:`~ttt_sm.hardware.serial_arm.SerialArm`; the fault goes into the
+  emulator's plant (:meth:`~ttt_sm.hardware.emulator.ArmEmulator.inject_fault`)
+  and the C controller reads it as a board would.
+
+The phases:
 
 - ``initialising``: 1.5 s after power-on, while drive 1 searches its index;
 - ``drawing the field``: 0.3 s into the field's first line, pen on the board;
@@ -36,12 +46,14 @@ initialised again.  It reports (docs/safety.md, "Fault matrix"):
 - ``recovered``: after the reset every drive is initialised again and the
   Safety chart watches.
 
-Simulation only: it measures against the twin's ground truth.
+Simulation only: it measures against the plant's ground truth (the twin's,
+or the emulator's ``EMU_TRUTH`` frames: :class:`~ttt_sm.hardware.serial_arm.LinkTruth`).
 """
 
 from __future__ import annotations
 
 import math
+import os
 import tempfile
 import time
 from collections.abc import Callable, Sequence
@@ -52,17 +64,28 @@ from typing import Any
 import numpy as np
 
 from ..app.game_record import GameRecord, read_record
+from ..app.init_wiring import servo_init_angle
 from ..app.robot import Robot
+from ..arm import Arm
+from ..hardware.emulator import ArmEmulator
+from ..hardware.serial_arm import LinkTruth, SerialArm
 from ..params import ArmParams
 from ..sched.scheduler import Signals
 from ..twin.control import Gains
 from ..twin.kinematics import arm_chain_py, link_points
 from ..twin.sim import ArmSim
+from ..twin.truth import ArmTruth
 from ..twin.tuning import design_gains
 from ..twin.whiteboard import Whiteboard
+from .plant import PlantFault
 from .twin import DRIVE_FAULTS, TWIN_FAULTS, FaultyArm
 
 PHASES = ("initialising", "drawing the field", "drawing a symbol", "erasing")
+#: The arms a cell runs on (``ttt-sm faults --arm``).
+ARMS = ("sim", "emulator")
+#: What each arm is, as the report names it.
+BACKENDS = {"sim": "the twin, in process (Python cascade on the plant)",
+            "emulator": "the C firmware on the twin's plant, gated, behind a pseudo-terminal (SerialArm)"}
 #: How long a cell watches after the onset before the fault is switched off, s.
 WATCH_S = 1.5
 #: Longest the re-initialisation after the reset may take, s (one takes 6-12 s from rest).
@@ -100,12 +123,61 @@ class Cell:
     wall_s: float
 
 
-class _Watch:
-    """Joint stage run last: limits, board-zone entries and the pen's path against the twin's ground truth."""
+class _TwinBench:
+    """A cell's arm: the in-process twin, its faults in a :class:`~.twin.FaultyArm`."""
 
-    def __init__(self, params: ArmParams, sim: ArmSim, board: Whiteboard, allowance_rad: float) -> None:
+    def __init__(self, params: ArmParams, seed: int, gains: Gains | None) -> None:
+        self.sim = ArmSim(params, gains=gains, seed=seed)
+        self.faulty = FaultyArm(self.sim)
+        self.arm: Arm = self.faulty
+        self.truth: ArmTruth | LinkTruth = self.sim.truth
+
+    def inject(self, fault: str, drive: int) -> None:
+        self.faulty.inject(fault, drive)
+
+    def clear(self) -> None:
+        self.faulty.clear()
+
+    def close(self) -> None:
+        pass
+
+
+class _EmulatorBench:
+    """A cell's arm: the C firmware on a gated emulator behind a pty, over :class:`SerialArm`, faults in its plant."""
+
+    def __init__(self, params: ArmParams, seed: int, gains: Gains | None, folder: Path, cache: Path | None) -> None:
+        self.emulator = ArmEmulator(params, pace="gated", link=folder / "arm", seed=seed, truth=True, cache=cache)
+        self.emulator.start()
+        try:
+            self.serial = SerialArm(self.emulator.port, params, gains, servo_angle=servo_init_angle(params))
+        except BaseException:
+            self.emulator.stop()
+            raise
+        assert self.serial.truth is not None  # the emulator sends it before its first status
+        self.arm = self.serial
+        self.truth = self.serial.truth
+
+    def inject(self, fault: str, drive: int) -> None:
+        self.emulator.inject_fault(lambda plant: PlantFault(plant, fault, drive))
+
+    def clear(self) -> None:
+        self.emulator.clear_fault()
+
+    def close(self) -> None:
+        try:
+            self.serial.close()
+        finally:
+            self.emulator.stop()
+
+
+class _Watch:
+    """Joint stage run last: limits, board-zone entries and the pen's path against the plant's ground truth."""
+
+    def __init__(self, params: ArmParams, arm: Arm, truth: ArmTruth | LinkTruth, board: Whiteboard,
+                 allowance_rad: float) -> None:
         self.params = params
-        self.sim = sim
+        self.arm = arm
+        self.truth = truth
         self.board = board
         allowance = (allowance_rad, 0.0, 0.0)
         self.lo = [d.limit_min_rad - a for d, a in zip(params.drives, allowance, strict=True)]
@@ -122,8 +194,8 @@ class _Watch:
         self._pen: tuple[float, float] | None = None
 
     def tick(self, signals: Signals) -> None:
-        sim, truth, board = self.sim, self.sim.truth, self.params.board
-        offsets, estimates, q_set = truth.offsets, sim.offset_estimates(), signals.q_set
+        truth, board = self.truth, self.params.board
+        offsets, estimates, q_set = truth.offsets, self.arm.offset_estimates(), signals.q_set
         for i in range(3):
             q_cmd = q_set[i] - estimates[i] + offsets[i]
             if not self.lo[i] <= q_cmd <= self.hi[i]:
@@ -149,28 +221,28 @@ def _over_board(params: ArmParams, x: float, y: float) -> bool:
     return x0 <= x <= x1 and y0 <= y <= y1
 
 
-def _pen_down(robot: Robot, sim: ArmSim) -> bool:
+def _pen_down(robot: Robot, truth: ArmTruth | LinkTruth) -> bool:
     """The true pen tip presses the board with the pen upright (simulation only)."""
-    x, y, z, phi = sim.truth.tool_pose()
+    x, y, z, phi = truth.tool_pose()
     return bool(robot.initialised and _over_board(robot.params, x, y) and z < robot.params.board.surface_z
                 and abs(phi) < 0.2)
 
 
-def _sponge_down(robot: Robot, sim: ArmSim) -> bool:
+def _sponge_down(robot: Robot, truth: ArmTruth | LinkTruth) -> bool:
     """The sponge lies on the board (phi = 90 deg, the tool at sponge height)."""
-    x, y, z, phi = sim.truth.tool_pose()
+    x, y, z, phi = truth.tool_pose()
     p = robot.params
     return bool(robot.control.erasing and abs(phi - math.pi / 2) < 0.05
                 and z < p.board.surface_z + p.sponge.offset)
 
 
-def reach_phase(robot: Robot, sim: ArmSim, phase: str) -> None:
+def reach_phase(robot: Robot, truth: ArmTruth | LinkTruth, phase: str) -> None:
     """Run the robot to the moment the phase's fault begins."""
     c = robot.control
     if phase == "initialising":
         robot.run_for(1.5)
         return
-    if not robot.run_until(lambda: _pen_down(robot, sim), 120.0):
+    if not robot.run_until(lambda: _pen_down(robot, truth), 120.0):
         raise FaultMatrixError("the field's first line never began")
     if phase == "drawing the field":
         robot.run_for(0.3)
@@ -180,12 +252,12 @@ def reach_phase(robot: Robot, sim: ArmSim, phase: str) -> None:
     if phase == "drawing a symbol":
         c.row, c.column, c.symbol = 3, 3, 1
         robot.post("Control", "button")
-        if not robot.run_until(lambda: _pen_down(robot, sim), 30.0):
+        if not robot.run_until(lambda: _pen_down(robot, truth), 30.0):
             raise FaultMatrixError("the X's first line never began")
         robot.run_for(0.2)
         return
     robot.control_stage.erase_requested = True
-    if not robot.run_until(lambda: _sponge_down(robot, sim), 60.0):
+    if not robot.run_until(lambda: _sponge_down(robot, truth), 60.0):
         raise FaultMatrixError("the sponge never came down")
     robot.run_for(0.3)
 
@@ -196,57 +268,73 @@ def _fastest_drive(robot: Robot) -> int:
     return 1 + int(np.argmax(speeds))
 
 
-def run_cell(params: ArmParams, fault: str, phase: str, seed: int = 0, gains: Gains | None = None) -> Cell:
-    """Inject `fault` in `phase` on a new robot, watch, reset, recover: one cell of the matrix."""
+def run_cell(params: ArmParams, fault: str, phase: str, seed: int = 0, gains: Gains | None = None,
+             arm: str = "sim", cache: Path | None = None) -> Cell:
+    """Inject `fault` in `phase` on a new robot on a new `arm`, watch, reset, recover: one cell of the matrix.
+
+    `cache`: the folder of the emulator's firmware builds (default: the user's cache).
+    """
     if fault not in TWIN_FAULTS:
         raise FaultMatrixError(f"no fault {fault!r}; faults: {', '.join(TWIN_FAULTS)}")
     if phase not in PHASES:
         raise FaultMatrixError(f"no phase {phase!r}; phases: {', '.join(PHASES)}")
+    if arm not in ARMS:
+        raise FaultMatrixError(f"no arm {arm!r}; arms: {', '.join(ARMS)}")
     wall0 = time.perf_counter()
-    sim = ArmSim(params, gains=gains, seed=seed)
-    arm = FaultyArm(sim)
-    robot = Robot(params, seed=seed, arm=arm, truth=sim.truth)
-    one_step = robot.charts["DriveInit1"].search_speed * params.control.chart_dt  # type: ignore[attr-defined]
-    watch = _Watch(params, sim, robot.board, allowance_rad=robot.charts["DriveInit1"].stall_lag + one_step)  # type: ignore
-    robot.sched.joint_stages.append(watch)
     with tempfile.TemporaryDirectory(prefix="ttt_sm_faults_") as tmp:
-        record = GameRecord.open(Path(tmp) / "game.jsonl")
-        robot.safety_stage.listeners.append(lambda kind, data: record.add(robot.t, kind, tick=robot.chart_ticks,
-                                                                          **data))
-        reach_phase(robot, sim, phase)
-        drive = _fastest_drive(robot) if fault in DRIVE_FAULTS else 0
-        t0 = robot.t
-        record.add(t0, "fault", tick=robot.chart_ticks, fault=fault, phase=phase, drive=drive)
-        if fault == "camera_lost":
-            robot.camera_status.ok = False
-        else:
-            arm.inject(fault, drive or 1)
-        watch.count_smear = True
-        t_trip: float | None = None
-        reason = ""
-        moving_until = t0
-        for _ in range(robot.sched.ticks_for(WATCH_S)):
-            robot.chart_step()
-            if t_trip is None and robot.tripped:
-                t_trip = robot.t
-                reason = robot.safety.reason  # the first reason: a held arm may trip the init charts next
-                watch.count_zone = True
-            if float(np.max(np.abs(sim.truth.speed_load))) > REST_RAD_S:
-                moving_until = robot.t
-        watch.count_smear = False
-        zone_in_watch = watch.zone_entries
-        watch.count_zone = True  # the re-initialisation's entries, from the reset on
-        arm.clear()
-        robot.camera_status.ok = True
-        record.add(robot.t, "fault_cleared", tick=robot.chart_ticks)
-        robot.run_for(0.2)
-        robot.post("Safety", "reset")
+        bench = _TwinBench(params, seed, gains) if arm == "sim" else _EmulatorBench(params, seed, gains, Path(tmp),
+                                                                                    cache)
+        try:
+            return _run_cell(params, fault, phase, seed, bench, Path(tmp), wall0)
+        finally:
+            bench.close()
+
+
+def _run_cell(params: ArmParams, fault: str, phase: str, seed: int, bench: _TwinBench | _EmulatorBench,
+              tmp: Path, wall0: float) -> Cell:
+    arm, truth = bench.arm, bench.truth
+    robot = Robot(params, seed=seed, arm=arm, truth=truth)
+    one_step = robot.charts["DriveInit1"].search_speed * params.control.chart_dt  # type: ignore[attr-defined]
+    watch = _Watch(params, arm, truth, robot.board,
+                   allowance_rad=robot.charts["DriveInit1"].stall_lag + one_step)  # type: ignore[attr-defined]
+    robot.sched.joint_stages.append(watch)
+    record = GameRecord.open(tmp / "game.jsonl")
+    robot.safety_stage.listeners.append(lambda kind, data: record.add(robot.t, kind, tick=robot.chart_ticks,
+                                                                      **data))
+    reach_phase(robot, truth, phase)
+    drive = _fastest_drive(robot) if fault in DRIVE_FAULTS else 0
+    t0 = robot.t
+    record.add(t0, "fault", tick=robot.chart_ticks, fault=fault, phase=phase, drive=drive)
+    if fault == "camera_lost":
+        robot.camera_status.ok = False
+    else:
+        bench.inject(fault, drive or 1)
+    watch.count_smear = True
+    t_trip: float | None = None
+    reason = ""
+    moving_until = t0
+    for _ in range(robot.sched.ticks_for(WATCH_S)):
         robot.chart_step()
-        recovered = robot.run_until(lambda: robot.initialised and not robot.tripped, RECOVER_S) \
-            and not robot.tripped
-        record.add(robot.t, "finished", tick=robot.chart_ticks, recovered=recovered)
-        record.close()
-        intact = _record_intact(record, Path(tmp) / "game.jsonl", t_trip is not None)
+        if t_trip is None and robot.tripped:
+            t_trip = robot.t
+            reason = robot.safety.reason  # the first reason: a held arm may trip the init charts next
+            watch.count_zone = True
+        if float(np.max(np.abs(truth.speed_load))) > REST_RAD_S:
+            moving_until = robot.t
+    watch.count_smear = False
+    zone_in_watch = watch.zone_entries
+    watch.count_zone = True  # the re-initialisation's entries, from the reset on
+    bench.clear()
+    robot.camera_status.ok = True
+    record.add(robot.t, "fault_cleared", tick=robot.chart_ticks)
+    robot.run_for(0.2)
+    robot.post("Safety", "reset")
+    robot.chart_step()
+    recovered = robot.run_until(lambda: robot.initialised and not robot.tripped, RECOVER_S) \
+        and not robot.tripped
+    record.add(robot.t, "finished", tick=robot.chart_ticks, recovered=recovered)
+    record.close()
+    intact = _record_intact(record, tmp / "game.jsonl", t_trip is not None)
     detect = None if t_trip is None else round((t_trip - t0) * 1e3, 1)
     settled = t_trip is not None and moving_until < t0 + WATCH_S - 0.1
     return Cell(
@@ -273,19 +361,25 @@ def _record_intact(record: GameRecord, path: Path, tripped: bool) -> bool:
 
 
 def fault_matrix(params: ArmParams, faults: Sequence[str] = TWIN_FAULTS, phases: Sequence[str] = PHASES,
-                 seed: int = 0, status: Callable[[str], None] | None = None) -> dict[str, Any]:
-    """Every fault in every phase: what ``ttt-sm faults --json`` prints."""
+                 seed: int = 0, status: Callable[[str], None] | None = None, arm: str = "sim",
+                 cache: Path | None = None) -> dict[str, Any]:
+    """Every fault in every phase on `arm` (:data:`ARMS`): what ``ttt-sm faults --json`` prints."""
+    if arm not in ARMS:
+        raise FaultMatrixError(f"no arm {arm!r}; arms: {', '.join(ARMS)}")
     wall0 = time.perf_counter()
+    load0 = _load()
     gains = design_gains(params)
     cells: list[Cell] = []
     for fault in faults:
         for phase in phases:
             if status is not None:
                 status(f"faults: {fault} while {phase} ({len(cells) + 1} of {len(faults) * len(phases)})")
-            cells.append(run_cell(params, fault, phase, seed, gains))
+            cells.append(run_cell(params, fault, phase, seed, gains, arm, cache))
     detected = [c for c in cells if c.detected]
     late = [c for c in detected if c.detect_ms is not None and c.detect_ms > DETECT_TARGET_S * 1e3]
     return {
+        "arm": arm,
+        "backend": BACKENDS[arm],
         "cells": [asdict(c) for c in cells],
         "summary": {
             "cells": len(cells),
@@ -301,4 +395,13 @@ def fault_matrix(params: ArmParams, faults: Sequence[str] = TWIN_FAULTS, phases:
         },
         "seed": seed,
         "wall_time_s": round(time.perf_counter() - wall0, 2),
+        "load_average": [load0, _load()],
     }
+
+
+def _load() -> float | None:
+    """The machine's load average over the last minute (None where the system tells none)."""
+    try:
+        return round(os.getloadavg()[0], 2)
+    except (AttributeError, OSError):
+        return None

@@ -20,6 +20,14 @@ Two clocks (``pace``):
   control steps) past the step it was meant for, then it waits.  A loaded
   machine cannot make frames late, and a whole game runs as fast as the
   two processes can talk.
+
+Faults of the arm (``ttt-sm faults --arm emulator``, docs/safety.md) go in
+by a door a board has none of: :meth:`ArmEmulator.inject_fault` hands the
+emulator an :class:`ArmFault` (``ttt_sm.faults.plant.PlantFault``) that
+acts on the plant and on the sensors the firmware reads, in the emulator's
+own thread, between the plant's step and the firmware's next read.  The
+firmware's wire protocol has no fault command: the C sees a frozen
+counter, a spiking current or a stalled motor as a board would.
 """
 
 from __future__ import annotations
@@ -30,6 +38,7 @@ import select
 import threading
 import time
 from pathlib import Path
+from collections.abc import Callable
 from typing import Literal, Protocol
 
 import numpy as np
@@ -64,6 +73,22 @@ class WireTap(Protocol):
         """Bytes from the firmware, on their way to the PC."""
 
 
+class ArmFault(Protocol):
+    """A fault of the arm on the emulator's plant (``ttt_sm.faults.plant.PlantFault``), made on the plant at its onset.
+
+    :meth:`after_step` runs after each control step of the plant, before
+    the firmware's next read; :meth:`current_a` gives the current the
+    firmware reads of drive `drive` (1-3) at the plant's time `t`;
+    :meth:`clear` puts back what it changed in the plant.
+    """
+
+    def after_step(self) -> None: ...
+
+    def current_a(self, drive: int, reading: float, t: float) -> float: ...
+
+    def clear(self) -> None: ...
+
+
 class ArmEmulatorError(RuntimeError):
     """The emulator cannot do what was asked (a link path that is not ours, a bad option)."""
 
@@ -81,15 +106,18 @@ class FirmwareOnPlant:
         self._act = np.zeros(C.N_ACT)
         self._ints = self.plant.ints
         self._ps = self.plant.ps
+        #: A fault of the arm acting on the plant and the readings (None: none); set by the emulator's thread.
+        self.fault: ArmFault | None = None
 
     def read_sensors(self) -> None:
         """The plant's sensors into the firmware's input (no step)."""
-        s, ints = self.firmware.sensors, self._ints
+        s, ints, fault = self.firmware.sensors, self._ints, self.fault
         for d in range(3):
             s.counts[d] = int(ints[d, PL.PI_COUNTS])
             s.index_count[d] = int(ints[d, PL.PI_INDEX_COUNT])
             s.index_edges[d] = int(ints[d, PL.PI_INDEX_EDGES]) & 0xFFFF
-            s.current_a[d] = float(self._ps[d, PL.PS_I_MEAS])
+            current = float(self._ps[d, PL.PS_I_MEAS])
+            s.current_a[d] = current if fault is None else fault.current_a(d + 1, current, self.plant.t)
         s.servo_adc = self.plant.feedback_counts  # the twin's ADC reading of the servo's feedback wire
         s.index = sum(1 << d for d in range(3) if ints[d, PL.PI_INDEX] == 1)
 
@@ -104,6 +132,8 @@ class FirmwareOnPlant:
         self.firmware.step()
         self._act[:] = self.firmware.act
         self.plant.step(self._act)
+        if self.fault is not None:
+            self.fault.after_step()
 
 
 class ArmEmulator:
@@ -170,9 +200,7 @@ class ArmEmulator:
         self.priority_note: str | None = None
         self._truth_tx = L.Sender()
         self.truth_bytes = 0
-        ints, rpc = self.plant.ints, [d.rad_per_count for d in params.drives]
-        c0 = [float((ints[d, PL.PI_C0] + 0.5) * rpc[d]) for d in range(3)]
-        self._true_offsets = (c0[0], c0[1], c0[2])
+        self._rpc = [d.rad_per_count for d in params.drives]
         self._gate = 0  # setpoints frames seen by the gated clock
         self._until = 0  # ... which let it run to this step
         #: Tampers with the bytes between the pty and the firmware (fault injection); None passes them all.
@@ -218,6 +246,26 @@ class ArmEmulator:
         if thread is not None:
             thread.join(timeout_s)
 
+    def inject_fault(self, make: Callable[[Plant], ArmFault]) -> ArmFault:
+        """Switch a fault of the arm on now: `make` builds it on the plant, between two control steps.
+
+        Simulation only, a door into the emulator's process (a board has
+        none, and its wire protocol no fault command).  One fault at a
+        time: the one before is cleared first.
+        """
+        with self._lock:
+            self.clear_fault()
+            fault = make(self.plant)
+            self.bench.fault = fault
+            return fault
+
+    def clear_fault(self) -> None:
+        """Switch the fault of the arm off: what it changed in the plant is put back."""
+        with self._lock:
+            fault, self.bench.fault = self.bench.fault, None
+            if fault is not None:
+                fault.clear()
+
     def __enter__(self) -> ArmEmulator:
         return self.start()
 
@@ -244,18 +292,20 @@ class ArmEmulator:
                 due = int((time.monotonic() - t0) / self.dt)
                 if due - fw.steps > self.max_behind_steps:
                     self.max_behind_steps = due - fw.steps
-                while fw.steps < due and not self._stop.is_set():
-                    self.bench.step()
-                    self._note_state()
-                    self._send(fd)
+                with self._lock:  # (a fault goes in between two steps)
+                    while fw.steps < due and not self._stop.is_set():
+                        self.bench.step()
+                        self._note_state()
+                        self._send(fd)
                 if self.tap is not None:
                     self._send(fd)
             else:
                 if fw.setpoints_ok != self._gate:  # new setpoints: one more chart step past their step
                     self._gate = fw.setpoints_ok
                     self._until = fw.last_setpoint_step + fw.board.status_every
-                while fw.state == 1 and fw.steps < self._until:
-                    self.bench.step()
+                with self._lock:
+                    while fw.state == 1 and fw.steps < self._until:
+                        self.bench.step()
                 self._note_state()
                 self._send(fd)
 
@@ -305,10 +355,11 @@ class ArmEmulator:
         if self.tap is not None:
             data = self.tap.to_pc(data, time.monotonic())
         if data and self.truth:  # before the firmware's frames: the PC has it when it reads their status
-            ps, pgs = self.plant.ps, self.plant.pgs
+            ps, pgs, ints, rpc = self.plant.ps, self.plant.pgs, self.plant.ints, self._rpc
             frame = self._truth_tx.frame(L.EmuTruth(self.firmware.steps, int(self.pace == "gated"), (
                 float(ps[0, PL.PS_Q]), float(ps[1, PL.PS_Q]), float(ps[2, PL.PS_Q]), float(pgs[PL.PGS_SV_Q])),
-                self._true_offsets))
+                ((ints[0, PL.PI_C0] + 0.5) * rpc[0], (ints[1, PL.PI_C0] + 0.5) * rpc[1],
+                 (ints[2, PL.PI_C0] + 0.5) * rpc[2])))  # (live: a jumped encoder moves its offset)
             self.truth_bytes += len(frame)
             self._out += frame
         self._out += data
@@ -327,4 +378,4 @@ class ArmEmulator:
             self._out.clear()
 
 
-__all__ = ["ArmEmulator", "ArmEmulatorError", "FirmwareOnPlant", "PACES", "WireTap"]
+__all__ = ["ArmEmulator", "ArmEmulatorError", "ArmFault", "FirmwareOnPlant", "PACES", "WireTap"]

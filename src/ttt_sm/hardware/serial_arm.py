@@ -83,7 +83,9 @@ class LinkTruth:
     Simulation only, for what exists in simulation alone (the PC's whiteboard
     inked by the true pen, a drawing's precision); the charts never see it.
     It offers what :class:`ttt_sm.twin.truth.ArmTruth` offers those parts:
-    :attr:`q`, :meth:`angles`, :meth:`tool_pose`, :attr:`offsets`.
+    :attr:`q`, :meth:`angles`, :meth:`tool_pose`, :attr:`offsets`, and
+    :attr:`speed_load` (from two frames in a row: the fault matrix's
+    ``time_to_safe_ms``).
     """
 
     def __init__(self, params: ArmParams, q: tuple[float, float, float, float], offsets: tuple[float, float, float],
@@ -93,9 +95,17 @@ class LinkTruth:
         self._offsets = offsets
         #: The firmware step these angles are after.
         self.step = step
+        self._speed = (0.0, 0.0, 0.0)
 
-    def update(self, q: tuple[float, float, float, float], step: int) -> None:
+    def update(self, q: tuple[float, float, float, float], step: int,
+               offsets: tuple[float, float, float] | None = None) -> None:
+        if step > self.step:
+            h = (step - self.step) * self.params.control.dt
+            p = self._q
+            self._speed = ((q[0] - p[0]) / h, (q[1] - p[1]) / h, (q[2] - p[2]) / h)
         self._q, self.step = q, step
+        if offsets is not None:
+            self._offsets = offsets
 
     @property
     def q(self) -> np.ndarray:
@@ -113,6 +123,11 @@ class LinkTruth:
     def tool_pose(self) -> np.ndarray:
         """The true tool pose x, y, z (m), phi (rad): forward kinematics of :attr:`q`."""
         return fk(self.q, self.params.geometry)
+
+    @property
+    def speed_load(self) -> np.ndarray:
+        """True joint speeds of drives 1..3 (rad/s): the mean over the firmware steps between the last two frames."""
+        return np.array(self._speed)
 
 
 @dataclass(frozen=True)
@@ -321,7 +336,7 @@ class SerialArm:
                     if self.truth is None:
                         self.truth = LinkTruth(self.params, m.q, m.offsets, m.step)
                     else:
-                        self.truth.update(m.q, m.step)
+                        self.truth.update(m.q, m.step, m.offsets)
                 else:
                     self._replies.append(m)
 

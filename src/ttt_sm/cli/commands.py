@@ -323,21 +323,40 @@ def _choices(text: str, known: Any, option: str) -> list[str]:
     return names
 
 
+def fault_arm(text: str) -> str:
+    """The ``type`` of ``ttt-sm faults --arm``: ``sim`` or ``emulator`` (a board has no plant to put a fault in)."""
+    if text in ("sim", "emulator"):
+        return text
+    if text.startswith("serial:"):
+        raise argparse.ArgumentTypeError(f"{text[:80]!r}: faults go into a simulated plant, which an arm behind a"
+                                         " serial link has none of; choose emulator (the C firmware on the twin's"
+                                         " plant, behind a pseudo-terminal) or sim")
+    raise argparse.ArgumentTypeError(f"expected sim or emulator, got {text[:80]!r}")
+
+
 def cmd_faults(args: argparse.Namespace) -> int:
     from ..faults.matrix import fault_matrix
     from ..faults.twin import TWIN_FAULTS
+    from ..hardware.firmware import FirmwareError
 
     if args.link:
+        if args.arm is not None:
+            raise CliError(f"--arm {args.arm}: the link's faults always run against the firmware emulator in real"
+                           " time; drop --arm or --link")
         return _link_faults(args)
+    arm = args.arm or "sim"
     faults = _choices(args.only, TWIN_FAULTS, "--only") if args.only else list(TWIN_FAULTS)
     phases = [FAULT_PHASES[p] for p in _choices(args.phases, FAULT_PHASES, "--phases")] if args.phases \
         else list(FAULT_PHASES.values())
     params = load_arm(args.params)
     try:
-        report = fault_matrix(params, faults, phases, seed=args.seed, status=status_line())
+        report = fault_matrix(params, faults, phases, seed=args.seed, status=status_line(), arm=arm)
+    except (FirmwareError, OSError) as exc:
+        raise CliError(f"the firmware emulator cannot run: {exc}") from None
     finally:
         clear_status()
-    lines = [f"{'fault':15} {'phase':18} {'detected':>9} {'safe':>8} {'limits':>6} {'zone':>4} {'ink':>7}"
+    lines = [f"arm: {report['backend']}"] if arm != "sim" else []
+    lines += [f"{'fault':15} {'phase':18} {'detected':>9} {'safe':>8} {'limits':>6} {'zone':>4} {'ink':>7}"
              f" {'record':>6} {'recovered':>9}"]
     for c in report["cells"]:
         detect = f"{c['detect_ms']:.0f} ms" if c["detected"] else "no"
@@ -492,6 +511,9 @@ def register(sub: Any) -> None:
                          "current_spike,servo_stuck,power_cut,camera_lost")
     sp.add_argument("--phases", default=None, metavar="PHASES",
                     help="comma-separated phases (default all): init,field,symbol,erase")
+    sp.add_argument("--arm", type=fault_arm, default=None, metavar="sim|emulator",
+                    help="sim (default): each cell on the twin in this process; emulator: on the C firmware on the"
+                         " twin's plant (gated), over a pseudo-terminal, as ttt-sm arm serve runs it")
     sp.add_argument("--link", action="store_true",
                     help="the faults of the serial link instead (frames_lost,frames_garbled,frames_duplicated,"
                          "frames_late,frames_out_of_order,link_cut), against the firmware emulator in real time")

@@ -505,7 +505,8 @@ def register(sub: Any) -> None:
                     help="longest one initialisation may run, simulated seconds (default 40; one takes 6-12)")
     add_arm_option(sp)
     sp = add_command(sub, "faults", cmd_faults,
-                     "inject each fault of the twin in each phase and measure what the Safety chart does")
+                     "inject each fault of the arm (twin or emulator) in each phase and measure what the Safety chart"
+                     " does")
     sp.add_argument("--only", default=None, metavar="FAULTS",
                     help="comma-separated faults (default all): encoder_frozen,encoder_jump,motor_blocked,"
                          "current_spike,servo_stuck,power_cut,camera_lost")

@@ -63,10 +63,9 @@ class FaultyArm:
         s = self.sim.sensors()
         fault = self._fault
         if fault is not None and s.t < fault.spike_until:
-            d = fault.drive - 1
-            current = list(s.current_a)
-            current[d] = fault.current_a(fault.drive, current[d], s.t)
-            return s._replace(current_a=tuple(current))
+            i1, i2, i3 = s.current_a
+            return s._replace(current_a=(fault.current_a(1, i1, s.t), fault.current_a(2, i2, s.t),
+                                         fault.current_a(3, i3, s.t)))
         return s
 
     def encoder_angles(self) -> tuple[float, float, float]:

@@ -44,7 +44,8 @@ def ik_closed_form(target: Any, geometry: Geometry, elbow_up: bool = True) -> np
         lies outside the annulus the two links reach; ``residual`` is that
         shortfall in metres.
     """
-    x, y, z, phi = _as_vector(target, "target")
+    # Python floats: a huge target overflows to inf quietly (and is unreachable), numpy's would warn
+    x, y, z, phi = (float(c) for c in _as_vector(target, "target"))
     g = geometry
     u, v = x + g.l_f, y  # from the base axis
     r_sq = u * u + v * v - g.l_f**2

@@ -4,14 +4,18 @@ What Simulink shows as signal lines between Stateflow blocks, drawn from
 :data:`~ttt_sm.app.wires.ROBOT_WIRES` and :data:`~ttt_sm.app.wires.GAME_WIRES`
 with Graphviz: charts are blue blocks, the other blocks of the loop grey, and
 each arrow carries the data it feeds (``ini_23 → ini1``: the source's output,
-then the target's input where their names differ).  ``ttt-sm charts export``
-writes it as ``charts/wiring.svg`` with a section of ``charts/index.md``;
-docs/architecture.md shows the same section.
+then the target's input where their names differ).  One picture of every wire
+is four times as wide as it is tall and unreadable at a page's width, so the
+wiring is drawn in three parts (:data:`PARTS`: the drives, the game, the
+Safety chart); a block may appear in several, each wire in exactly one.
+``ttt-sm charts export`` writes them as ``charts/wiring_<part>.svg`` with a
+section of ``charts/index.md``; docs/architecture.md shows the same section.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 
 from ..charts import ALL_CHARTS
 from ..runtime.export import ExtraDiagram
@@ -41,6 +45,27 @@ COLUMNS: tuple[tuple[str, ...], ...] = (
     ("SafeState",),
 )
 
+
+
+@dataclass(frozen=True)
+class Part:
+    """One picture of the wiring: its blocks; a wire is drawn in the first part that has both its ends."""
+
+    name: str
+    title: str
+    blocks: frozenset[str]
+
+
+#: The pictures, in the order a wire looks for its part.
+PARTS: tuple[Part, ...] = (
+    Part("drives", "One chart step: the Control chart, inverse kinematics, the init charts and the drives",
+         frozenset({"FK", "Control", "IK", "Encoder", "DriveInit1", "DriveInit2", "DriveInit3", "Drives", "Homing"})),
+    Part("game", "A game: the Game chart, the AlgorithmActivator and the Control chart",
+         frozenset({"AlgorithmActivator", "Session", "Game", "EraseFlag", "Control", "Homing"})),
+    Part("safety", "The Safety chart: what it watches and what it asks of the drives",
+         frozenset({"Homing", "FK", "Monitor", "Link", "Camera", "Safety", "SafeState"})),
+)
+
 _CHART_STYLE = 'shape=box, style="rounded,filled", fillcolor="#d6e6f5", color="#3b6ea8", penwidth=1.4'
 _BLOCK_STYLE = 'shape=box, style="filled", fillcolor="#eeeeee", color="#777777"'
 
@@ -60,10 +85,27 @@ def _label(row: CheckedWire) -> str:
     return source if source == target else f"{source} → {target}"
 
 
-def wiring_dot(wires: Iterable[Wire] = (*ROBOT_WIRES, *GAME_WIRES), blocks: Sequence[Block] | None = None) -> str:
-    """Graphviz source of the wiring: one node per block, one arrow per pair of blocks, labelled per wire."""
+def part_of(source: str, target: str) -> Part:
+    """The picture a wire from block `source` to block `target` is drawn in (ValueError: none has both)."""
+    for part in PARTS:
+        if source in part.blocks and target in part.blocks:
+            return part
+    raise ValueError(f"no part of the wiring's pictures (PARTS) has both {source} and {target}: add them to one")
+
+
+def wiring_dot(wires: Iterable[Wire] = (*ROBOT_WIRES, *GAME_WIRES), blocks: Sequence[Block] | None = None,
+               part: str | None = None) -> str:
+    """Graphviz source of the wiring: one node per block, one arrow per pair of blocks, labelled per wire.
+
+    `part`: only the wires drawn in that :data:`PARTS` picture (None: every wire, in one picture).
+    """
     blocks = list(blocks) if blocks is not None else all_blocks()
     rows = check(wires, blocks)
+    if part is not None:
+        if part not in {p.name for p in PARTS}:
+            raise ValueError(f"no part {part!r} of the wiring; parts: {', '.join(p.name for p in PARTS)}")
+        rows = [r for r in rows if part_of(r.source.block, r.target.block).name == part]
+    title = next((p.title for p in PARTS if p.name == part), "How the charts are wired")
     used = {r.source.block for r in rows} | {r.target.block for r in rows}
     edges: dict[tuple[str, str], list[str]] = {}
     for row in rows:
@@ -71,7 +113,7 @@ def wiring_dot(wires: Iterable[Wire] = (*ROBOT_WIRES, *GAME_WIRES), blocks: Sequ
     lines = [
         "digraph wiring {",
         '  graph [rankdir=LR, fontname="Helvetica", nodesep=0.35, ranksep=0.9, newrank=true,'
-        ' label="How the charts are wired (ttt_sm.app.wires): blue = chart, grey = another block of the loop",'
+        f' label={_quote(title + " (ttt_sm.app.wires): blue = chart, grey = another block of the loop")},'
         " labelloc=t, fontsize=12];",
         '  node [fontname="Helvetica", fontsize=11];',
         '  edge [fontname="Helvetica", fontsize=9, color="#555555", arrowsize=0.7];',
@@ -119,8 +161,8 @@ def wiring_table(wires: Iterable[Wire], blocks: Sequence[Block] | None = None) -
     return "\n".join(lines)
 
 
-def wiring_section(svg_path: str, heading: str = "##") -> str:
-    """Markdown: the picture and the table of the robot's and a game's wires."""
+def wiring_section(directory: str = "", heading: str = "##") -> str:
+    """Markdown: the pictures (``<directory>wiring_<part>.svg``) and the table of the robot's and a game's wires."""
     return "\n".join([
         f"{heading} Wiring",
         "",
@@ -130,8 +172,7 @@ def wiring_section(svg_path: str, heading: str = "##") -> str:
         "used as a target, a unit mismatch raise `WiringError` naming the row) and compiles it into",
         "plain attribute copies run at every chart step.",
         "",
-        f"![How the charts are wired]({svg_path})",
-        "",
+        *(line for p in PARTS for line in (f"![{p.title}]({directory}wiring_{p.name}.svg)", "")),
         f"{heading}# Every robot: the init charts and the Control chart",
         "",
         wiring_table(ROBOT_WIRES),
@@ -143,6 +184,7 @@ def wiring_section(svg_path: str, heading: str = "##") -> str:
     ])
 
 
-def wiring_diagram() -> ExtraDiagram:
-    """What `ttt-sm charts export` writes beside the charts: `wiring.svg` and its index.md section."""
-    return ExtraDiagram(name="wiring", dot=wiring_dot(), section=wiring_section("wiring.svg"))
+def wiring_diagrams() -> tuple[ExtraDiagram, ...]:
+    """What `ttt-sm charts export` writes beside the charts: `wiring_<part>.svg` and their index.md section."""
+    return tuple(ExtraDiagram(name=f"wiring_{p.name}", dot=wiring_dot(part=p.name),
+                              section=wiring_section() if k == 0 else "") for k, p in enumerate(PARTS))

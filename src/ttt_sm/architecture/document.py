@@ -324,10 +324,10 @@ def conventions_section(pictures: Pictures) -> str:
 
 def wiring_section(pictures: Pictures) -> str:
     """How the charts are wired: the table of ``ttt_sm.app.wires``, drawn (the picture of charts/)."""
-    del pictures  # the picture is charts/wiring.svg, written and checked with the charts' diagrams
+    del pictures  # the pictures are charts/wiring_<part>.svg, written and checked with the charts' diagrams
     from ..app.wiring_diagram import wiring_section as section
 
-    return section("../charts/wiring.svg")
+    return section("../charts/")
 
 
 #: The sections of docs/architecture.md, in order.  Add yours here.

@@ -420,9 +420,9 @@ REPO_CHART_FORMATS = ("svg", "mermaid")
 
 def repo_chart_extras() -> tuple[ExtraDiagram, ...]:
     """What `charts export` draws beside the charts: how the application wires them."""
-    from ..app.wiring_diagram import wiring_diagram
+    from ..app.wiring_diagram import wiring_diagrams
 
-    return (wiring_diagram(),)
+    return wiring_diagrams()
 
 
 def cmd_charts(args: argparse.Namespace) -> int:

@@ -58,6 +58,34 @@ def test_previous_output_is_the_value_one_chart_tick_earlier():
     assert pen.previous_outputs() == {"X_out": 10.0, "fr_sw": False}
 
 
+class Stamp(TickChart):
+    """An event's action writes the output: ``stamp`` sets X to the tick it was handled at."""
+
+    outputs = (Data("X", "1", 0, "tick of the last stamp"),)
+
+    waiting = State(initial=True)
+    stamped = State()
+    stamp = waiting.to(stamped, on="write") | stamped.to(stamped, on="write")
+
+    def write(self) -> None:
+        self.X = self.tick_count
+
+
+def test_a_tick_with_a_posted_event_counts_and_copies_previous_values_before_the_event():
+    chart = Stamp()
+    chart.tick()
+    chart.tick()  # two quiet ticks
+    chart.post("stamp")
+    chart.tick()  # the third: X_p is copied before the event's action writes X
+    assert (chart.tick_count, chart.X_p, chart.X) == (3, 0, 3)
+    chart.post("stamp")
+    chart.tick()
+    assert (chart.tick_count, chart.X_p, chart.X) == (4, 3, 4)
+    chart.tick()  # quiet again: the previous value catches up
+    assert (chart.tick_count, chart.X_p, chart.X) == (5, 4, 4)
+    assert chart.ticks_in("stamped") == 1
+
+
 def test_reset_data_restores_defaults_and_mutable_defaults_are_not_shared():
     a, b = Pen(), Pen()
     a.go = True

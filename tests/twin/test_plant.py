@@ -236,6 +236,9 @@ def test_bad_requests_are_specific_errors(params, gains):
         sim.set_enabled(0, False)
     with pytest.raises(SimError, match="4 finite angles"):
         sim.set_setpoints([0.0, float("nan"), 0.0, 0.0])
+    for bad in ([0.0, 0.1, 0.2], [0.0, 0.1, 0.2, 0.3, 0.4], ["0.1", 0.0, 0.0, 0.0]):
+        with pytest.raises(SimError, match="4 finite angles"):
+            sim.set_setpoints(bad)  # type: ignore[arg-type]
 
 
 def test_numba_disabled_runs_the_same_kernel(params, gains, tmp_path):

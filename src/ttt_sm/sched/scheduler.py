@@ -208,7 +208,8 @@ class Scheduler:
         for stage in self.task_stages:
             stage.tick(s)
         task = s.task
-        pose = as_floats(task)
+        # a new list of numbers (as_floats, written out: this runs every chart step)
+        pose: list[float] = task.tolist() if isinstance(task, np.ndarray) else list(task)
         if pose == self._ik_pose:
             # The same pose as last step (the arm waits): IK is a function of
             # the pose and its warm start, so the answer is the last one.

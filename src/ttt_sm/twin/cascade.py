@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from math import isfinite
 
 import numpy as np
 
@@ -27,6 +28,9 @@ from . import _cascade as C
 from ._buffers import flat_view
 from .control import Gains, check_drive, setpoint_filter_row, speed_filter_alpha
 from .errors import SimError
+
+# slots of the controllers' shared state that every chart step writes
+_FR_SW, _SV_SET = C.CGS_FR_SW, C.CGS_SV_SET
 
 
 class CascadeController:
@@ -85,6 +89,10 @@ class CascadeController:
         self._csv = flat_view(self.cs)
         self._cgsv = flat_view(self.cgs)
         self._modev = flat_view(self.modes)
+        # ... at flat indices worked out once (not from the layout's names on every call)
+        n = C.WIDTH
+        self._i_raw = (C.CS_R_RAW, n + C.CS_R_RAW, 2 * n + C.CS_R_RAW)
+        self._i_offset = (C.CS_OFFSET, n + C.CS_OFFSET, 2 * n + C.CS_OFFSET)
 
     # ---- the step -------------------------------------------------------------
 
@@ -104,16 +112,21 @@ class CascadeController:
         `fr_sw` selects the slow setpoint filters (thesis' slow moves).  The
         step turns the servo angle into its PWM duty.
         """
-        if not (math.isfinite(q_des[0]) and math.isfinite(q_des[1]) and math.isfinite(q_des[2])
-                and math.isfinite(q_des[3])):
-            raise SimError(f"setpoints must be 4 finite angles (rad), got {list(q_des)!r}")
-        cs, n = self._csv, C.WIDTH
-        cs[C.CS_R_RAW] = float(q_des[0])
-        cs[n + C.CS_R_RAW] = float(q_des[1])
-        cs[2 * n + C.CS_R_RAW] = float(q_des[2])
+        try:
+            q1, q2, q3, q4 = q_des
+            finite = isfinite(q1) and isfinite(q2) and isfinite(q3) and isfinite(q4)
+        except (TypeError, ValueError):
+            finite = False
+        if not finite:
+            raise SimError(f"setpoints must be 4 finite angles (rad), got {q_des!r}")
+        # (a float64 view takes any real number as float() makes it)
+        cs, (i1, i2, i3) = self._csv, self._i_raw
+        cs[i1] = q1
+        cs[i2] = q2
+        cs[i3] = q3
         cgs = self._cgsv
-        cgs[C.CGS_FR_SW] = 1.0 if fr_sw else 0.0
-        cgs[C.CGS_SV_SET] = float(q_des[3])
+        cgs[_FR_SW] = 1.0 if fr_sw else 0.0
+        cgs[_SV_SET] = q4
 
     @property
     def servo_setpoint(self) -> float:
@@ -122,8 +135,8 @@ class CascadeController:
 
     def offset_estimates(self) -> tuple[float, float, float]:
         """The encoder offsets (rad), 0 until a drive is initialised."""
-        cs, n = self._csv, C.WIDTH
-        return cs[C.CS_OFFSET], cs[n + C.CS_OFFSET], cs[2 * n + C.CS_OFFSET]
+        cs, (i1, i2, i3) = self._csv, self._i_offset
+        return cs[i1], cs[i2], cs[i3]
 
     def set_offset_estimate(self, drive: int, offset_rad: float) -> None:
         """Set a drive's encoder offset (rad); its setpoints and speed estimate move with it.

@@ -112,6 +112,9 @@ class ArmSim:
         self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
         self._intsv, self._pgsv = self.plant.intsv, self.plant.pgsv
         self._csv = self.controller._csv
+        ni, n = P.N_PI, C.WIDTH  # the encoder counts' and the offsets' flat indices, drives 1-3
+        self._i_counts = (P.PI_COUNTS, ni + P.PI_COUNTS, 2 * ni + P.PI_COUNTS)
+        self._i_offset = (C.CS_OFFSET, n + C.CS_OFFSET, 2 * n + C.CS_OFFSET)
         # set_setpoints runs every chart step: the controller's own method, bound here, spares
         # the call a delegating method would add (the method below documents it)
         self.set_setpoints = self.controller.set_setpoints  # type: ignore[method-assign]
@@ -173,10 +176,9 @@ class ArmSim:
 
     def encoder_angles(self) -> tuple[float, float, float]:
         """What the controllers see: counts * rad_per_count + offset estimate (rad), as plain floats."""
-        di, ni, cs, n = self._intsv, P.N_PI, self._csv, C.WIDTH
-        r1, r2, r3 = self._rpc
-        return (di[P.PI_COUNTS] * r1 + cs[C.CS_OFFSET], di[ni + P.PI_COUNTS] * r2 + cs[n + C.CS_OFFSET],
-                di[2 * ni + P.PI_COUNTS] * r3 + cs[2 * n + C.CS_OFFSET])
+        di, cs = self._intsv, self._csv
+        (c1, c2, c3), (o1, o2, o3), (r1, r2, r3) = self._i_counts, self._i_offset, self._rpc
+        return di[c1] * r1 + cs[o1], di[c2] * r2 + cs[o2], di[c3] * r3 + cs[o3]
 
     def offset_estimates(self) -> tuple[float, float, float]:
         """The controllers' encoder offsets (rad), 0 until a drive is initialised."""

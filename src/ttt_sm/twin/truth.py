@@ -21,6 +21,9 @@ from . import _plant as P
 from .kinematics import fk
 from .plant import Plant
 
+# the servo's true angle in the plant's shared state (read every chart step)
+_SV_Q = P.PGS_SV_Q
+
 
 class GroundTruth(Protocol):
     """What the simulation-only parts (the whiteboard's ink, precision figures) read of ground truth.
@@ -66,6 +69,8 @@ class ArmTruth:
         self._act = act
         self._rpc = np.array([d.rad_per_count for d in params.drives])
         self._psv, self._pgsv = plant.psv, plant.pgsv
+        n = P.WIDTH  # the true angles' flat indices, drives 1-3
+        self._i_q = (P.PS_Q, n + P.PS_Q, 2 * n + P.PS_Q)
 
     @property
     def q(self) -> np.ndarray:
@@ -76,8 +81,8 @@ class ArmTruth:
 
     def angles(self) -> tuple[float, float, float, float]:
         """:attr:`q` as plain floats, for code that runs every chart step (the whiteboard)."""
-        ps, n = self._psv, P.WIDTH
-        return ps[P.PS_Q], ps[n + P.PS_Q], ps[2 * n + P.PS_Q], self._pgsv[P.PGS_SV_Q]
+        ps, (i1, i2, i3) = self._psv, self._i_q
+        return ps[i1], ps[i2], ps[i3], self._pgsv[_SV_Q]
 
     def tool_pose(self) -> np.ndarray:
         """The true tool pose x, y, z (m), phi (rad): forward kinematics of :attr:`q` (eqs. 3.17-3.25)."""

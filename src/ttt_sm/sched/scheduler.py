@@ -66,11 +66,6 @@ class Signals:
         self.ik_error = None
 
 
-def as_floats(values: np.ndarray | Sequence[float]) -> list[float]:
-    """A short vector as a new list of numbers (cheap: `tolist` for an array, a copy for a list)."""
-    return values.tolist() if isinstance(values, np.ndarray) else list(values)
-
-
 class Stage(Protocol):
     """Something ticked at the chart rate: a chart, or a plain setpoint source."""
 
@@ -208,7 +203,7 @@ class Scheduler:
         for stage in self.task_stages:
             stage.tick(s)
         task = s.task
-        # a new list of numbers (as_floats, written out: this runs every chart step)
+        # a new list of numbers (tolist for an array, a copy for a list)
         pose: list[float] = task.tolist() if isinstance(task, np.ndarray) else list(task)
         if pose == self._ik_pose:
             # The same pose as last step (the arm waits): IK is a function of

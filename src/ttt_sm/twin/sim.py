@@ -112,9 +112,9 @@ class ArmSim:
         self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
         self._intsv, self._pgsv = self.plant.intsv, self.plant.pgsv
         self._csv = self.controller._csv
-        ni, n = P.N_PI, C.WIDTH  # the encoder counts' and the offsets' flat indices, drives 1-3
+        ni = P.N_PI  # the encoder counts' flat indices, drives 1-3 (the offsets': the controller's)
         self._i_counts = (P.PI_COUNTS, ni + P.PI_COUNTS, 2 * ni + P.PI_COUNTS)
-        self._i_offset = (C.CS_OFFSET, n + C.CS_OFFSET, 2 * n + C.CS_OFFSET)
+        self._i_offset = self.controller._i_offset
         # set_setpoints runs every chart step: the controller's own method, bound here, spares
         # the call a delegating method would add (the method below documents it)
         self.set_setpoints = self.controller.set_setpoints  # type: ignore[method-assign]

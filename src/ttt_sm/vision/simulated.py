@@ -315,6 +315,7 @@ class SimulatedCamera:
         W, H = self.pose.width_px, self.pose.height_px
         self._illum = self.lighting.illumination(W, H)[:, :, None] * np.asarray(self.lighting.tint, np.float32)
         self._table = _table_top(W, H, self._rng)
+        self._noise = np.empty((H, W, 3), np.float32)  # each frame's sensor noise is drawn into it
         b = params.board
         self._surface_z = b.surface_z
         # render the board a little finer than the camera sees it near its closest point
@@ -350,20 +351,25 @@ class SimulatedCamera:
         W, H = self._size
         img = cv2.warpPerspective(top, self._H, (W, H), dst=self._table.copy(), flags=cv2.INTER_LINEAR,
                                   borderMode=cv2.BORDER_TRANSPARENT)
-        lit = img.astype(np.float32) * self._illum
+        # One float32 frame, worked on in place from here: a photo is taken while the
+        # game waits for it, and every temporary of 640x480x3 floats costs a millisecond.
+        lit = np.asarray(cv2.multiply(img, self._illum, dtype=cv2.CV_32F), np.float32)  # (no copy)
         s = self.lighting.blur_sigma_px
         if s > 0.0:
-            lit = cv2.GaussianBlur(lit, (0, 0), s)
+            cv2.GaussianBlur(lit, (0, 0), s, dst=lit)
         if self.lighting.noise_sigma > 0.0:
             # Sensor noise, independent per pixel and channel.  OpenCV's generator
             # fills a 640x480x3 frame three times faster than numpy's; seeding it
             # from this camera's own generator keeps a seed's photos reproducible.
             cv2.setRNGSeed(int(self._rng.integers(1, 2**31)))
-            noise = np.empty_like(lit)
+            noise = self._noise
             # one mean and sigma per channel: scalars would fill channel 0 only
             cv2.randn(noise, np.zeros(3), np.full(3, float(self.lighting.noise_sigma)))
             lit += noise
-        return np.clip(lit + 0.5, 0, 255).astype(np.uint8)
+        # rounded half up and clipped to 0..255 (astype truncates what the clip left non-negative)
+        lit += 0.5
+        np.clip(lit, 0, 255, out=lit)
+        return lit.astype(np.uint8)
 
     def release(self) -> None:
         """Nothing to release (the :class:`~ttt_sm.vision.camera.Camera` protocol asks for it)."""

@@ -86,19 +86,21 @@ def render(raster: InkRaster, px_per_mm: float = 4.0, grid_mm: bool = False, reg
     interp = cv2.INTER_AREA if px_per_m * res < 1 / 1.5 else cv2.INTER_LINEAR
     if sub.any():
         # coverage by robot and by hand ink (0..255) of every image pixel, in one resize
-        full = np.uint8(255)
-        two = cv2.merge([(sub == 1).view(np.uint8) * full, (sub == 2).view(np.uint8) * full])
+        # (cv2.compare writes 255 where equal: one pass over the raster per author)
+        by_robot = cv2.compare(sub, 1, cv2.CMP_EQ)  # type: ignore[call-overload]
+        by_hand = cv2.compare(sub, 2, cv2.CMP_EQ)  # type: ignore[call-overload]
+        two = cv2.merge([by_robot, by_hand])
         cover = cv2.resize(two, (W, H), interpolation=interp)
         at = cv2.findNonZero(cv2.bitwise_or(cover[:, :, 0], cover[:, :, 1]))
         if at is not None:  # blend only where there is ink: a few % of the image
             at = at.reshape(-1, 2)
-            cols, rows = at[:, 0], at[:, 1]
-            c = cover[rows, cols].astype(np.float32) / 255.0
-            under = out[rows, cols].astype(np.float32)
+            xs, ys = at[:, 0], at[:, 1]
+            c = cover[ys, xs].astype(np.float32) / 255.0
+            under = out[ys, xs].astype(np.float32)
             blended = (under * (1.0 - np.minimum(c.sum(axis=1, keepdims=True), 1.0))
                        + c[:, :1] * np.asarray(ROBOT_INK_BGR, np.float32)
                        + c[:, 1:] * np.asarray(HAND_INK_BGR, np.float32))
-            out[rows, cols] = np.clip(blended + 0.5, 0, 255).astype(np.uint8)
+            out[ys, xs] = np.clip(blended + 0.5, 0, 255).astype(np.uint8)
     if desired is not None:
         lines = []
         for line in desired:

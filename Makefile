@@ -2,6 +2,9 @@
 # what is missing first (scripts/setup.sh), so a fresh clone needs nothing else.
 PY := .venv/bin/python
 TTT := .venv/bin/ttt-sm
+# Test workers (pytest-xdist): one per CPU, at most 4.  `make test JOBS=0` runs in this process alone.
+JOBS ?= auto
+PYTEST := $(PY) -m pytest -q -n $(JOBS) --maxprocesses 4 --dist worksteal
 
 .PHONY: setup play test gui screenshots soak fuzz lint bench tune firmware clean
 
@@ -12,7 +15,7 @@ play: setup
 	$(TTT) play
 
 test: setup
-	$(PY) -m pytest -q
+	$(PYTEST)
 
 gui: setup
 	$(TTT) gui --open
@@ -23,10 +26,10 @@ screenshots: setup
 		tests/web/test_safety_reset_page.py -k "guide or whole_game or circle or blocked_drive"
 
 soak: setup
-	$(PY) -m pytest -q -m soak; rc=$$?; [ $$rc -eq 5 ] && echo "no soak tests" || exit $$rc
+	$(PYTEST) -m soak; rc=$$?; [ $$rc -eq 5 ] && echo "no soak tests" || exit $$rc
 
 fuzz: setup
-	TTT_SM_FUZZ_RANDOM=1 $(PY) -m pytest -q -m soak -k fuzz
+	TTT_SM_FUZZ_RANDOM=1 $(PYTEST) -m soak -k fuzz
 
 lint: setup
 	.venv/bin/ruff check src tests

@@ -238,8 +238,26 @@ class Wiring:
                 self._used.add(i)
         return code.function("feed_" + "_".join(charts), "")
 
+    def routes(self, chart: str, args: Sequence[str]) -> list[tuple[int, str]]:
+        """What :meth:`feed` with `args` and `flat` would write to `chart` from those blocks, as
+        (element of the flat arguments, chart datum) pairs: for compiled code that writes them itself."""
+        if chart not in self.charts:
+            raise WiringError(f"no chart named {chart} to feed; charts: {', '.join(self.charts)}")
+        code = _Code(self, args, flat=True)
+        found = []
+        for i, row in enumerate(self.rows):
+            start = code.offsets.get(f"{row.source.block}.{row.source.port}")
+            if row.target.block == chart and start is not None:
+                found.append((start + (row.source.index or 0), row.target.port))
+                self._used.add(i)
+        return found
+
+    def sources(self, chart: str) -> set[str]:
+        """The blocks (and charts) the wiring table feeds `chart`'s inputs from."""
+        return {row.source.block for row in self.rows if row.target.block == chart}
+
     def collect(self, *ports: str) -> Callable[[], Any]:
-        """A function returning what is wired to these block inputs now (a tuple for several).
+        """A function returning what is wired to these block inputs (or chart inputs) now (a tuple for several).
 
         A vector port comes back as a list, one value per element; every element must be wired.
         """
@@ -247,6 +265,14 @@ class Wiring:
         values = []
         for text in ports:
             block, _, name = text.partition(".")
+            if block in self.charts:  # a chart's input: what is wired to it (a chart's data are scalars)
+                found = [(i, row) for i, row in enumerate(self.rows)
+                         if row.target.block == block and row.target.port == name]
+                if not found:
+                    raise WiringError(f"nothing is wired to {text}")
+                self._used.add(found[0][0])
+                values.append(code.source(found[0][1]))
+                continue
             spec = self.blocks.get(block)
             port = spec.port("input", name) if spec is not None else None
             if spec is None or port is None:
@@ -298,7 +324,7 @@ class _Code:
 
     def chart(self, name: str) -> str:
         var = "d_" + name
-        self.bound[var] = vars(self.wiring.charts[name])  # the chart's data are its instance attributes
+        self.bound[var] = self.wiring.charts[name].data_mapping()  # the chart's data, read and written by name
         return var
 
     def source(self, row: CheckedWire) -> str:

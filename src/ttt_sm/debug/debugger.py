@@ -41,7 +41,7 @@ import operator
 import signal
 import threading
 from collections import deque
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -174,8 +174,8 @@ class Debugger:
         self._index = ChartIndex(dict(robot.charts))
         self._names.forget()
         # The charts' data just before the last chart tick (for data_diff): one
-        # itemgetter per chart over its instance dict, where the declared data live.
-        self._data_getters = [(name, [d.name for d in c.declarations()], c.__dict__)
+        # itemgetter per chart over its data (the instance dict, or a buffered chart's view).
+        self._data_getters = [(name, [d.name for d in c.declarations()], c.data_mapping())
                               for name, c in robot.charts.items()]
         self._getters = [(_values_of(names), d) for _, names, d in self._data_getters]
 
@@ -699,8 +699,8 @@ def _game_error(robot: Robot) -> Exception | None:
     return None if game is None or game.driver is None else game.driver.error
 
 
-def _values_of(names: Sequence[str]) -> Callable[[dict[str, Any]], tuple[Any, ...]]:
-    """A fast reader of the named values of a dict, as a tuple (one C call per chart tick)."""
+def _values_of(names: Sequence[str]) -> Callable[[Mapping[str, Any]], tuple[Any, ...]]:
+    """A fast reader of the named values of a chart's data, as a tuple (one C call per chart tick)."""
     if len(names) > 1:
         return operator.itemgetter(*names)
     return lambda d: tuple(d[n] for n in names)

@@ -84,7 +84,7 @@ class RobotNames:
                              f" e.g. {name}[1] (numbered from 1, as the joints)")
 
     def datum(self, chart: str, name: str) -> Any:
-        return self._robot().charts[chart].__dict__[name]
+        return self._robot().charts[chart].data_mapping()[name]
 
     def signal(self, name: str, index: int | None) -> Any:
         value = self._values()[name]

@@ -29,8 +29,9 @@ and cached per active configuration (see :mod:`.guards`).
 
 from __future__ import annotations
 
+from array import array
 from collections import deque
-from collections.abc import Callable, Mapping, MutableSet, Sequence
+from collections.abc import Callable, Iterator, Mapping, MutableMapping, MutableSet, Sequence
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from statemachine import StateChart
@@ -39,7 +40,7 @@ from statemachine.factory import StateMachineMetaclass
 from statemachine.state import State
 from statemachine.transition import Transition
 
-from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, check_values, collect_declarations
+from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, buffers, check_values, collect_declarations, make_slot
 from .errors import ChartDefinitionError, GuardMismatchError, TemporalLogicError, UnknownEventError
 from .guards import Guard, compile_guard
 from .structure import (
@@ -61,7 +62,8 @@ _Plan = tuple[tuple[tuple[Guard | None, str, Transition], ...], tuple[Callable[[
 
 def _plan_runner(candidates: Sequence[tuple[Guard | None, str, Transition]],
                  durings: Sequence[Callable[[], Any]],
-                 prev_pairs: Sequence[tuple[str, str]] | None = None) -> Callable[..., int]:
+                 prev_pairs: Sequence[tuple[str, str]] | None = None,
+                 slot_pairs: Sequence[tuple[int, int]] = ()) -> Callable[..., int]:
     """The tick of one configuration as straight-line code: the index of the first candidate whose guard
     holds, or -1 once every guard failed and the during actions ran.
 
@@ -73,11 +75,13 @@ def _plan_runner(candidates: Sequence[tuple[Guard | None, str, Transition]],
     steps 1 of a tick (see the module docstring) as well: counts the tick and copies
     every output to its previous value.  That is the whole tick when no event is
     queued, one call instead of three (the tick count, the copy and the guards).
+    ``slot_pairs`` are the (output, previous) places of a buffered chart's outputs in its buffer;
+    ``prev_pairs`` then names only the outputs kept as plain attributes.
     """
     lines, bound = [], {}
     if prev_pairs is not None:
         lines.append("    d['_ticks'] += 1")
-        lines += [f"    d[{prev!r}] = d[{out!r}]" for out, prev in prev_pairs]
+        lines += _copy_lines(prev_pairs, slot_pairs)
     for k, (guard, _event, _transition) in enumerate(candidates):
         if guard is None:
             lines.append(f"    return {k}")
@@ -118,16 +122,37 @@ class TickChartMeta(StateMachineMetaclass):
         cls._prev_pairs = tuple(
             (d.name, d.name + PREVIOUS_SUFFIX) for d in decls if d.kind == "output"
         )
-        cls._copy_previous = staticmethod(_previous_copier(name, cls._prev_pairs))
+        slots: dict[str, int] = {}
+        if cls.buffered:  # type: ignore[attr-defined]
+            for decl in decls:
+                if buffers(decl):
+                    names = [decl.name] + [decl.name + PREVIOUS_SUFFIX] * (decl.kind == "output")
+                    for datum in names:
+                        slots[datum] = len(slots)
+                        setattr(cls, datum, make_slot(decl, slots[datum], name, datum))
+        cls._slots = slots
+        cls._slot_prev_pairs = tuple((slots[o], slots[p]) for o, p in cls._prev_pairs if o in slots)
+        cls._dict_prev_pairs = tuple((o, p) for o, p in cls._prev_pairs if o not in slots)
+        cls._copy_previous = staticmethod(_previous_copier(name, cls._dict_prev_pairs, cls._slot_prev_pairs))
 
 
-def _previous_copier(name: str, pairs: tuple[tuple[str, str], ...]) -> Callable[[dict[str, Any]], None]:
+def _copy_lines(pairs: Sequence[tuple[str, str]], slot_pairs: Sequence[tuple[int, int]]) -> list[str]:
+    """``X_p = X`` as lines of code: plain attributes by name, a buffered chart's numbers by place."""
+    lines = [f"    d[{prev!r}] = d[{out!r}]" for out, prev in pairs]
+    if slot_pairs:
+        lines.append("    b = d['_data_view']")
+        lines += [f"    b[{prev}] = b[{out}]" for out, prev in slot_pairs]
+    return lines
+
+
+def _previous_copier(name: str, pairs: tuple[tuple[str, str], ...],
+                     slot_pairs: tuple[tuple[int, int], ...] = ()) -> Callable[[dict[str, Any]], None]:
     """``X_p = X`` for every output of a chart class, as straight-line code.
 
     It runs at the start of every tick of every chart; a loop over the pairs
     costs about a third more per output.  The names are checked identifiers.
     """
-    body = "".join(f"    d[{prev!r}] = d[{out!r}]\n" for out, prev in pairs) or "    pass\n"
+    body = "".join(line + "\n" for line in _copy_lines(pairs, slot_pairs)) or "    pass\n"
     namespace: dict[str, Any] = {}
     exec(compile("def copy_previous(d):\n" + body, f"<{name}.copy_previous>", "exec"), namespace)  # noqa: S102
     return namespace["copy_previous"]  # type: ignore[no-any-return]
@@ -229,6 +254,9 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     #: The chart's actions read ``tick_period_s`` (a per-tick step is a per-second
     #: datum times the period): building it without a period is an error.
     timed: ClassVar[bool] = False
+    #: Keep the numeric data (every datum whose default is a number or a flag) in one float buffer:
+    #: compiled code reads and writes them in place (:meth:`data_buffer`, :meth:`data_slots`).
+    buffered: ClassVar[bool] = False
     inputs: ClassVar[tuple[Data, ...]] = ()
     outputs: ClassVar[tuple[Data, ...]] = ()
     local: ClassVar[tuple[Data, ...]] = ()
@@ -247,6 +275,9 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     _structure: ClassVar[ChartStructure]
     _data_decls: ClassVar[tuple[Data, ...]] = ()
     _prev_pairs: ClassVar[tuple[tuple[str, str], ...]] = ()
+    _dict_prev_pairs: ClassVar[tuple[tuple[str, str], ...]] = ()
+    _slot_prev_pairs: ClassVar[tuple[tuple[int, int], ...]] = ()
+    _slots: ClassVar[dict[str, int]] = {}
     _copy_previous: ClassVar[Any] = staticmethod(lambda d: None)  # per chart class: see _previous_copier
 
     def __init__(
@@ -278,13 +309,17 @@ class TickChart(StateChart, metaclass=TickChartMeta):
                 " its actions turn per-second data into per-tick steps"
             )
         d["chart_name"] = chart_name or type(self).__name__
+        if self._slots:
+            d["_data_buffer"] = buffer = array("d", bytes(8 * len(self._slots)))
+            d["_data_view"] = memoryview(buffer)
         # Data must exist before the library resolves guards that name it.
         self.reset_data()
         if data:
             check_values(type(self).__name__, self._data_decls, data, set(KIND_ATTRS))
-            d.update(data)
+            for name, value in data.items():
+                setattr(self, name, value)
             for name, prev in self._prev_pairs:
-                d[prev] = d[name]
+                setattr(self, prev, getattr(self, name))
         super().__init__(listeners=[_Clock(self), *(listeners or [])], **kwargs)
         for state in self.configuration:
             self._entered_at[state.id] = 0
@@ -438,7 +473,7 @@ class TickChart(StateChart, metaclass=TickChartMeta):
             for name in state.during:
                 durings.append(getattr(self, name))
         return (tuple(candidates), tuple(durings), frozenset(active), _plan_runner(candidates, durings),
-                _plan_runner(candidates, durings, self._prev_pairs))
+                _plan_runner(candidates, durings, self._dict_prev_pairs, self._slot_prev_pairs))
 
     def guard_paths(self) -> dict[str, str]:
         """For each tick transition, whether its guard runs as a plain call (``fast``) or
@@ -462,29 +497,86 @@ class TickChart(StateChart, metaclass=TickChartMeta):
 
     def snapshot(self, kinds: tuple[str, ...] = ("input", "output", "local")) -> dict[str, Any]:
         """Current values of the declared data of the given kinds, by name."""
-        d = self.__dict__
+        d = self.data_mapping()
         return {decl.name: d[decl.name] for decl in self._data_decls if decl.kind in kinds}
 
     def previous_outputs(self) -> dict[str, Any]:
         """Each output's value one chart tick earlier, by output name."""
-        d = self.__dict__
+        d = self.data_mapping()
         return {name: d[prev] for name, prev in self._prev_pairs}
 
     def set_inputs(self, **values: Any) -> None:
         """Set inputs by name; an unknown name raises :class:`UnknownDataError`."""
         check_values(type(self).__name__, self._data_decls, values, {"input"})
-        self.__dict__.update(values)
+        self.data_mapping().update(values)
 
     def reset_data(self, kinds: tuple[str, ...] = ("input", "output", "local")) -> None:
         """Put the declared data of the given kinds back to their defaults."""
-        d = self.__dict__
         for decl in self._data_decls:
             if decl.kind in kinds:
-                d[decl.name] = decl.fresh_default()
+                setattr(self, decl.name, decl.fresh_default())
                 if decl.kind == "output":
-                    d[decl.name + PREVIOUS_SUFFIX] = decl.fresh_default()
+                    setattr(self, decl.name + PREVIOUS_SUFFIX, decl.fresh_default())
+
+    def data_mapping(self) -> MutableMapping[str, Any]:
+        """The chart's data (and each output's previous value) as a mapping by name, read and written live.
+
+        The instance's ``__dict__`` itself, where the data are plain attributes; for a
+        buffered chart, a view that reads and writes its buffer's numbers by name.
+        """
+        return self.__dict__ if not self._slots else _BufferedData(self)
+
+    def data_buffer(self) -> array:
+        """A buffered chart's float buffer (``array('d')``): :meth:`data_slots` says which datum is where.
+
+        Compiled code wraps it without a copy (``numpy.frombuffer``) and reads and writes
+        the chart's numbers in place; a flag is 1.0 or 0.0.
+        """
+        if not self._slots:
+            raise TypeError(f"{self.chart_name}: the chart is not buffered (buffered = True keeps its"
+                            " numbers in one buffer)")
+        return self.__dict__["_data_buffer"]  # type: ignore[no-any-return]
+
+    @classmethod
+    def data_slots(cls) -> dict[str, int]:
+        """Where each number of a buffered chart lies in :meth:`data_buffer`, by datum (``X_p`` too)."""
+        return dict(cls._slots)
 
 
 def entered_states(chart: StateChart, transition: Transition) -> list[State]:
     """Alias of :func:`.structure.states_entered_by`, for listeners written by users."""
     return states_entered_by(chart, transition)
+
+
+class _BufferedData(MutableMapping[str, Any]):
+    """A buffered chart's data as a mapping: a number by its slot, anything else in the instance dict."""
+
+    __slots__ = ("_chart", "_d")
+
+    def __init__(self, chart: TickChart) -> None:
+        self._chart = chart
+        self._d = chart.__dict__
+
+    def __getitem__(self, name: str) -> Any:
+        if name in self._chart._slots:
+            return getattr(self._chart, name)
+        return self._d[name]
+
+    def __setitem__(self, name: str, value: Any) -> None:
+        if name in self._chart._slots:
+            setattr(self._chart, name, value)
+        else:
+            self._d[name] = value
+
+    def __delitem__(self, name: str) -> None:
+        raise TypeError(f"{self._chart.chart_name}: a chart's data cannot be deleted ({name})")
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._chart._slots or name in self._d
+
+    def __iter__(self) -> Iterator[str]:
+        yield from self._chart._slots
+        yield from (k for k in self._d if k not in self._chart._slots)
+
+    def __len__(self) -> int:
+        return len(self._chart._slots) + sum(k not in self._chart._slots for k in self._d)

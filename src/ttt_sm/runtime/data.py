@@ -12,6 +12,14 @@ and actions read like the thesis' equations.  Every output ``X`` also has ``X_p`
 its value one chart tick earlier, so a during action writes ``X = X_p + inc``.
 A debugger, a trace or a GUI lists the declarations with :func:`declarations`
 without reading code.
+
+A chart class with ``buffered = True`` keeps its numeric data (a number or a
+flag by default: every datum but text) in one float buffer instead of plain
+attributes, each datum a :class:`Slot` of it: chart code still reads and
+writes ``chart.err_1``, and compiled code of the chart's wiring reads and
+writes the same numbers in place (:meth:`TickChart.data_buffer`,
+:meth:`TickChart.data_slots`), with no Python assignment per datum and chart
+step (docs/runtime.md, "Data in a buffer").
 """
 
 from __future__ import annotations
@@ -71,6 +79,69 @@ class Data:
         return copy.deepcopy(value)
 
 
+def buffers(decl: Data) -> bool:
+    """Whether a buffered chart keeps `decl` in its float buffer: a number or a flag by default."""
+    return type(decl.default) in (bool, int, float)
+
+
+class Slot:
+    """A datum of a buffered chart: reads and writes its place in the chart's float buffer.
+
+    A data descriptor of the chart class, so it takes the place of the plain
+    attribute; the chart instance's ``_data_view`` (a memoryview of the buffer)
+    holds the number.  A float datum reads as the float, a flag as a bool, a
+    count as an int.  Only a real number (or a bool) can be written.
+    """
+
+    __slots__ = ("name", "index", "owner")
+
+    def __init__(self, name: str, index: int, owner: str) -> None:
+        self.name = name
+        self.index = index
+        self.owner = owner
+
+    def __get__(self, instance: Any, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        return instance.__dict__["_data_view"][self.index]
+
+    def __set__(self, instance: Any, value: Any) -> None:
+        try:
+            instance.__dict__["_data_view"][self.index] = value
+        except TypeError:
+            raise TypeError(f"{self.owner}.{self.name} is a number in the chart's data buffer;"
+                            f" got {value!r} ({type(value).__name__})") from None
+
+
+class BoolSlot(Slot):
+    """A flag of a buffered chart: 1.0 or 0.0 in the buffer, True or False to read."""
+
+    __slots__ = ()
+
+    def __get__(self, instance: Any, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        return instance.__dict__["_data_view"][self.index] != 0.0
+
+
+class IntSlot(Slot):
+    """A count of a buffered chart: an exact integer in the buffer (to 2**53), an int to read."""
+
+    __slots__ = ()
+
+    def __get__(self, instance: Any, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        return int(instance.__dict__["_data_view"][self.index])
+
+
+def make_slot(decl: Data, index: int, owner: str, name: str | None = None) -> Slot:
+    """The slot of `decl` (or of its previous value `name`) at `index` of the buffer."""
+    kind = type(decl.default)
+    cls = BoolSlot if kind is bool else IntSlot if kind is int else Slot
+    return cls(name or decl.name, index, owner)
+
+
 def collect_declarations(cls: type) -> tuple[Data, ...]:
     """Read and check the data declarations of a chart class, kinds filled in.
 
@@ -112,7 +183,7 @@ def _check_name(cls: type, name: str, attr: str, seen: dict[str, str]) -> None:
     states_map = getattr(cls, "states_map", {})
     if any(getattr(s, "id", None) == name for s in states_map.values()):
         raise ChartDefinitionError(f"{where}: data name {name!r} is also a state; rename one")
-    if hasattr(cls, name):
+    if hasattr(cls, name) and not isinstance(cls.__dict__.get(name, getattr(cls, name)), Slot):
         raise ChartDefinitionError(
             f"{where}: data name {name!r} clashes with the chart attribute {cls.__name__}.{name}"
             " (a method, event or class attribute); rename one"

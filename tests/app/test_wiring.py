@@ -12,6 +12,7 @@ from ttt_sm.app.wires import BLOCKS, GAME_WIRES, INIT_WIRES, ROBOT_WIRES
 from ttt_sm.app.wiring import Wire, WiringError, chart_block, check
 from ttt_sm.charts import ALL_CHARTS
 from ttt_sm.params import load_params
+from ttt_sm.runtime.data import BoolSlot
 
 P = load_params()
 
@@ -112,7 +113,7 @@ def _plant(robot: Robot) -> tuple[dict[str, float], list[object]]:
         values[key] = value = 1000.0 + k
         port = f"{source.block}.{source.port}"
         if source.block in robot.charts:
-            vars(robot.charts[source.block])[source.port] = value
+            robot.charts[source.block].data_mapping()[source.port] = value
         elif port in arguments:
             if source.index is None:
                 arguments[port] = value
@@ -130,6 +131,19 @@ def _plant(robot: Robot) -> tuple[dict[str, float], list[object]]:
     return values, list(arguments.values())
 
 
+def _held(chart, datum: str, value: float) -> object:
+    """What `datum` of `chart` reads after `value` is written to it: a buffered chart's flag reads as a bool."""
+    if datum in chart.data_slots() and isinstance(getattr(type(chart), datum), BoolSlot):
+        return bool(value)
+    return value
+
+
+def _source_value(robot: Robot, values: dict[str, float], row) -> object:
+    source = row.source
+    value = values[str(source)]
+    return _held(robot.charts[source.block], source.port, value) if source.block in robot.charts else value
+
+
 def test_every_row_that_feeds_a_chart_copies_its_source_into_the_input(game_robot):
     robot = game_robot
     values, arguments = _plant(robot)
@@ -137,7 +151,9 @@ def test_every_row_that_feeds_a_chart_copies_its_source_into_the_input(game_robo
     rows = [r for r in robot.wiring.rows if r.target.block in robot.charts]
     assert len(rows) == 55  # 30 into the thesis' charts and the game's, 25 into the Safety chart
     for row in rows:
-        assert getattr(robot.charts[row.target.block], row.target.port) == values[str(row.source)], row.wire
+        chart = robot.charts[row.target.block]
+        expected = _held(chart, row.target.port, _source_value(robot, values, row))
+        assert getattr(chart, row.target.port) == expected, row.wire
 
 
 def test_every_row_into_another_block_is_collected_from_its_source(game_robot):
@@ -150,7 +166,7 @@ def test_every_row_into_another_block_is_collected_from_its_source(game_robot):
         value = collected[f"{row.target.block}.{row.target.port}"]
         if row.target.index is not None:
             value = value[row.target.index]
-        assert value == values[str(row.source)], row.wire
+        assert value == _source_value(robot, values, row), row.wire
 
 
 def test_a_game_is_wired_from_the_robots_table_and_the_games():

@@ -140,11 +140,25 @@ class SafetyStage:
         m[_monitor.M_GEOMETRY:_monitor.M_GEOMETRY + 5] = [g.L1, g.L2, g.L3, g.L4, g.l_f]
         m[_monitor.M_FAST_STEPS] = max(1, round(FAST_HOLD_S / c.chart_dt))
         m[_monitor.M_CHART_DT] = c.chart_dt
+        m[_monitor.M_TICK_S] = chart.tick_period_s
         enc = arm.encoder_angles()
         m[_monitor.M_R:_monitor.M_R + 3] = enc
         m[_monitor.M_P:_monitor.M_P + 3] = enc
         m[_monitor.M_OFFSET:_monitor.M_OFFSET + 3] = arm.offset_estimates()
         sensors = arm.sensors()
+        # where _monitor.step reads the arm: the simulated arm's own memory, or copies of the protocol's readings
+        inplace = getattr(arm, "readings_in_place", None)
+        if inplace is not None:
+            src = inplace()
+            self._src = (src.plant_floats, src.plant_ints, src.controller_floats)
+            self._src_ix = [*src.counts, *src.currents, src.servo_counts, *src.offsets, src.servo_setpoint]
+            m[_monitor.M_FB_CAL:_monitor.M_FB_CAL + 3] = src.servo_calibration
+            self._copied: tuple[Any, Any, Any] | None = None
+        else:
+            self._src = (np.zeros(4), np.zeros(3, dtype=np.int64), np.zeros(4))
+            self._src_ix = [0, 1, 2, 0, 1, 2, 3, 0, 1, 2, 3]  # counts, currents, servo_q; offsets, setpoint
+            m[_monitor.M_FB_CAL:_monitor.M_FB_CAL + 3] = (0.0, 0.0, 1.0)  # the reading is in rad already
+            self._copied = tuple(memoryview(a) for a in self._src)  # type: ignore[arg-type,assignment]
         m[_monitor.M_COUNTS:_monitor.M_COUNTS + 3] = sensors.counts
         m[_monitor.M_SV] = sensors.servo_rad
         m[_monitor.M_SV_RATE] = params.servo.rate_rad_s
@@ -159,16 +173,24 @@ class SafetyStage:
         self._lift_s = max(s.lift_height_m / s.lift_speed_m_s, c.chart_dt)  # how long the lift's ramp takes
         self._tripped = False
         self._reinit = False
+        self._busy = False  # a trip, a hold, a reset or the end of one to carry out: the chart ticks itself
         #: Called with (kind, data) on every trip ("safety_trip") and reset ("safety_reset").
         self.listeners: list[Callable[[str, dict[str, Any]], object]] = []
-        # the Monitor block's outputs as this chart step computed them (app/_monitor.py: OUT_*)
-        self._out: tuple[Any, ...] = (0.0,) * _monitor.N_OUT
+        # the Safety chart's numbers, in place (the chart is buffered), and where _monitor.step finds them
+        self._b = np.frombuffer(chart.data_buffer(), dtype=np.float64)
+        self._ix = np.full(_monitor.IX_PREV + 1, -1, dtype=np.int64)
+        self._chart_d = vars(chart)
+        # the configuration _monitor.step ticks (a state reference, not its name: a rename fails here)
+        self._watching = Safety.monitoring.value
+        #: The chart's quiet tick in ``monitoring`` computed with the Monitor block (``_monitor.step``);
+        #: False ticks the chart itself every chart step (the same behaviour: tests compare the two).
+        self.compiled_tick = True
         #: The ``Link`` block: the arm's own report of its link, where it has one (else True), read every tick
         #: (``link_ok``, the :class:`~ttt_sm.arm.Arm` protocol's optional surface).
         self.link_ok = True
         #: Inputs forced by a test or scenario (``Robot.set_input(..., force=True)``): name -> value.
         self.overrides: dict[str, object] = {}
-        self._feed: Callable[..., None] = not_wired
+        self._flags: Callable[[], tuple[bool, bool, bool, bool]] = not_wired  # type: ignore[assignment]
         self._outputs: Callable[[], Any] = not_wired
         self._quiet: Callable[[], tuple[bool, bool, bool]] = not_wired  # type: ignore[assignment]
         # read every chart step: bound once (an arm without a link has no link_ok: its link is always up)
@@ -179,6 +201,11 @@ class SafetyStage:
         """Each drive's commanded speed, rad/s: the rate of the model of its setpoint filter."""
         mv, dt = self._mv, self._chart_dt
         return [mv[_monitor.M_DP + i] / dt for i in range(3)]
+
+    @property
+    def _out(self) -> tuple[float, ...]:
+        """The Monitor block's outputs as this chart step computed them (app/_monitor.py: OUT_*)."""
+        return tuple(self._mv[_monitor.M_OUT:_monitor.M_OUT + _monitor.N_OUT])
 
     @property
     def err(self) -> list[float]:
@@ -195,31 +222,68 @@ class SafetyStage:
         if ports != _monitor.PORTS:
             raise WiringError(f"the Monitor and FK blocks declare {', '.join(ports)}; the compiled monitor"
                               f" (app/_monitor.py) returns {', '.join(_monitor.PORTS)}")
-        # the Monitor block's outputs, then the FK block's: the compiled monitor's tuple as it is (OUT_*)
-        self._feed = wiring.feed([self.chart.chart_name], args=("Monitor", "FK"), flat=True)
+        # where the Monitor block's outputs, then the FK block's (OUT_*), go in the chart's buffer, and what
+        # the wiring table sends to the chart's flags: _monitor.step writes them all, every chart step
+        name, slots = self.chart.chart_name, self.chart.data_slots()
+        ix = self._ix
+        for element, datum in wiring.routes(name, ("Monitor", "FK")):
+            ix[element] = slots[datum]
+        ix[_monitor.IX_FLAGS:_monitor.IX_NAMES] = [slots[f] for f in _monitor.FLAGS]
+        self._flags = wiring.collect(*(f"{name}.{f}" for f in _monitor.FLAGS))
+        flag_sources = {row.source.block for row in wiring.rows
+                        if row.target.block == name and row.target.port in _monitor.FLAGS}
+        others = wiring.sources(name) - {"Monitor", "FK"} - flag_sources
+        if others:
+            raise WiringError(f"the Safety stage writes the {name} chart's inputs from the Monitor and FK blocks and"
+                              f" its flags ({', '.join(_monitor.FLAGS)}); the wiring table also feeds it from"
+                              f" {', '.join(sorted(others))}")
+        ix[_monitor.IX_NAMES:_monitor.IX_SRC] = [slots[n] for n in _monitor.NAMES]
+        ix[_monitor.IX_SRC:_monitor.IX_PREV] = self._src_ix
+        pairs = type(self.chart)._slot_prev_pairs
+        self._ix = ix = np.concatenate([ix, [v for pair in pairs for v in pair]]).astype(np.int64)
+        ix[_monitor.IX_PREV] = len(pairs)
+        self._dict_prev = type(self.chart)._dict_prev_pairs
         self._outputs = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.lift_z",
                                        "SafeState.bridge_off", "SafeState.reinit")
         # whether there is anything to carry out: the three outputs that say so (every chart step)
         self._quiet = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.reinit")
 
     def tick(self, signals: Signals) -> None:
-        """Monitor in (one compiled call on the sensors this chart step read), chart ticked, the safe state out."""
+        """Monitor in, chart ticked, the safe state out: while the chart watches and nothing trips it,
+        one compiled call (``_monitor.step``) does the Monitor block and the chart's tick."""
         arm = self.arm
-        sensors = signals.sensors
-        assert sensors is not None
         if self._has_link:
             self.link_ok = bool(arm.link_ok)  # type: ignore[attr-defined]
-        c1, c2, c3 = sensors.counts
-        i1, i2, i3 = sensors.current_a
-        o1, o2, o3 = self._offset_estimates()
-        servo = arm.servo_setpoint
-        self._out = out = _monitor.monitor(self._m, c1, c2, c3, i1, i2, i3, o1, o2, o3, servo, sensors.servo_rad)
-        self._feed(out)
+        if self._copied is not None:  # an arm with no memory to read in place: its readings, copied
+            sensors = signals.sensors
+            assert sensors is not None
+            f, i, c = self._copied
+            i[0], i[1], i[2] = sensors.counts
+            f[0], f[1], f[2] = sensors.current_a
+            f[3] = sensors.servo_rad
+            c[0], c[1], c[2] = self._offset_estimates()
+            c[3] = arm.servo_setpoint
+        ini, failed, link, camera = self._flags()
+        d = self._chart_d
+        q = signals.q_set
+        # the chart's own tick is needed for an event, a forced input, a state but monitoring, or the end of a trip
+        quiet = (self.compiled_tick and not d["_queue"] and not self.overrides and not self._busy
+                 and getattr(d["model"], d["state_field"]) == self._watching)
+        fsrc, isrc, csrc = self._src
+        k = _monitor.step(self._m, self._b, self._ix, fsrc, isrc, csrc, ini, failed, link, camera, quiet,
+                          float(q[0]), float(q[1]), float(q[2]), bool(signals.fr_sw), float(q[3]))
+        if k == -1:  # the chart's quiet tick, done: count it, and copy what is not in the buffer
+            d["_ticks"] += 1
+            for out, prev in self._dict_prev:
+                d[prev] = d[out]
+            return
         if self.overrides:
-            vars(self.chart).update(self.overrides)
+            self.chart.data_mapping().update(self.overrides)
         self.chart.tick()
+        servo = arm.servo_setpoint
         tripped, hold, reinit = self._quiet()
-        if tripped or hold or reinit or self._tripped or self._reinit or self._pose is not None:
+        self._busy = bool(tripped or hold or reinit or self._tripped or self._reinit or self._pose is not None)
+        if self._busy:
             # a trip, a hold, a reset, or the end of one
             q_safe = self._carry_out(servo)
             if q_safe is not None:

@@ -80,6 +80,9 @@ class Safety(TickChart):
     """Watch following error, current, encoders, limits, link and camera; stop, lift, hold; reset re-initialises."""
 
     timed = True  # still_k counts seconds: the tick period per quiet tick
+    # its numbers in one buffer: the Safety stage's compiled Monitor block writes the inputs there, and
+    # computes the quiet tick in `monitoring` in place (docs/safety.md, "Cost")
+    buffered = True
     tick_period_s: float
     trips: int
 
@@ -166,7 +169,7 @@ class Safety(TickChart):
         Written out drive by drive: it runs on every chart step of a game
         (:meth:`_arm_fault` says which check failed, once it has).
         """
-        d = self.__dict__
+        d = self.data_mapping()
         if not d["link_ok"] or d["init_failed"]:
             return True
         ini = d["initialised"]
@@ -201,7 +204,7 @@ class Safety(TickChart):
         """The first failed check as (reason, drive), drive 0 for one not of a drive; None if all hold."""
         if not self.link_ok:
             return "link lost: no valid status from the arm", 0
-        d = self.__dict__
+        d = self.data_mapping()
         ini = d["initialised"]
         err_max = d["max_following_error"] if ini else d["max_following_error_init"]
         cur_max = d["max_current"] if ini else d["max_current_init"]
@@ -214,7 +217,7 @@ class Safety(TickChart):
         return None
 
     def _drive_check(self, k: int, ini: bool, err_max: float, cur_max: float) -> str | None:
-        d = self.__dict__
+        d = self.data_mapping()
         speed, current, still, err = d[f"speed_{k}"], d[f"current_{k}"], d[f"still_{k}"], d[f"err_{k}"]
         if speed > d["max_speed"]:
             return f"{_KINDS['jump'][0]} on drive {k}: {speed:.3g} rad/s > {d['max_speed']:g} rad/s"
@@ -296,7 +299,7 @@ class Safety(TickChart):
     def _count_still(self) -> None:
         """still_k: how long drive k's encoder has run at most stall_ratio of its commanded speed (0 while
         initialising); servo_off: how long the servo's feedback has been off its model."""
-        d = self.__dict__
+        d = self.data_mapping()
         # while initialising, only a silent encoder counts: the searches push their stops on purpose
         dt, moving, ratio = self.tick_period_s, d["moving_speed"], d["stall_ratio"] if d["initialised"] else 0.0
         c1, c2, c3 = abs(d["cmd_speed_1"]), abs(d["cmd_speed_2"]), abs(d["cmd_speed_3"])

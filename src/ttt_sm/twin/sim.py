@@ -63,6 +63,28 @@ class Trace:
     speed_meas: np.ndarray  # (n, 3) rad/s, filtered encoder derivative
 
 
+@dataclass(frozen=True)
+class ReadingsInPlace:
+    """The simulated arm's readings where they live (:meth:`ArmSim.readings_in_place`).
+
+    ``plant_floats[currents[k]]`` is drive k's measured current (A), ``plant_ints[counts[k]]`` its
+    encoder count, ``controller_floats[offsets[k]]`` its offset estimate (rad),
+    ``controller_floats[servo_setpoint]`` the servo's last setpoint (rad), and the servo's feedback
+    reads ``a0 + (plant_floats[servo_counts] - c0) * inv_k`` rad with ``servo_calibration = (a0, c0, inv_k)``.
+    The arrays are views: they change as the arm steps.
+    """
+
+    plant_floats: np.ndarray
+    plant_ints: np.ndarray
+    controller_floats: np.ndarray
+    counts: tuple[int, ...]
+    currents: tuple[int, ...]
+    servo_counts: int
+    offsets: tuple[int, ...]
+    servo_setpoint: int
+    servo_calibration: tuple[float, float, float]
+
+
 class ArmSim:
     """The simulated arm: cascade controllers and plant, stepped at the control rate.
 
@@ -173,6 +195,26 @@ class ArmSim:
         (Each arm binds :meth:`~ttt_sm.twin.plant.Plant.sensors` in its place, as :meth:`set_setpoints`.)
         """
         return self.plant.sensors()
+
+    def readings_in_place(self) -> ReadingsInPlace:
+        """Where :meth:`sensors`, :meth:`offset_estimates` and :attr:`servo_setpoint` read their numbers.
+
+        For compiled code that reads them itself every chart step (the Safety stage's
+        Monitor block, docs/safety.md "Cost"): the plant's and the controller's memory,
+        flat, and the places in it.  An arm that is no simulation has no such memory
+        (the protocol's methods are what it offers).
+        """
+        pf, pi, cf = self._pf.reshape(-1), self._pi.reshape(-1), self._cf.reshape(-1)
+        pw, cw = P.WIDTH, C.WIDTH
+        a0, c0, inv_k = self.plant._fb
+        return ReadingsInPlace(
+            pf, pi, cf,
+            counts=tuple(d * P.N_PI + P.PI_COUNTS for d in range(3)),
+            currents=tuple((P.PR_PS + d) * pw + P.PS_I_MEAS for d in range(3)),
+            servo_counts=P.PR_PGS * pw + P.PGS_FB_COUNTS,
+            offsets=tuple((C.CR_CS + d) * cw + C.CS_OFFSET for d in range(3)),
+            servo_setpoint=C.CR_CGS * cw + C.CGS_SV_SET,
+            servo_calibration=(a0, c0, inv_k))
 
     def encoder_angles(self) -> tuple[float, float, float]:
         """What the controllers see: counts * rad_per_count + offset estimate (rad), as plain floats."""

@@ -35,9 +35,9 @@ def _same(a: dict[str, object], b: dict[str, object]) -> bool:
 
 
 def test_the_compiled_quiet_tick_decides_and_does_what_the_charts_tick_does() -> None:
-    """Random readings, thresholds, timers and flags: where the compiled step says nothing fires, the chart's
-    own tick takes no transition and leaves every datum as the step left it; where it says a guard holds,
-    the chart's own tick leaves ``monitoring``."""
+    """Random readings, thresholds, timers and flags (1,200 cases): where the compiled step says nothing
+    fires, the chart's own tick takes no transition and leaves every datum as the step left it; where it
+    says a guard holds, the chart's own tick leaves ``monitoring``."""
     robot = Robot(P, seed=0)
     robot.run_for(0.2)
     stage, chart = robot.safety_stage, robot.safety
@@ -47,7 +47,7 @@ def test_the_compiled_quiet_tick_decides_and_does_what_the_charts_tick_does() ->
     defaults = {name: getattr(chart, name) for name in THRESHOLDS}
     angles = counts * base[_monitor.M_RPC:_monitor.M_RPC + 3] + base[_monitor.M_OFFSET:_monitor.M_OFFSET + 3]
     outcomes: Counter[str] = Counter()
-    for _ in range(2000):
+    for _ in range(1200):
         data = {name: float(v * rng.uniform(0.2, 1.8)) for name, v in defaults.items()}
         data.update({name: float(rng.choice([0.0, rng.uniform(0.0, 0.035)])) for name in TIMERS})
         for k, q in enumerate(angles, start=1):  # joint limits near where the encoders read
@@ -61,9 +61,9 @@ def test_the_compiled_quiet_tick_decides_and_does_what_the_charts_tick_does() ->
         m[_monitor.M_P:_monitor.M_P + 3] += rng.normal(0.0, 0.02, 3)
         m[_monitor.M_DP:_monitor.M_DP + 3] = rng.normal(0.0, 0.004, 3)
         m[_monitor.M_FAST:_monitor.M_FAST + 3] = rng.integers(0, 2, 3)
-        c = counts + rng.integers(-40, 40, 3) * rng.choice([1, 8], 3, p=[0.9, 0.1])
+        c = counts + rng.integers(-40, 40, 3) * rng.choice([1, 8], 3, p=[0.8, 0.2])
         i = rng.normal(0.0, 2.5, 3)
-        flags = [bool(rng.random() < p) for p in (0.8, 0.03, 0.97, 0.97)]  # initialised, init_failed, link, camera
+        flags = [bool(rng.random() < p) for p in (0.8, 0.06, 0.97, 0.97)]  # initialised, init_failed, link, camera
         u = rng.normal(0.0, 0.5, 4)
         # the readings, as an arm without memory to read in place gives them (no calibration: rad already)
         m[_monitor.M_FB_CAL:_monitor.M_FB_CAL + 3] = (0.0, 0.0, 1.0)
@@ -89,7 +89,7 @@ def test_the_compiled_quiet_tick_decides_and_does_what_the_charts_tick_does() ->
         for name in TIMERS:  # the next case starts from its own data
             setattr(chart, name, 0.0)
     # every guard of monitoring fired, and the quiet tick was checked often
-    assert outcomes["quiet"] > 300, outcomes
+    assert outcomes["quiet"] > 200, outcomes
     for reason in ("encoder jumped", "overcurrent", "encoder stalled while commanded to move", "following error",
                    "joint limit", "link lost", "initialisation gave up", "camera lost", "servo stuck"):
         assert outcomes[reason] > 5, (reason, outcomes)

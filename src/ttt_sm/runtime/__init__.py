@@ -9,21 +9,29 @@ from .chart import TickChart, TickChartMeta
 from .data import Data
 from .errors import (
     ChartDefinitionError,
+    ChartExecutionError,
     GraphvizMissingError,
-    GuardMismatchError,
     TemporalLogicError,
     UnknownDataError,
     UnknownEventError,
 )
-from .structure import ChartStructure, StateInfo, TransitionInfo, priority_conflicts, states_entered_by
-from .temporal import after, after_s
+from .structure import ChartStructure, StateInfo, TransitionInfo, states_entered_by
+from .junction import Junction
+from .state_actions import action_on
+from .temporal import after, after_s, at, before, duration, every
 
 __all__ = [
     "ChartDefinitionError",
+    "ChartExecutionError",
+    "Junction",
+    "action_on",
+    "at",
+    "before",
+    "duration",
+    "every",
     "ChartStructure",
     "Data",
     "GraphvizMissingError",
-    "GuardMismatchError",
     "StateInfo",
     "TemporalLogicError",
     "TickChart",
@@ -33,6 +41,5 @@ __all__ = [
     "UnknownEventError",
     "after",
     "after_s",
-    "priority_conflicts",
     "states_entered_by",
 ]

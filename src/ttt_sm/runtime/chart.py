@@ -1,30 +1,26 @@
-"""TickChart: a python-statemachine ``StateChart`` with Stateflow's clock.
+"""TickChart: a python-statemachine ``StateChart`` run with Stateflow's semantics and clock.
 
 A chart is written like any python-statemachine chart — states as attributes,
 ``source.to(target, cond=..., on=...)``, callbacks by name — and reads like its
-diagram.  Two kinds of transition:
+diagram.  The runtime (:mod:`.engine`) executes it as Stateflow executes a
+chart: one **wake-up** per tick (or per event), outer transitions of the
+active state first, then its during and ``on`` actions, its inner
+transitions, its active children (docs/runtime.md, "One wake-up").
 
-* **tick transitions**: written without an event (``off.to(on, cond="switch")``).
-  Stateflow's eventless transitions: tried on every chart tick, guard only.
-* **event transitions**: assigned to an event name (``button = off.to(on)``),
-  taken when that event, posted from outside with :meth:`TickChart.post`, is
-  handled at the next tick.
+* a transition **without an event** (``off.to(on, cond="switch")``) is tried at
+  every wake-up: Stateflow's eventless transition;
+* a transition **with an event** (``button = off.to(on)``) only when that event
+  wakes the chart: :meth:`TickChart.post` queues it for the next tick,
+  :meth:`TickChart.send` wakes the chart on it now (from an action: a local
+  event, handled at once).
 
-One :meth:`TickChart.tick`:
+One :meth:`TickChart.tick`: outputs are copied to ``<name>_p`` (their value one
+chart tick earlier), then the chart wakes once for each event posted since the
+last tick, in order, or once with no event if none was posted.
 
-1. outputs are copied to ``<name>_p`` (their value one chart tick earlier; the
-   copies are straight-line code made per chart class);
-2. the events posted since the last tick are sent to the library, in order;
-3. the tick transitions of the active states are tried in Stateflow order
-   (outermost state first; within a state, outer transitions then inner ones,
-   each in declaration order).  The first whose guard holds is taken through the
-   library — exit actions, transition action, entry actions, listeners — and the
-   tick ends: at most one tick transition per tick;
-4. if none was taken, the during actions (``during_<state>`` methods) of the
-   active states run, outermost first.
-
-A quiet tick (step 4) never calls ``send()``: guards are compiled to plain calls
-and cached per active configuration (see :mod:`.guards`).
+A quiet tick (no transition taken) never builds event data: the guards and
+actions of the active configuration run as one generated function, cached per
+configuration (the *plan*).
 """
 
 from __future__ import annotations
@@ -32,17 +28,21 @@ from __future__ import annotations
 from array import array
 from collections import deque
 from collections.abc import Callable, Iterator, Mapping, MutableMapping, MutableSet, Sequence
+from functools import partial
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from statemachine import StateChart
+from statemachine.engines.sync import SyncEngine
 from statemachine.exceptions import StateMachineError
 from statemachine.factory import StateMachineMetaclass
 from statemachine.state import State
 from statemachine.transition import Transition
 
 from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, buffers, check_values, collect_declarations, make_slot
-from .errors import ChartDefinitionError, GuardMismatchError, TemporalLogicError, UnknownEventError
-from .guards import Guard, compile_guard
+from .engine import EarlyReturn, Execution
+from .errors import ChartDefinitionError, TemporalLogicError, UnknownEventError
+from .guards import Guard, compile_condition, compile_guard
+from .program import Node, Program, Seg, build_program
 from .structure import (
     DURING_PREFIX,
     ChartStructure,
@@ -50,50 +50,67 @@ from .structure import (
     states_entered_by,
     tag_tick_transitions,
 )
-from .temporal import temporal_of
+from .temporal import DurationSpec, Temporal, duration_of, temporal_of
 
 _NO_PLAN = object()
-# What a tick does in one configuration: the tick transitions to try (in order),
-# the during actions, the active state ids, both run as one function (_plan_runner), and
-# the whole quiet-queue tick as one function: the count, the previous values, then both.
-_Plan = tuple[tuple[tuple[Guard | None, str, Transition], ...], tuple[Callable[[], Any], ...], frozenset[str],
-              Callable[[], int], Callable[[dict[str, Any]], int]]
+#: The key of the chart's own clock in ``_entered_at``: temporal logic on a junction outside every state.
+_CHART_CLOCK = "<chart>"
+#: Where a plan hands over to the interpreter: the states from the top down to the one whose
+#: transition held, the phase ("outer" or "inner") and the transition's place in that list.
+_Resume = tuple[tuple[Node, ...], str, int]
 
 
-def _plan_runner(candidates: Sequence[tuple[Guard | None, str, Transition]],
-                 durings: Sequence[Callable[[], Any]],
-                 prev_pairs: Sequence[tuple[str, str]] | None = None,
-                 slot_pairs: Sequence[tuple[int, int]] = ()) -> Callable[..., int]:
-    """The tick of one configuration as straight-line code: the index of the first candidate whose guard
-    holds, or -1 once every guard failed and the during actions ran.
+class _Plan:
+    """What a quiet tick does in one configuration, as generated functions (see :func:`_plan_runner`)."""
 
-    ``if g0(): return 0 ... d0(); return -1``: a loop over the candidates and the
-    durings costs about a third more, and it runs on every tick of every chart.
-    A candidate without a guard is taken unconditionally (nothing after it runs).
+    __slots__ = ("active", "run", "run_tick", "resume")
 
-    With ``prev_pairs`` the function takes the chart's ``__dict__`` and first does
-    steps 1 of a tick (see the module docstring) as well: counts the tick and copies
-    every output to its previous value.  That is the whole tick when no event is
-    queued, one call instead of three (the tick count, the copy and the guards).
-    ``slot_pairs`` are the (output, previous) places of a buffered chart's outputs in its buffer;
-    ``prev_pairs`` then names only the outputs kept as plain attributes.
+    def __init__(self, active: frozenset[str], run: Callable[[dict[str, Any]], int],
+                 run_tick: Callable[[dict[str, Any]], int], resume: Sequence[_Resume]) -> None:
+        self.active = active
+        self.run = run
+        self.run_tick = run_tick
+        self.resume = tuple(resume)
+
+
+def _plan_runner(steps: Sequence[tuple[str, Any]], prev_pairs: Sequence[tuple[str, str]] | None = None,
+                 slot_pairs: Sequence[tuple[int, int]] = ()) -> Callable[[dict[str, Any]], int]:
+    """A quiet wake-up of one configuration as straight-line code: the index of the first
+    transition whose guard holds, or -1 once every step ran.
+
+    ``steps`` are, in Stateflow's order, ``("guard", (k, fn))``: return ``k`` if
+    ``fn()`` holds (``fn`` None: always); ``("act", (node, fn))``: note the state
+    whose action runs (for an event it sends) and call ``fn()``.  A loop over the
+    steps costs about a third more, and it runs on every tick of every chart.
+
+    With ``prev_pairs`` the function first counts the tick and copies every output
+    to its previous value (the whole tick when no event is queued, in one call).
+    ``slot_pairs`` are the (output, previous) places of a buffered chart's outputs in
+    its buffer; ``prev_pairs`` then names only the outputs kept as plain attributes.
     """
     lines, bound = [], {}
     if prev_pairs is not None:
         lines.append("    d['_ticks'] += 1")
         lines += _copy_lines(prev_pairs, slot_pairs)
-    for k, (guard, _event, _transition) in enumerate(candidates):
-        if guard is None:
-            lines.append(f"    return {k}")
-            break
-        bound[f"g{k}"] = guard
-        lines += [f"    if g{k}():", f"        return {k}"]
+    acted = False
+    for n, (kind, item) in enumerate(steps):
+        if kind == "guard":
+            k, fn = item
+            if fn is None:
+                lines.append(f"    return {k}")
+                break
+            bound[f"g{n}"] = fn
+            lines += [f"    if g{n}():", f"        return {k}"]
+        else:
+            node, fn = item
+            bound[f"n{n}"], bound[f"a{n}"] = node, fn
+            lines += [f"    d['_cur'] = n{n}", f"    a{n}()"]
+            acted = True
     else:
-        for k, during in enumerate(durings):
-            bound[f"d{k}"] = during
-            lines.append(f"    d{k}()")
+        if acted:
+            lines.append("    d['_cur'] = None")
         lines.append("    return -1")
-    args = ", ".join(["d"] * (prev_pairs is not None) + [f"{name}={name}" for name in bound])
+    args = ", ".join(["d"] + [f"{name}={name}" for name in bound])
     namespace: dict[str, Any] = dict(bound)
     exec(compile(f"def run_plan({args}):\n" + "\n".join(lines) + "\n", "<tick plan>", "exec"),  # noqa: S102
          namespace)
@@ -111,8 +128,8 @@ class TickChartMeta(StateMachineMetaclass):
         structure = build_structure(cls)  # type: ignore[arg-type]
         decls = collect_declarations(cls)
         _check_during_names(cls, structure)
-        _check_temporal_guards(cls, structure)
         cls._structure = structure
+        cls._program = build_program(cls, structure)
         events = getattr(cls, "_events", {})
         for state in structure.states:
             # (a state named like an event is reached through the event, as in the library)
@@ -169,18 +186,6 @@ def _check_during_names(cls: type, structure: ChartStructure) -> None:
                 )
 
 
-def _check_temporal_guards(cls: type, structure: ChartStructure) -> None:
-    for info in structure.transitions:
-        if info.kind == "event":
-            for spec in info.transition.cond:
-                if temporal_of(spec.func) is not None:
-                    raise ChartDefinitionError(
-                        f"{cls.__name__}: {info.label}: temporal guards belong on tick transitions"
-                        " (written without an event); an event transition is only tried when"
-                        " its event arrives"
-                    )
-
-
 class _StateName:
     """A chart class's attribute named after a state: reads as the state, refuses assignment.
 
@@ -207,27 +212,7 @@ class _StateName:
             f"State overriding is not allowed. Trying to add {value!r} to {self.name}")
 
 
-class _Clock:
-    """Internal listener: records when states are (re-)entered and which transitions ran.
-
-    It uses ``after_transition`` rather than ``on_enter_state`` so that the
-    library's own instance diagrams do not list a hook on every state.
-    """
-
-    def __init__(self, chart: TickChart) -> None:
-        self.chart = chart
-
-    def after_transition(self, transition: Transition) -> None:
-        chart = self.chart
-        now = chart._ticks
-        entered_at = chart._entered_at
-        for state in states_entered_by(chart, transition):
-            entered_at[state.id] = now
-        if chart._recording:
-            chart._taken.append(transition)
-
-
-class TickChart(StateChart, metaclass=TickChartMeta):
+class TickChart(Execution, StateChart, metaclass=TickChartMeta):
     """Base class of a Stateflow-style chart: subclass it and declare states and data.
 
     Parameters
@@ -270,9 +255,9 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     _plan: _Plan | None
     _guards: dict[int, Guard | None]
     _taken: list[Transition]
-    _recording: bool
 
     _structure: ClassVar[ChartStructure]
+    _program: ClassVar[Program]
     _data_decls: ClassVar[tuple[Data, ...]] = ()
     _prev_pairs: ClassVar[tuple[tuple[str, str], ...]] = ()
     _dict_prev_pairs: ClassVar[tuple[tuple[str, str], ...]] = ()
@@ -291,14 +276,28 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     ) -> None:
         d = self.__dict__
         d["_ticks"] = 0
-        d["_entered_at"] = {}
+        d["_entered_at"] = {_CHART_CLOCK: 0}
         d["_queue"] = deque()
         d["_plans"] = {}
         d["_plan_key"] = _NO_PLAN
         d["_plan"] = None
         d["_guards"] = {}
         d["_taken"] = []
-        d["_recording"] = False
+        # the engine's own (docs: engine.Execution)
+        d["_active"] = set()
+        d["_counts"] = {}
+        d["_since"] = {}
+        d["_recorded"] = {}
+        d["_runners"] = {}
+        d["_frames"] = []
+        d["_event"] = None
+        d["_event_kwargs"] = {}
+        d["_stepping"] = 0
+        d["_depth"] = 0
+        d["_cur"] = None
+        d["_entered_log"] = []
+        d["_entered_path"] = ((), [])
+        d["_durations"] = {}
         if tick_period_s is not None:
             if not tick_period_s > 0:
                 raise ValueError(f"tick_period_s must be > 0 s, got {tick_period_s!r}")
@@ -320,9 +319,19 @@ class TickChart(StateChart, metaclass=TickChartMeta):
                 setattr(self, name, value)
             for name, prev in self._prev_pairs:
                 setattr(self, prev, getattr(self, name))
-        super().__init__(listeners=[_Clock(self), *(listeners or [])], **kwargs)
-        for state in self.configuration:
-            self._entered_at[state.id] = 0
+        super().__init__(listeners=list(listeners or []), **kwargs)
+        # The library's engine does not start the chart (_Engine.start): the runtime enters
+        # it with Stateflow's default transitions, running entry actions and listeners.
+        self._activate()
+
+    def _get_engine(self) -> SyncEngine:
+        return _Engine(self)
+
+    def add_listener(self, *listeners: Any) -> Any:
+        """Attach listeners (python-statemachine's ``add_listener``); the runtime looks callbacks up again."""
+        result = super().add_listener(*listeners)
+        self._forget_runners()
+        return result
 
     if TYPE_CHECKING:
         # Declared data are instance attributes made from ``inputs``/``outputs``/``local``;
@@ -340,24 +349,93 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     # -- the clock ---------------------------------------------------------
 
     def tick(self) -> Transition | None:
-        """Advance the chart by one chart tick; return the tick transition taken, if any."""
+        """Advance the chart by one chart tick; return the first transition taken, if any.
+
+        The chart wakes once per event posted since the last tick, in order, or
+        once with no event when none was posted.
+        """
         d = self.__dict__
         if d["_queue"]:
             d["_ticks"] += 1
             self._copy_previous(d)
-            self._handle_posted_events()  # they may change the configuration
-            raw = getattr(d["model"], d["state_field"])
-            plan = d["_plan"] if raw is d["_plan_key"] else self._load_plan(raw)
-            k = plan[3]()  # the guards in order, then the durings if none held
-        else:
-            raw = getattr(d["model"], d["state_field"])
-            plan = d["_plan"] if raw is d["_plan_key"] else self._load_plan(raw)
-            k = plan[4](d)  # the count and previous values, then as plan[3]
+            d["_taken"].clear()
+            queue = d["_queue"]
+            # only those posted before this tick: an event posted by an action waits for the next one
+            for _ in range(len(queue)):
+                event, data = queue.popleft()
+                self._wake(event, data)
+            taken = d["_taken"]
+            return taken[0] if taken else None
+        raw = getattr(d["model"], d["state_field"])
+        plan = d["_plan"] if raw is d["_plan_key"] else self._load_plan(raw)
+        try:
+            k = plan.run_tick(d)  # the count and previous values, then the quiet wake-up
+        except EarlyReturn:
+            d["_cur"] = None
+            return None
+        except BaseException:
+            d["_cur"] = None
+            raise
         if k < 0:
             return None
-        _, event, transition = plan[0][k]
-        self._take(event, transition)
-        return transition
+        d["_cur"] = None
+        d["_taken"].clear()
+        self._resume(plan.resume[k])
+        taken = d["_taken"]
+        return taken[0] if taken else None
+
+    def _resume(self, resume: _Resume) -> None:
+        """Go on with a wake-up where the plan found a transition whose guard holds."""
+        chain, phase, index = resume
+        d = self.__dict__
+        d["_stepping"] += 1
+        try:
+            self._exec(chain[-1], phase, index, held=True)
+            # the parallel regions after the one that took the transition still run their step
+            for parent, child in zip(reversed(chain[:-1]), reversed(chain[1:]), strict=True):
+                if parent.parallel and parent.id in d["_active"]:
+                    self._exec_children(parent, after=child)
+        finally:
+            d["_stepping"] -= 1
+
+    def send(self, event: str, *args: Any, **data: Any) -> None:  # type: ignore[override]
+        """Wake the chart on `event` now; from an action, broadcast it as a local event.
+
+        ``self.send("E")`` in an action is Stateflow's ``send(E)``: the whole chart
+        handles E at once, as a nested wake-up, and the action goes on after it
+        (unless the broadcast made its state inactive: early return).
+        ``self.send("E", "B")`` sends it to state ``B`` and what is inside it only
+        (a directed broadcast; nothing happens if B is not active).  From outside
+        a tick, ``chart.send("E")`` is one wake-up on the input event E, now, that
+        does not advance chart time (:meth:`post` queues it for the next tick).
+        The keyword arguments are the event's data, as with :meth:`post`.
+        """
+        if event not in self._structure.user_events:
+            raise UnknownEventError(
+                f"{self.chart_name}: no transition handles event {event!r};"
+                f" events: {', '.join(self._structure.user_events) or '(none)'}"
+            )
+        receiver = None
+        if args:
+            if len(args) > 1:
+                raise TypeError(f"send({event!r}, state): one state to send to, got {args!r}")
+            name = args[0].id if isinstance(args[0], State) else args[0]
+            receiver = self._program.nodes.get(name)
+            if receiver is None or not receiver.is_state:
+                raise UnknownEventError(f"{self.chart_name}: send({event!r}, {name!r}): no state {name!r}")
+        d = self.__dict__
+        if d["_stepping"] or d["_cur"] is not None:
+            if not d["_frames"] and d["_cur"] is not None:
+                d["_frames"].append(("during", d["_cur"], None))
+                try:
+                    self._broadcast(event, receiver, data)
+                finally:
+                    d["_frames"].pop()
+            else:
+                self._broadcast(event, receiver, data)
+            return
+        d["_taken"].clear()
+        self._wake(event, data, receiver)
 
     @property
     def active_ids(self) -> frozenset[str]:
@@ -366,11 +444,11 @@ class TickChart(StateChart, metaclass=TickChartMeta):
         d = self.__dict__
         raw = getattr(d["model"], d["state_field"])
         if raw is d["_plan_key"]:
-            return d["_plan"][2]
-        return self._load_plan(raw)[2]
+            return d["_plan"].active  # type: ignore[no-any-return]
+        return self._load_plan(raw).active
 
     def run_ticks(self, n: int) -> int:
-        """Tick ``n`` times; return how many tick transitions were taken."""
+        """Tick ``n`` times; return how many ticks took a transition."""
         return sum(self.tick() is not None for _ in range(n))
 
     def post(self, event: str, **data: Any) -> None:
@@ -421,30 +499,6 @@ class TickChart(StateChart, metaclass=TickChartMeta):
         state_id = state if isinstance(state, str) else state.id
         return self._ticks - self._entered_at[state_id]
 
-    def _handle_posted_events(self) -> None:
-        queue = self._queue
-        # Only those posted before this tick: an action that posts waits for the next one.
-        for _ in range(len(queue)):
-            event, data = queue.popleft()
-            self.send(event, **data)
-
-    def _take(self, event: str, transition: Transition) -> None:
-        d = self.__dict__
-        taken = d["_taken"]
-        taken.clear()
-        d["_recording"] = True
-        try:
-            self.send(event)
-        finally:
-            d["_recording"] = False
-        if transition not in taken:
-            info = self._structure.info(transition)
-            raise GuardMismatchError(
-                f"{self.chart_name}: the guard of '{info.label}' held on the fast path but"
-                " python-statemachine did not take the transition; guards must be pure"
-                " functions of the chart's inputs and data (no side effects, no event data)"
-            )
-
     def _load_plan(self, raw: Any) -> _Plan:
         d = self.__dict__
         key = frozenset(raw) if isinstance(raw, MutableSet) else raw
@@ -457,30 +511,123 @@ class TickChart(StateChart, metaclass=TickChartMeta):
         return plan
 
     def _build_plan(self) -> _Plan:
-        active = set(self.configuration_values)
-        guards = self._guards
-        candidates: list[tuple[Guard | None, str, Transition]] = []
-        durings: list[Callable[[], Any]] = []
-        for state in self._structure.states:
-            if state.id not in active:
-                continue
-            for info in self._structure.tick_by_state[state.id]:
-                t = info.transition
-                if id(t) not in guards:
-                    guards[id(t)] = compile_guard(self, t)[0]
-                assert info.tick_event is not None
-                candidates.append((guards[id(t)], info.tick_event, t))
-            for name in state.during:
-                durings.append(getattr(self, name))
-        return (tuple(candidates), tuple(durings), frozenset(active), _plan_runner(candidates, durings),
-                _plan_runner(candidates, durings, self._dict_prev_pairs, self._slot_prev_pairs))
+        """The quiet wake-up of the active configuration, in Stateflow's order (see :mod:`.engine`)."""
+        active = self.__dict__["_active"]
+        steps: list[tuple[str, Any]] = []
+        resume: list[_Resume] = []
+        if self._program.has_durations:
+            steps.append(("act", (None, self._sample_durations)))
+
+        def transitions(chain: tuple[Node, ...], segs: Sequence[Seg], phase: str) -> bool:
+            for i, seg in enumerate(segs):
+                if seg.events is not None:
+                    continue  # only an event wakes it
+                guard = self._guard_of(seg)
+                steps.append(("guard", (len(resume), guard)))
+                resume.append((chain, phase, i))
+                if guard is None:
+                    return True  # always taken: nothing after it runs
+            return False
+
+        def walk(chain: tuple[Node, ...]) -> bool:
+            node = chain[-1]
+            if transitions(chain, node.outer, "outer"):
+                return True
+            if node.actions:
+                steps.append(("act", (node, partial(self._during, node))))
+            elif node.during is not None:
+                steps.append(("act", (node, getattr(self, node.during))))
+            if transitions(chain, node.inner, "inner"):
+                return True
+            for child in node.children:
+                if child.id in active:
+                    if walk((*chain, child)):
+                        return True
+                    if not node.parallel:
+                        break
+            return False
+
+        for node in self._program.top:
+            if node.id in active:
+                walk((node,))
+                break
+        return _Plan(frozenset(active), _plan_runner(steps),
+                     _plan_runner(steps, self._dict_prev_pairs, self._slot_prev_pairs), resume)
+
+    def _guard_of(self, seg: Seg) -> Guard | None:
+        guards = self.__dict__["_guards"]
+        t = seg.transition
+        if id(t) not in guards:
+            guards[id(t)] = self._compile_guard(seg)
+        return guards[id(t)]
+
+    def _compile_guard(self, seg: Seg) -> Guard | None:
+        return compile_guard(self, seg.transition, _clock_of(seg))[0]
+
+    # -- temporal logic ---------------------------------------------------------
+
+    def temporal_holds(self, spec: Temporal, state: Any) -> bool:
+        """Whether a temporal operator holds for `state` (a state or its id) now."""
+        state_id = getattr(state, "id", state)
+        return spec.holds(self.temporal_count(spec.unit, state_id, raw=True), spec.ticks(self.tick_period_s))
+
+    def temporal_count(self, unit: str = "tick", state: Any = None, raw: bool = False) -> float:
+        """Stateflow's ``temporalCount(unit)``: ticks, seconds (``sec``, ``msec``, ``usec``) or events E
+        counted since `state` was entered (default: the state whose action or transition is running).
+
+        With ``raw=True`` time units are counted in ticks.
+        """
+        from .temporal import TIME_UNITS
+
+        d = self.__dict__
+        if state is None:
+            state = self._current_state_id()
+        state_id = getattr(state, "id", state)
+        if unit == "tick" or unit in TIME_UNITS:
+            ticks = d["_ticks"] - d["_entered_at"][state_id]
+            if unit == "tick" or raw:
+                return ticks
+            if self.tick_period_s is None:
+                raise TemporalLogicError(f"temporal_count({unit!r}) needs the chart's tick period")
+            return ticks * self.tick_period_s / TIME_UNITS[unit]
+        return int(d["_counts"].get((state_id, unit), 0))
+
+    def _current_state_id(self) -> str:
+        d = self.__dict__
+        if d["_frames"]:
+            kind, node, path = d["_frames"][-1]
+            return str(node.id)
+        if d["_cur"] is not None:
+            return str(d["_cur"].id)
+        raise TemporalLogicError(f"{self.chart_name}: temporal_count() without a state, outside an action:"
+                                 " name the state (temporal_count(unit, state))")
+
+    def duration_holds(self, spec: DurationSpec, state: Any) -> bool:
+        """Whether ``duration(condition) <op> seconds`` holds for `state` now."""
+        return spec.holds(self._duration_s(spec, getattr(state, "id", state)))
+
+    def _duration_s(self, spec: DurationSpec, state_id: str) -> float:
+        d = self.__dict__
+        since = d["_since"].get((state_id, spec))
+        if since is None or self.tick_period_s is None:
+            return 0.0
+        return (d["_ticks"] - since) * self.tick_period_s
+
+    def _duration_condition(self, node: Node, spec: DurationSpec) -> Guard:
+        conds = self.__dict__["_durations"]
+        fn = conds.get(spec)
+        if fn is None:
+            fn = conds[spec] = compile_condition(self, spec.condition, node.state)
+        return fn  # type: ignore[no-any-return]
 
     def guard_paths(self) -> dict[str, str]:
         """For each tick transition, whether its guard runs as a plain call (``fast``) or
         through the library (``library``): a chart author checks the fast path is used."""
+        segs = self._program.segs
         return {
-            info.label: "fast" if compile_guard(self, info.transition)[1] else "library"
-            for info in self._structure.transitions if info.kind == "tick"
+            info.label: "fast" if compile_guard(self, info.transition, _clock_of(segs[id(info.transition)]))[1]
+            else "library"
+            for info in self._structure.transitions if info.scope != "action" and id(info.transition) in segs
         }
 
     # -- data ----------------------------------------------------------------
@@ -541,6 +688,30 @@ class TickChart(StateChart, metaclass=TickChartMeta):
     def data_slots(cls) -> dict[str, int]:
         """Where each number of a buffered chart lies in :meth:`data_buffer`, by datum (``X_p`` too)."""
         return dict(cls._slots)
+
+
+def _clock_of(seg: Seg) -> str:
+    """The state whose clock a segment's temporal guards read (the chart's own at the top level)."""
+    return seg.clock.id if seg.clock is not None else _CHART_CLOCK
+
+
+class _Engine(SyncEngine):
+    """python-statemachine's engine, with the execution handed to the runtime.
+
+    It does not start the chart (the runtime enters it with Stateflow's default
+    transitions) and it hands every event sent through the library's API
+    (``chart.some_event()``, ``StateChart.send``) to the chart as a wake-up.
+    """
+
+    def start(self, **kwargs: Any) -> None:
+        return None
+
+    def processing_loop(self) -> Any:
+        sm: Any = self.sm
+        while not self.external_queue.is_empty():
+            trigger = self.external_queue.pop()
+            sm.send(str(trigger.event), **trigger.kwargs)
+        return None
 
 
 def entered_states(chart: StateChart, transition: Transition) -> list[State]:

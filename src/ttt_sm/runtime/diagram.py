@@ -18,7 +18,7 @@ from typing import Any
 
 from statemachine import StateChart
 
-from .structure import ChartStructure, StateInfo, TransitionInfo, priority_conflicts
+from .structure import ChartStructure, StateInfo, TransitionInfo
 
 ACTIVE_FILL = "turquoise"
 ACTIVE_CLUSTER_FILL = "#e3f8f6"
@@ -246,7 +246,4 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
         target = f"`{t.target}`" if t.target else "(none)"
         out.append(f"| `{t.source}` | {target} | {_cell(t.trigger)} |"
                    f" {t.priority or '—'} | {_cell(' and '.join(t.guards))} | {_cell(', '.join(t.actions))} |")
-    conflicts = priority_conflicts(structure)
-    if conflicts:
-        out += ["", "## Priority notes", ""] + [f"- {c}" for c in conflicts]
     return "\n".join(out) + "\n"

@@ -47,13 +47,8 @@ class TemporalLogicError(RuntimeError):
     """A temporal guard cannot be evaluated, e.g. ``after_s`` on a chart without a tick period."""
 
 
-class GuardMismatchError(RuntimeError):
-    """A tick transition's guard held on the fast path but the library did not take it.
-
-    Guards must be pure functions of the chart's inputs and data: the runtime
-    evaluates them once itself and the library evaluates them again when it takes
-    the transition.  A guard with side effects, or one that reads the event, breaks this.
-    """
+class ChartExecutionError(RuntimeError):
+    """A chart cannot go on as Stateflow would: no valid default transition, endless local events."""
 
 
 class GraphvizMissingError(RuntimeError):

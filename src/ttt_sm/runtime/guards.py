@@ -32,10 +32,10 @@ from statemachine.event_data import EventData, TriggerData
 from statemachine.spec_parser import operator_mapping, parse_boolean_expr, replace_operators
 from statemachine.transition import Transition
 
-from .temporal import TickCounter, temporal_of
+from .temporal import Temporal, TickCounter, duration_of, temporal_of
 
 
-class FastPathChart(TickCounter, Protocol):
+class FastPathChart(TickCounter, Protocol):  # noqa: D101
     """What compiling a guard reads of its chart; :class:`~.chart.TickChart` is one.
 
     A protocol rather than an import of :mod:`.chart`, which imports this
@@ -47,6 +47,8 @@ class FastPathChart(TickCounter, Protocol):
     model: Any
     _callbacks: Any
 
+    def _duration_s(self, spec: Any, state_id: str) -> float: ...
+
 Guard = Callable[[], Any]
 
 
@@ -54,17 +56,19 @@ class _Unsupported(Exception):
     """This guard cannot be made a plain call; use the library's evaluation."""
 
 
-def compile_guard(chart: FastPathChart, transition: Transition) -> tuple[Guard | None, bool]:
+def compile_guard(chart: FastPathChart, transition: Transition, clock: str | None = None) -> tuple[Guard | None, bool]:
     """A zero-argument callable that is truthy when all guards of ``transition`` hold.
 
+    ``clock`` is the state whose clock its temporal operators read (default: its source).
     Returns ``(guard, fast)``: ``guard`` is ``None`` when the transition has no
     guard; ``fast`` is False when the library's evaluation had to be used.
     """
     specs = list(transition.cond)
     if not specs:
         return None, True
+    clock = clock if clock is not None else transition.source.id
     try:
-        parts = [_compile_spec(chart, transition, spec) for spec in specs]
+        parts = [_compile_spec(chart, transition, spec, clock) for spec in specs]
     except _Unsupported:
         return _library_guard(chart, transition), False
     if len(parts) == 1:
@@ -79,9 +83,9 @@ def compile_guard(chart: FastPathChart, transition: Transition) -> tuple[Guard |
     return all_hold, True
 
 
-def _compile_spec(chart: FastPathChart, transition: Transition, spec: Any) -> Guard:
+def _compile_spec(chart: FastPathChart, transition: Transition, spec: Any, clock: str) -> Guard:
     if spec.reference is SpecReference.CALLABLE:
-        fn = _compile_callable(chart, transition, spec)
+        fn = _compile_callable(chart, transition, spec, clock)
     elif spec.reference is SpecReference.PROPERTY:
         fn = partial(spec.func.fget, chart)
     elif spec.attr_name.isidentifier():
@@ -100,25 +104,48 @@ def _negate(fn: Guard) -> Guard:
     return negated
 
 
-def _compile_callable(chart: FastPathChart, transition: Transition, spec: Any) -> Guard:
+def _compile_callable(chart: FastPathChart, transition: Transition, spec: Any, clock: str) -> Guard:
     func = spec.func
     temporal = temporal_of(func)
     if temporal is not None:
-        n = temporal.ticks(chart.tick_period_s, f" on {transition.source.id} -> "
-                           f"{transition.target.id if transition.target else '(none)'}")
-        entered_at = chart._entered_at
-        state_id = transition.source.id
-        counters = chart.__dict__
+        return _compile_temporal(chart, transition, temporal, clock)
+    span = duration_of(func)
+    if span is not None:
+        def held() -> bool:
+            return bool(span.holds(chart._duration_s(span, clock)))
 
-        def elapsed() -> bool:
-            return counters["_ticks"] - entered_at[state_id] >= n
-
-        return elapsed
+        return held
     if not spec.is_bounded:
         bound = getattr(chart, spec.lookup_name, None)
         if getattr(bound, "__func__", None) is func:
             func = bound
     return _bind_known(chart, transition, func)
+
+
+def _compile_temporal(chart: FastPathChart, transition: Transition, temporal: Temporal, clock: str) -> Guard:
+    """A temporal operator as a comparison of the chart's counters (ticks since entry, or events)."""
+    n = temporal.ticks(chart.tick_period_s, f" on {transition.source.id} -> "
+                       f"{transition.target.id if transition.target else '(none)'}")
+    counters = chart.__dict__
+    if temporal.event is not None:
+        counts, key, holds = counters["_counts"], (clock, temporal.event), temporal.holds
+
+        def counted() -> bool:
+            return holds(counts.get(key, 0), n)
+
+        return counted
+    entered_at = chart._entered_at
+    if temporal.op == "after":
+        def elapsed() -> bool:
+            return counters["_ticks"] - entered_at[clock] >= n
+
+        return elapsed
+    holds = temporal.holds
+
+    def ticks() -> bool:
+        return holds(counters["_ticks"] - entered_at[clock], n)
+
+    return ticks
 
 
 def _compile_name(chart: FastPathChart, transition: Transition, name: str) -> Guard:
@@ -253,3 +280,19 @@ def _library_guard(chart: FastPathChart, transition: Transition) -> Guard:
         return bool(evaluate(key, **kwargs))
 
     return library_guard
+
+
+def compile_condition(chart: FastPathChart, text: str, state: Any) -> Guard:
+    """A condition in the guard language (data, guard methods, and/or/not, comparisons) as a plain call.
+
+    Used for ``duration(condition)``, whose condition is sampled at every wake-up.
+    """
+    from statemachine.transition import Transition as _T
+
+    probe = _T(state, state)  # binds `source`/`state` for a guard method that asks for them
+    if text.isidentifier():
+        return _compile_name(chart, probe, text)
+    try:
+        return _inline_expression(chart, probe, text)
+    except _Unsupported:
+        return _compile_expression(chart, probe, text)

@@ -17,6 +17,8 @@ from statemachine.state import HistoryState, State
 from statemachine.transition import Transition
 from statemachine.utils import humanize_id
 
+from .junction import is_junction
+
 if TYPE_CHECKING:
     from statemachine import StateChart
 
@@ -44,6 +46,7 @@ class StateInfo:
     during: tuple[str, ...]
     exit: tuple[str, ...]
     history: Literal["", "shallow", "deep"] = ""
+    junction: bool = False
 
     @property
     def is_compound(self) -> bool:
@@ -54,11 +57,16 @@ class StateInfo:
 class TransitionInfo:
     """One transition of a chart, as a diagram, a trace and coverage name it.
 
-    ``kind`` is ``"tick"`` for a guard-only (eventless in Stateflow) transition tried
-    on every chart tick, ``"event"`` for one triggered by an event from outside.
-    ``priority`` is the 1-based Stateflow execution order among the tick transitions
-    of the same source (outer ones first, then inner ones, each in declaration order);
-    0 for event transitions.
+    ``kind`` is ``"tick"`` for a transition without an event (Stateflow's eventless
+    transition, tried at every wake-up of the chart), ``"event"`` for one triggered
+    by an event.  ``scope`` says where Stateflow tries it: ``"outer"`` (it leaves its
+    source), ``"inner"`` (from the source's inner edge to the source itself, a
+    descendant or a junction inside it), ``"segment"`` (it leaves a junction),
+    ``"action"`` (no target: the source state's ``on`` action, run in its during
+    phase).  ``priority`` is the 1-based execution order among the transitions of
+    the same source and scope, in the order they were written.
+    ``condition_actions`` run when the segment's condition holds (``before=``),
+    ``transition_actions`` when the whole path reaches a state (``on=``).
     """
 
     index: int
@@ -74,6 +82,10 @@ class TransitionInfo:
     priority: int
     label: str
     transition: Transition = field(compare=False, repr=False)
+    scope: Literal["outer", "inner", "segment", "action"] = "outer"
+    condition_actions: tuple[str, ...] = ()
+    transition_actions: tuple[str, ...] = ()
+    after_actions: tuple[str, ...] = ()
 
     @property
     def trigger(self) -> str:
@@ -119,12 +131,25 @@ def _walk_with_history(states: Iterable[State], depth: int = 0) -> Iterator[tupl
 
 
 def is_inner(transition: Transition) -> bool:
-    """Whether a transition stays inside its source (Stateflow's inner transition)."""
+    """Whether a transition stays inside its source (Stateflow's inner transition).
+
+    Written ``source.to(target, internal=True)`` with a target that is the source
+    itself, a state inside it, or a junction (or history junction) inside it.
+    """
     target = transition.target
     return bool(
         transition.internal and target is not None
         and (target is transition.source or target.is_descendant(transition.source))
     )
+
+
+def scope_of(transition: Transition) -> Literal["outer", "inner", "segment", "action"]:
+    """Where Stateflow tries a transition (see :class:`TransitionInfo`)."""
+    if is_junction(transition.source):
+        return "segment"
+    if transition.target is None:
+        return "action"
+    return "inner" if is_inner(transition) else "outer"
 
 
 def tag_tick_transitions(cls: type[StateChart]) -> None:
@@ -192,27 +217,29 @@ def build_structure(cls: type[StateChart]) -> ChartStructure:
                 history=history_kind,
             ))
             continue
+        junction = is_junction(state)
         during_name = f"{DURING_PREFIX}{state.id}"
         states.append(StateInfo(
             id=state.id,
-            label=_display_name(state),
+            label="" if junction else _display_name(state),
             parent=state.parent.id if state.parent else None,
             depth=depth,
             children=tuple(c.id for c in state.states) + tuple(h.id for h in state.history),
             initial=bool(state.initial),
             final=bool(state.final),
             parallel=bool(state.parallel),
-            entry=action_names(cls, state.enter),
-            during=(during_name,) if during_name in names else (),
-            exit=action_names(cls, state.exit),
+            entry=() if junction else action_names(cls, state.enter),
+            during=(during_name,) if during_name in names and not junction else (),
+            exit=() if junction else action_names(cls, state.exit),
+            junction=junction,
         ))
         own = [t for t in state.transitions if not t.initial]
-        tick = [t for t in own if any(str(e).startswith(TICK_EVENT_PREFIX) for e in t.events)]
-        # Stateflow order: outer transitions before inner ones, each in declaration order.
-        ordered_tick = [t for t in tick if not is_inner(t)] + [t for t in tick if is_inner(t)]
-        priority = {id(t): i + 1 for i, t in enumerate(ordered_tick)}
+        # Stateflow's execution order: per source and scope, in the order written
+        orders: dict[str, int] = {}
         infos: dict[int, TransitionInfo] = {}
         for t in own:
+            scope = scope_of(t)
+            orders[scope] = orders.get(scope, 0) + 1
             tick_event = next((str(e) for e in t.events if str(e).startswith(TICK_EVENT_PREFIX)), None)
             events = _display_events(t)
             guards = _guard_names(t)
@@ -224,19 +251,20 @@ def build_structure(cls: type[StateChart]) -> ChartStructure:
             labels[label] = labels.get(label, 0) + 1
             if labels[label] > 1:
                 label = f"{label} #{labels[label]}"
-            actions = (
-                action_names(cls, t.before) + action_names(cls, t.on) + action_names(cls, t.after)
-            )
+            before, on, after = action_names(cls, t.before), action_names(cls, t.on), action_names(cls, t.after)
             info = TransitionInfo(
                 index=index, source=state.id, target=target, kind=kind, events=events,
-                tick_event=tick_event, guards=guards, actions=actions,
-                internal=bool(t.internal), inner=is_inner(t), priority=priority.get(id(t), 0),
-                label=label, transition=t,
+                tick_event=tick_event, guards=guards, actions=before + on + after,
+                internal=bool(t.internal), inner=scope == "inner", priority=orders[scope],
+                label=label, transition=t, scope=scope,
+                condition_actions=before, transition_actions=on, after_actions=after,
             )
             index += 1
             infos[id(t)] = info
             transitions.append(info)
-        tick_by_state[state.id] = tuple(infos[id(t)] for t in ordered_tick)
+        tick_by_state[state.id] = tuple(
+            i for scope in ("outer", "inner", "segment") for i in infos.values()
+            if i.kind == "tick" and i.scope == scope)
     tick_events = frozenset(t.tick_event for t in transitions if t.tick_event)
     user_events: list[str] = []
     for t in transitions:
@@ -255,51 +283,21 @@ def build_structure(cls: type[StateChart]) -> ChartStructure:
     )
 
 
-def priority_conflicts(structure: ChartStructure) -> list[str]:
-    """Events handled both by a state and by one of its ancestors.
-
-    Where this happens python-statemachine (SCXML) lets the inner state win, while
-    Stateflow would take the ancestor's transition.  Returns one sentence per
-    conflict; an empty list means both semantics agree for every event of the chart.
-    """
-    parents = {s.id: s.parent for s in structure.states}
-    handlers: dict[str, set[str]] = {}
-    for t in structure.transitions:
-        for e in t.events:
-            handlers.setdefault(e, set()).add(t.source)
-    out: list[str] = []
-    for event, sources in handlers.items():
-        for src in sorted(sources):
-            anc = parents.get(src)
-            while anc is not None:
-                if anc in sources:
-                    out.append(
-                        f"event {event!r}: handled by {anc!r} and its descendant {src!r};"
-                        f" the library takes {src!r}'s transition (SCXML), Stateflow would take {anc!r}'s"
-                    )
-                anc = parents.get(anc)
-    return out
-
-
 def states_entered_by(chart: StateChart, transition: Transition) -> list[State]:
     """The active states that ``transition`` (just taken) entered or re-entered.
 
-    Uses the library's own transition domain, so a self-transition or a transition
-    to a parent counts its re-entered states, as python-statemachine ran their
-    entry actions.  Call it after the transition (e.g. from ``after_transition``).
+    A chart of the runtime records them as it enters them (for a path through
+    junctions, every segment of the path answers with the states the whole
+    path entered); for another chart, the library's own transition domain says.
+    Call it after the transition (e.g. from ``after_transition``).
     """
+    path, entered = vars(chart).get("_entered_path", ((), None))
+    if entered is not None and any(seg.transition is transition for seg in path):
+        return list(entered)
     if not transition.targets:
         return []
     domain = chart._engine.get_transition_domain(transition)
     config = list(chart.configuration)
     if domain is None:
-        entered = config
-    else:
-        entered = [s for s in config if s.is_descendant(domain)]
-    target = transition.target
-    if (
-        transition.internal and transition.is_self and target is not None and target.is_atomic
-        and chart.enable_self_transition_entries
-    ):
-        entered.extend(s for s in config if s == target and s not in entered)
-    return entered
+        return config
+    return [s for s in config if s.is_descendant(domain)]

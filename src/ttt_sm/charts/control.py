@@ -24,7 +24,9 @@ A ``button`` that arrives while the arm is busy (anything but ``wait_1``, or
 ``wait_1`` with the field or an erase still to do) is ignored and counted in
 `ignored_buttons`: a drawing is never started twice, the field and erasing
 come first, and the person presses again once the arm waits (the GUI shows
-when).  A ``draw_sine`` then is dropped.  ``finish`` before the first move
+when).  (One that arrives in the very wake-up that leaves ``wait_1`` to erase
+or to draw the field is not counted: that transition takes the wake-up.)
+A ``draw_sine`` then is dropped.  ``finish`` before the first move
 ends at once: the arm still stands at its start pose.
 
 Every move is a straight line at a set speed, one increment per tick, towards
@@ -41,7 +43,7 @@ import math
 
 from statemachine import State
 
-from ..runtime import Data, TickChart
+from ..runtime import Data, TickChart, action_on
 from .geometry import (
     O_START,
     arc_end,
@@ -240,37 +242,28 @@ class Control(TickChart):
         go_home.to(finished, cond="at_target")
 
     # -- from the waiting pose: erase first, then the field, then what the person asks.
-    # Events are handled before tick transitions, so the person's events also wait for
-    # `idle` (Stateflow tries wait_1's erase and field transitions first, in order).
-    # A button anywhere else, or before the arm is idle, is ignored and counted
-    # (targetless: nothing is left or entered).
+    # Stateflow tries wait_1's transitions in the order written, at every wake-up, the
+    # person's events included: a button draws only once the arm is idle.  A button that
+    # no transition takes (the arm busy anywhere, or wait_1 not idle) is ignored and
+    # counted: the `on button` action of every state it can arrive in, which runs in the
+    # state's during phase, i.e. only when none of its transitions was taken.
     start_stop.wait_1.to(Erase, cond="erase")
     start_stop.wait_1.to(Drawing_playing_field, cond="not Pl_fld")
     button = (start_stop.wait_1.to(Drawing_X, cond="symbol == 1 and idle", on="count_symbol")
               | start_stop.wait_1.to(Drawing_O, cond="symbol == 0 and idle", on="count_symbol")
-              | start_stop.to(None, on="ignore_button")  # type: ignore[arg-type]
-              | Drawing_playing_field.to(None, on="ignore_button")  # type: ignore[arg-type]
-              | Drawing_X.to(None, on="ignore_button")  # type: ignore[arg-type]
-              | Drawing_O.to(None, on="ignore_button")  # type: ignore[arg-type]
-              | Drawing_sine.to(None, on="ignore_button")  # type: ignore[arg-type]
-              | Erase.to(None, on="ignore_button")  # type: ignore[arg-type]
-              | finishing.to(None, on="ignore_button"))  # type: ignore[arg-type]
+              | action_on((start_stop.wait_ini, start_stop.rise, start_stop.go_over, start_stop.go_wait,
+                           start_stop.wait_1, Drawing_playing_field, Drawing_X, Drawing_O, Drawing_sine, Erase,
+                           finishing), "ignore_button"))
     draw_sine = start_stop.wait_1.to(Drawing_sine, cond="idle")
 
     # -- back to the waiting pose once a sub-chart is done (lifted to z_travel)
-    Drawing_playing_field.field_lift_off.to(start_stop.go_wait, cond="at_target")
-    Drawing_X.x_lift_off.to(start_stop.go_wait, cond="at_target")
-    Drawing_O.o_lift_off.to(start_stop.go_wait, cond="at_target")
-    Drawing_sine.s_lift_off.to(start_stop.go_wait, cond="at_target")
+    start_stop.go_wait.from_(Drawing_playing_field.field_lift_off, Drawing_X.x_lift_off, Drawing_O.o_lift_off,
+                             Drawing_sine.s_lift_off, cond="at_target")
     Erase.turn_pen.to(start_stop.go_wait, cond="phi <= 0 and at_target")
 
-    # -- finish, at any moment (tried before anything inside, as Stateflow does)
+    # -- finish, at any moment (a sub-chart's outer transition: tried before anything inside it)
     start_stop.to(finishing, cond="finish and initialised", on="aim_lift")
-    Drawing_playing_field.to(finishing, cond="finish", on="aim_lift")
-    Drawing_X.to(finishing, cond="finish", on="aim_lift")
-    Drawing_O.to(finishing, cond="finish", on="aim_lift")
-    Drawing_sine.to(finishing, cond="finish", on="aim_lift")
-    Erase.to(finishing, cond="finish", on="aim_lift")
+    finishing.from_(Drawing_playing_field, Drawing_X, Drawing_O, Drawing_sine, Erase, cond="finish", on="aim_lift")
 
     pi_2 = math.pi / 2
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from statemachine import State
 
-from ..runtime import Data, TickChart, after, after_s
+from ..runtime import Data, TickChart, action_on, after, after_s
 
 #: The Tic-tac-toe GUI's messages (thesis section 3.7, Text box2), and the results.
 MSG_COMPILING = "Wait for the model to be compiled."
@@ -51,9 +51,13 @@ class AlgorithmActivator(TickChart):
     enabled = State()
     spent = State()
 
-    # A click in `spent` counts if the moves changed in the same tick (events come before tick transitions).
-    trigger = (armed.to(enabled) | spent.to(enabled, cond="o_pos != o_pos_used or hold")
-               | spent.to(None, on="ignore_trigger") | enabled.to(None, on="ignore_trigger"))
+    # A click in `spent` counts if the moves changed by then (spent's transitions in the order written:
+    # the click's own first).  A click that no transition takes is ignored and counted (`on trigger`);
+    # so is one in the step that ends the pulse, which leaves `enabled` as the pulse's end would.
+    trigger = (armed.to(enabled)
+               | spent.to(enabled, cond="o_pos != o_pos_used or hold")
+               | enabled.to(spent, cond=after(1), on="ignore_trigger")
+               | action_on((enabled, spent), "ignore_trigger"))
     enabled.to(spent, cond=after(1))  # the enable pulse lasts one chart tick
     spent.to(armed, cond="o_pos != o_pos_used or hold")
 
@@ -111,6 +115,8 @@ class Game(TickChart):
     turning_off = State()
     off = State(final=True)
 
+    # stop from any phase: written first, so it goes before the phase's own transitions
+    stop = turning_off.from_(compiling, initialising, playing, game_over, erasing)
     compiling.to(initialising)
     initialising.to(playing, cond="ready")
     playing.to(game_over, cond="result != 0 and ready")
@@ -118,8 +124,6 @@ class Game(TickChart):
     erasing.to(playing, cond="erased and ready and play_again", on="new_game")
     erasing.to(turning_off, cond="erased and not play_again")
     turning_off.to(off, cond="finished")
-    stop = (compiling.to(turning_off) | initialising.to(turning_off) | playing.to(turning_off)
-            | game_over.to(turning_off) | erasing.to(turning_off))
 
     def on_enter_initialising(self) -> None:
         self.message = MSG_INITIALISING

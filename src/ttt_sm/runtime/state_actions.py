@@ -16,23 +16,28 @@ its state.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from statemachine.state import State
 from statemachine.transition_list import TransitionList
 
 
-def action_on(state: State | type, action: str | Callable[..., Any], cond: Any = None) -> TransitionList:
-    """`state`'s ``on`` action: run `action` in its during phase when the event (or `cond`) matches.
+def action_on(states: State | Sequence[State], action: str | Callable[..., Any], cond: Any = None) -> TransitionList:
+    """The ``on`` action of a state (or of each of several): run `action` in its during phase when
+    the event (or `cond`) matches.
 
     Assign it to an event name (``button = action_on(busy, "ignore_button")``, or
     joined with ``|`` to that event's transitions) for ``on button:``; leave it
     unassigned with a temporal `cond` for ``on after(3, tick):`` or ``on every(...)``.
     """
-    if not isinstance(state, State):
-        raise TypeError(f"action_on(state, action): {state!r} is not a state")
+    many = [states] if isinstance(states, State) else list(states)
+    if not many or not all(isinstance(s, State) for s in many):
+        raise TypeError(f"action_on(states, action): {states!r} is not a state or a sequence of states")
     kwargs: dict[str, Any] = {"on": action}
     if cond is not None:
         kwargs["cond"] = cond
-    return state.to(None, **kwargs)  # type: ignore[arg-type]  # a targetless transition
+    result = TransitionList()
+    for state in many:
+        result = result | state.to(None, **kwargs)  # type: ignore[arg-type]  # a targetless transition
+    return result

@@ -67,9 +67,10 @@ def test_dot_draws_compound_states_as_nested_clusters_with_guards_and_actions():
     assert "during / during_dim" in body  # during action inside the state
     assert "entry / on_enter_off" in dot
     assert '"dim" -> "bright" [label="[after(3)]\\n/ louder"' in dot
-    assert '"off" -> "on__start" [label="[switch]", lhead="cluster_on"' in dot
+    # off's two transitions into on are tried in the order written: their execution order is drawn
+    assert '"off" -> "on__start" [label="1: [switch]", lhead="cluster_on"' in dot
     assert '"on" -> "off" [label="[not switch]", ltail="cluster_on"' in dot
-    assert '"off" -> "on__start" [label="button"' in dot
+    assert '"off" -> "on__start" [label="2: button"' in dot
 
 
 def test_mermaid_nests_compound_states():
@@ -80,7 +81,7 @@ def test_mermaid_nests_compound_states():
     assert "[*] --> dim" in nested.group(1)
     assert "dim --> bright : [after(3)] / louder" in nested.group(1)
     assert "dim : during / during_dim" in nested.group(1)
-    assert "off --> on : [switch]" in text and "off --> on : button" in text
+    assert "off --> on : 1#58; [switch]" in text and "off --> on : 2#58; button" in text
 
 
 def test_markdown_page_has_the_mermaid_block_and_data_table():
@@ -89,7 +90,7 @@ def test_markdown_page_has_the_mermaid_block_and_data_table():
     assert "```mermaid\nstateDiagram-v2\n" in page
     assert "| input | `switch` | bool | `False` | wall switch |" in page
     assert "| output | `level` | 1 | `0.0` | light level (previous tick: `level_p`) |" in page
-    assert "| `dim` | `bright` | tick | 1 | after(3) | louder |" in page
+    assert "| `dim` | `bright` | outer | 1 | tick | after(3) | — | louder |" in page
 
 
 def test_render_active_highlights_the_active_states():

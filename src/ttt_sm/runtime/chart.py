@@ -590,7 +590,7 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
             if self.tick_period_s is None:
                 raise TemporalLogicError(f"temporal_count({unit!r}) needs the chart's tick period")
             return ticks * self.tick_period_s / TIME_UNITS[unit]
-        return int(d["_counts"].get((state_id, unit), 0))
+        return int(d["_counts"].get(state_id, {}).get(unit, 0))
 
     def _current_state_id(self) -> str:
         d = self.__dict__

@@ -55,29 +55,38 @@ def state_actions(state: StateInfo) -> list[str]:
 
 
 def handler_lines(state: StateInfo, structure: ChartStructure) -> list[str]:
-    """The state's targetless transitions (``button / ignore_button``), listed inside it.
+    """The state's ``on`` actions (``on button / ignore_button``) and inner self-transitions, listed inside it.
 
-    They leave no state and enter none (python-statemachine runs their actions only),
-    so they are written in the state's box rather than drawn as loops, which would read
-    as an exit and a re-entry.
+    They leave no state and enter none, so they are written in the state's box
+    rather than drawn as loops, which would read as an exit and a re-entry.
     """
     lines = []
     for t in structure.transitions:
-        if t.source == state.id and t.target is None:
-            lines.append(" ".join(p for p in edge_text(t, structure) if p))
+        if t.source != state.id:
+            continue
+        if t.target is None:
+            first, action = edge_text(t, structure)
+            lines.append(" ".join(p for p in ("on", first or "every wake-up", action) if p))
+        elif t.scope == "inner" and t.target == state.id and not state.is_compound:
+            first, action = edge_text(t, structure)
+            lines.append(" ".join(p for p in ("↻", first, action) if p))
     return lines
 
 
+def competing(structure: ChartStructure, t: TransitionInfo) -> int:
+    """How many transitions of the same source and scope are tried in turn with `t` (its order counts)."""
+    return sum(1 for u in structure.transitions if u.source == t.source and u.scope == t.scope)
+
+
 def edge_text(t: TransitionInfo, structure: ChartStructure) -> tuple[str, str]:
-    """(trigger and guard, action) of a transition as drawn on its edge."""
-    trigger = ""
-    if t.kind == "event":
-        trigger = " ".join(t.events)
-    elif len(structure.tick_by_state[t.source]) > 1:
-        trigger = f"{t.priority}:"
+    """(order, trigger, [guard] and {condition action}; / transition action) of a segment, as Stateflow labels it."""
+    order = f"{t.priority}:" if t.scope != "action" and competing(structure, t) > 1 else ""
+    trigger = " ".join(t.events) if t.kind == "event" else ""
     guard = f"[{' and '.join(t.guards)}]" if t.guards else ""
-    first = " ".join(p for p in (trigger, guard) if p)
-    action = f"/ {', '.join(t.actions)}" if t.actions else ""
+    condition = f"{{{', '.join(t.condition_actions)}}}" if t.condition_actions else ""
+    first = " ".join(p for p in (order, trigger, guard, condition) if p)
+    done = t.transition_actions + t.after_actions
+    action = f"/ {', '.join(done)}" if done else ""
     return first, action
 
 
@@ -128,7 +137,7 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
 
     def edges(scope: str | None, indent: str) -> None:
         for t in scoped.get(scope, []):
-            if t.target is None:
+            if t.target is None or (t.scope == "inner" and t.target == t.source and not by_id[t.source].is_compound):
                 continue  # listed in its state (handler_lines)
             first, action = edge_text(t, structure)
             label = " ".join(p for p in (first, action) if p)
@@ -149,6 +158,9 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
             if state.label != state.id or (actions and not state.is_compound):
                 out.append(f'{indent}state "{_m(state.label)}" as {state.id}')
             if state.history:
+                continue
+            if state.junction:
+                out.append(f"{indent}state {state.id} <<choice>>")
                 continue
             if state.is_compound:
                 out.append(f"{indent}state {state.id} {{")
@@ -187,13 +199,16 @@ def _cell(value: Any) -> str:
 #: Under each Mermaid diagram: how to read it (Mermaid draws no legend of its own).
 MERMAID_LEGEND = (
     "How to read it: a box is titled with the state's name; under it, its actions"
-    " (`entry /` runs when the state is entered, `during /` on every chart tick in which"
-    " the chart takes no transition, `exit /` when it is left) and the events it handles"
-    " without leaving (`button / ignore_button`). Notes beside compound states list theirs."
-    " An edge reads `event [guard] / action`: an edge with no event is a tick transition,"
-    " tried on every chart tick and taken when its guard holds; `2:` is the order in which"
-    " a state's tick transitions are tried, 1 first. `H` / `H*`: history (the sub-state"
-    " active when the compound was left; `H*` at every depth)."
+    " (`entry /` runs when the state is entered, `during /` at every wake-up of the chart"
+    " in which the state stays active, `exit /` when it is left) and its `on` actions"
+    " (`on button / ignore_button`: runs after the during action when the event wakes the chart)."
+    " Notes beside compound states list theirs. An edge reads"
+    " `2: event [guard] {condition action} / transition action`, as in Stateflow: an edge with"
+    " no event is tried at every wake-up; `2:` is its execution order among the transitions"
+    " of its source (outer and inner ones counted apart), 1 first; the condition action runs as"
+    " soon as the guard holds, the transition action when the whole path reaches a state."
+    " A diamond is a connective junction: the segments leaving it are tried in their order."
+    " `H` / `H*`: history (the sub-state active when the compound was left; `H*` at every depth)."
 )
 
 
@@ -234,16 +249,26 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
         if s.history:
             out.append(f"| `{s.id}` ({s.history} history) | {_cell(s.parent or '')} | — | — | — |")
             continue
+        if s.junction:
+            out.append(f"| `{s.id}` (junction{', initial' if s.initial else ''}) | {_cell(s.parent or '')}"
+                       " | — | — | — |")
+            continue
         out.append(f"| `{s.id}`{' (initial)' if s.initial else ''} | {_cell(s.parent or '')} |"
                    f" {_cell(', '.join(s.entry))} | {_cell(', '.join(s.during))} |"
                    f" {_cell(', '.join(s.exit))} |")
     out += ["", "## Transitions", "",
-            "Tick transitions are tried on every chart tick, outermost active state first;"
-            " *priority* is their order within a state. Event transitions run when the event,"
-            " posted from outside, is handled at the next tick.", "",
-            "| source | target | trigger | priority | guard | action |", "|---|---|---|---|---|---|"]
+            "Tried in Stateflow's order at every wake-up of the chart: the outer transitions of the"
+            " active state, outermost state first; then its during and `on` actions; then its inner"
+            " transitions; then its active sub-state. *kind*: outer, inner (from the state's inner"
+            " edge), segment (from a junction), on (the state's `on` action). *order*: the execution"
+            " order among the transitions of the same source and kind. A transition with an event is"
+            " tried only when that event wakes the chart.", "",
+            "| source | target | kind | order | trigger | guard | condition action | transition action |",
+            "|---|---|---|---|---|---|---|---|"]
     for t in structure.transitions:
         target = f"`{t.target}`" if t.target else "(none)"
-        out.append(f"| `{t.source}` | {target} | {_cell(t.trigger)} |"
-                   f" {t.priority or '—'} | {_cell(' and '.join(t.guards))} | {_cell(', '.join(t.actions))} |")
+        kind = "on" if t.scope == "action" else t.scope
+        out.append(f"| `{t.source}` | {target} | {kind} | {t.priority} | {_cell(t.trigger)} |"
+                   f" {_cell(' and '.join(t.guards))} | {_cell(', '.join(t.condition_actions))} |"
+                   f" {_cell(', '.join(t.transition_actions + t.after_actions))} |")
     return "\n".join(out) + "\n"

@@ -14,11 +14,14 @@ a chart with subcharts:
 * the **whole chart**, compound states as nested clusters (what
   :func:`~.export.render_active` highlights).
 
-Every picture carries its title and a legend of what it uses (tick and event
-transitions, priorities, entry/during/exit, history, ...).  Transitions with the
-same trigger, guard and action into the same state are drawn once, from a small
-junction dot their sources lead into.  Targetless transitions
-(``button / ignore_button``) are listed inside their state.
+Every picture carries its title and a legend of what it uses (transitions with
+and without events, execution order, condition and transition actions,
+entry/during/exit, history, connective junctions, ...).  Labels read as in
+Stateflow: ``2: event [guard] {condition action} / transition action``.  A
+connective junction is a small circle.  Transitions with the same trigger,
+guard and action into the same state are drawn once, from a small dot their
+sources lead into.  A state's ``on`` actions (``on button / ignore_button``)
+and a leaf's inner transitions to itself are listed inside its box.
 
 The text is a pure function of the chart class, the view and the active states:
 byte-identical on every export.  SVG element ids are stable: ``state-<id>`` for a
@@ -163,19 +166,27 @@ _ARROW = "───▶"
 #: (feature, symbol as an HTML-like label cell, meaning), in the order listed.
 _LEGEND: tuple[tuple[str, str, str], ...] = (
     ("tick", f"<td>{_ARROW}</td>",
-     "tick transition: tried on every chart tick, taken when its [guard] holds; / its action"),
+     "transition without an event: tried at every wake-up of the chart, valid when its [guard] holds"),
     ("event", f'<td><font color="{EVENT_COLOR}">{_ARROW}</font></td>',
-     "event transition: the event, posted from outside, is handled at the next tick"),
-    ("priority", "<td>2: [guard]</td>", "the order in which a state's tick transitions are tried, 1 first"),
+     "transition with an event: tried only when that event wakes the chart"),
+    ("priority", "<td>2: [guard]</td>",
+     "execution order: a source's outer (or inner) transitions are tried in this order, 1 first"),
+    ("condition", "<td>{f}</td>", "condition action: f runs as soon as the guard holds, before anything is left"),
+    ("action", "<td>/ f</td>", "transition action: f runs once the path reaches a state, between exit and entry"),
     ("entry", "<td>entry / f</td>", "f runs when the state is entered"),
-    ("during", "<td>during / f</td>", "f runs on every tick in which the chart takes no transition"),
+    ("during", "<td>during / f</td>", "f runs at every wake-up in which the state stays active"),
     ("exit", "<td>exit / f</td>", "f runs when the state is left"),
-    ("handler", "<td>event / f</td>", "in a box: the state handles the event itself, runs f, stays"),
-    ("initial", "<td>●───▶</td>", "initial state: where the chart or a compound state starts"),
+    ("handler", "<td>on event / f</td>", "the state's on action: f runs after its during action, when the"
+                                          " event wakes the chart; the state stays"),
+    ("inner", "<td>↻ [guard] / f</td>", "inner transition of the state to itself: f runs, nothing is left"),
+    ("initial", "<td>●───▶</td>", "default transition: where the chart or a compound state starts"),
     ("final", '<td><table border="1" cellborder="1" cellspacing="2" cellpadding="1" style="rounded">'
-              '<tr><td style="rounded">final</td></tr></table></td>', "final state: the chart stops there"),
+              '<tr><td style="rounded">final</td></tr></table></td>', "final state: the chart rests there"),
     ("history", "<td>(H)  (H*)</td>",
-     "history: enters the sub-state that was active when the compound was left (H*: at every depth)"),
+     "history junction: the compound is entered in the sub-state that was active when it was left"
+     " (H*: at every depth)"),
+    ("connective", "<td>──○──▶</td>", "connective junction: a path's segments meet; those leaving it are"
+                                      " tried in their order"),
     ("junction", "<td>──•──▶</td>", "the same transition from several states, drawn once from the dot"),
     ("closed", f'<td border="1" bgcolor="{CLOSED_FILL}">sub-chart</td>',
      "sub-chart, closed (its own picture shows it open; click); ▸ s: its state s entered from outside,"
@@ -293,7 +304,8 @@ class _Picture:
     def edges(self) -> list[_Edge]:
         drawn: dict[tuple[_End, _End, str, str], _Edge] = {}
         for t in self.structure.transitions:
-            if t.target is None:
+            if t.target is None or (t.scope == "inner" and t.target == t.source
+                                    and not self.by_id[t.source].is_compound):
                 continue  # listed inside its state
             if not self.shown(t.source) and not self.shown(t.target):
                 continue
@@ -317,6 +329,10 @@ class _Picture:
             self.features.add(t.kind)
             if first[:1].isdigit():
                 self.features.add("priority")
+            if t.condition_actions:
+                self.features.add("condition")
+            if t.transition_actions or t.after_actions:
+                self.features.add("action")
         edges = list(drawn.values())
         for e in edges:
             if e.tail.port and not e.tail.compass:
@@ -400,10 +416,14 @@ class _Picture:
                 self.features.add(kind)
         handlers = handler_lines(state, self.structure)
         if handlers:
-            self.features.add("handler")
             for t in self.structure.transitions:
-                if t.source == state.id and t.target is None:
+                if t.source == state.id and (t.target is None or t.target == t.source):
+                    self.features.add("handler" if t.target is None else "inner")
                     self.features.add(t.kind)
+                    if t.condition_actions:
+                        self.features.add("condition")
+                    if t.transition_actions or t.after_actions:
+                        self.features.add("action")
         return actions + handlers
 
     def state_lines(self, states: list[StateInfo], indent: str, parent: StateInfo | None) -> list[str]:
@@ -447,6 +467,11 @@ class _Picture:
                 out.extend(self.state_lines([self.by_id[c] for c in state.children], indent + "  ", state))
                 out.extend(f"{indent}  {line}" for line in self.junctions.get(state.id, []))
                 out.append(f"{indent}}}")
+            elif state.junction:
+                self.features.add("connective")
+                out.append(f'{indent}{_q(state.id)} [label="", shape="circle", width="0.16", height="0.16",'
+                           f' fixedsize="true", style="filled", fillcolor="white", penwidth="1.5",'
+                           f' tooltip="junction {state.id}", {state_id}];')
             elif state.history:
                 self.features.add("history")
                 out.append(f'{indent}{_q(state.id)} [label={_q(state.label)}, shape="circle",'

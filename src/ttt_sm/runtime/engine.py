@@ -146,7 +146,8 @@ class Execution:
 
     def _kwargs(self: TickChart, ctx: tuple[Transition | None, State | None, Any]) -> dict[str, Any]:
         """The keyword arguments python-statemachine gives a callback, for a context."""
-        transition, state, event = ctx
+        transition, state, event = ctx[:3]
+        role = ctx[3] if len(ctx) > 3 else None
         d = self.__dict__
         if isinstance(event, str):
             event = self._program.events.get(event) or Event(event)
@@ -154,12 +155,14 @@ class Execution:
         if transition is None:
             transition = _NO_TRANSITION
         data = EventData(trigger_data=trigger, transition=transition)
+        # as the library does: an entered state is also the `target`, an exited one the `source`
         if state is not None:
             data.state = state
-        kwargs = data.extended_kwargs
-        if state is not None:
-            kwargs["state"] = state
-        return kwargs
+            if role == "enter":
+                data.target = state
+            elif role == "exit":
+                data.source = state
+        return data.extended_kwargs
 
     def _forget_runners(self: TickChart) -> None:
         """Listeners changed: callbacks are looked up again (and the tick plans rebuilt)."""
@@ -389,7 +392,7 @@ class Execution:
             if domain is not None:
                 self._record_history(domain)
             if top_exit is not None and top_exit.id in active:
-                self._exit(top_exit)
+                self._exit(top_exit, path)
             self._sync_configuration()
             self._transition_actions(path)
             if domain is not None and domain.id not in active:
@@ -425,15 +428,19 @@ class Execution:
         d["_active"].add(node.id)
         d["_entered_at"][node.id] = d["_ticks"]
         d["_entered_log"].append(node.state)
-        for event in node.counted:
-            d["_counts"][(node.id, event)] = 0
+        d["_counts"][node.id] = {}  # events counted since this entry (the one entering it is not)
         for spec in node.durations:
-            d["_since"].pop((node.id, spec), None)
+            # duration(C) counts from when C became true, but never from before the state was entered
+            if self._duration_condition(node, spec)():
+                d["_since"][(node.id, spec)] = d["_ticks"]
+            else:
+                d["_since"].pop((node.id, spec), None)
         run = self._runner(node.state.enter.key)
         if run is not _no_action:
             d["_frames"].append(("entry", node, None))
             try:
-                run((path[-1].transition if path else None, node.state, self._event_object(path[-1]) if path else None))
+                run((path[-1].transition if path else None, node.state,
+                     self._event_object(path[-1]) if path else None, "enter"))
             finally:
                 d["_frames"].pop()
             if node.id not in d["_active"]:
@@ -503,7 +510,7 @@ class Execution:
                     return found
         return None
 
-    def _exit(self: TickChart, node: Node) -> None:
+    def _exit(self: TickChart, node: Node, path: Sequence[Seg] | None = None) -> None:
         """Exit an active state: its active children first (a parallel state's in reverse order)."""
         d = self.__dict__
         active = d["_active"]
@@ -511,12 +518,13 @@ class Execution:
             self._record_history(node)
             for child in reversed(node.children) if node.parallel else node.children:
                 if child.id in active:
-                    self._exit(child)
+                    self._exit(child, path)
         run = self._runner(node.state.exit.key)
         if run is not _no_action:
             d["_frames"].append(("exit", node, None))
             try:
-                run((None, node.state, None))
+                run((path[0].transition if path else None, node.state,
+                     self._event_object(path[0]) if path else None, "exit"))
             finally:
                 d["_frames"].pop()
             if node.id not in active:
@@ -581,11 +589,11 @@ class Execution:
     # -- temporal logic ---------------------------------------------------------------------------------
 
     def _count_event(self: TickChart, event: str) -> None:
-        d = self.__dict__
-        counts, active, nodes = d["_counts"], d["_active"], self._program.nodes
-        for (state_id, counted), value in list(counts.items()):
-            if counted == event and state_id in active and nodes[state_id].is_state:
-                counts[(state_id, counted)] = value + 1
+        """Count `event` for every active state (``after(n, E)``, ``temporal_count(E)``)."""
+        counts = self.__dict__["_counts"]
+        for state_id in self.__dict__["_active"]:
+            seen = counts[state_id]
+            seen[event] = seen.get(event, 0) + 1
 
     def _sample_durations(self: TickChart) -> None:
         d = self.__dict__

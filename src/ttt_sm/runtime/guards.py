@@ -128,10 +128,10 @@ def _compile_temporal(chart: FastPathChart, transition: Transition, temporal: Te
                        f"{transition.target.id if transition.target else '(none)'}")
     counters = chart.__dict__
     if temporal.event is not None:
-        counts, key, holds = counters["_counts"], (clock, temporal.event), temporal.holds
+        counts, event, holds = counters["_counts"], temporal.event, temporal.holds
 
         def counted() -> bool:
-            return holds(counts.get(key, 0), n)
+            return holds(counts.get(clock, {}).get(event, 0), n)
 
         return counted
     entered_at = chart._entered_at

@@ -67,8 +67,6 @@ class Node:
     history: Node | None = None
     deep: bool = False
     during: str | None = None
-    #: events counted by temporal operators on this state's transitions and actions
-    counted: tuple[str, ...] = ()
     durations: tuple[object, ...] = field(default=(), repr=False)
 
     @property
@@ -107,13 +105,16 @@ class Program:
     events: dict[str, object] = field(default_factory=dict)
 
 
-def _events_of(t: Transition, temporal: tuple[Temporal, ...]) -> frozenset[str] | None:
+def _events_of(t: Transition) -> frozenset[str] | None:
+    """The events that trigger `t`, None for an eventless one.
+
+    ``after(3, "E")`` in the condition of an eventless transition is Stateflow's
+    conditional notation (``[after(3, E)]``: tried at every wake-up); assigned to
+    the event ``E`` it is the trigger notation (``after(3, E)``: tried on E only).
+    """
     names = [str(e) for e in t.events if not str(e).startswith(TICK_EVENT_PREFIX)]
     # the SCXML alias the library adds beside a dotted event name
     names = [n for n in names if not ("." in n and n.replace(".", "_") in names)]
-    counted = [spec.event for spec in temporal if spec.event is not None]
-    if not names and counted:
-        return frozenset(counted)  # after(3, E) on its own is triggered by E, as in Stateflow
     return frozenset(names) if names else None
 
 
@@ -172,12 +173,10 @@ def build_program(cls: type, structure: ChartStructure) -> Program:
         durations = tuple(d for d in (duration_of(c.func) for c in t.cond) if d is not None)
         has_durations = has_durations or bool(durations)
         clock = source if source.is_state else _owner(source)
-        seg = Seg(transition=t, info=info, source=source, target=target, events=_events_of(t, temporal),
+        seg = Seg(transition=t, info=info, source=source, target=target, events=_events_of(t),
                   clock=clock, temporal=temporal)
         segs[id(t)] = seg
         if clock is not None:
-            counted = [s.event for s in temporal if s.event is not None]
-            clock.counted = tuple(dict.fromkeys((*clock.counted, *counted)))
             clock.durations = tuple(dict.fromkeys((*clock.durations, *durations)))
         if source.kind == "history":
             continue  # the library's own default of a history state: not Stateflow's

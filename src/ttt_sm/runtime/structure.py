@@ -221,7 +221,7 @@ def build_structure(cls: type[StateChart]) -> ChartStructure:
         during_name = f"{DURING_PREFIX}{state.id}"
         states.append(StateInfo(
             id=state.id,
-            label="" if junction else _display_name(state),
+            label=state.id if junction else _display_name(state),
             parent=state.parent.id if state.parent else None,
             depth=depth,
             children=tuple(c.id for c in state.states) + tuple(h.id for h in state.history),

@@ -1,0 +1,1 @@
+"""Stateflow conformance tests written from MathWorks' documented semantics examples."""

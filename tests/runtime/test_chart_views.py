@@ -132,7 +132,7 @@ def test_every_picture_has_a_legend_of_what_it_draws():
     assert "transition without an event" in overview and "transition with an event" in overview  # poke
     assert "sub-chart, closed" in overview and "drawn once from the dot" in overview
     assert "2: [guard]" in overview and "final state" in overview
-X
+    assert "during / f" not in overview  # stroke's during action is inside a closed sub-chart
     assert "outside this sub-chart" not in overview and "history" not in overview
     draw = _legend(to_dot(Plotter, view=View("draw", root="draw")))
     assert "during / f" in draw and "outside this sub-chart" in draw and "sub-chart, closed" not in draw

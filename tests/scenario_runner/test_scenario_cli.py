@@ -76,7 +76,7 @@ def test_a_malformed_file_exits_2_and_nothing_runs(files, capsys) -> None:
     assert code == 2 and out == ""
     assert err.strip() == (f"ttt-sm scenario: error: {files['malformed']}:4: unknown step kind 'expect_state'"
                            " (did you mean 'expect_states'?); step kinds: set, release, post, run, run_until,"
-                           " expect, expect_states, mark")
+                           " expect, expect_states, expect_events, mark")
     code, out, _ = run_cli(capsys, "run", str(files["malformed"]), "--json")
     assert code == 2
     assert json.loads(out)["errors"][0].startswith(f"{files['malformed']}:4: unknown step kind")

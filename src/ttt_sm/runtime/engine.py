@@ -558,6 +558,7 @@ class Execution:
                 f"{self.chart_name}: local event {event!r} nested {MAX_BROADCAST_DEPTH} deep: the chart"
                 " broadcasts events without end (an action sends an event whose handling sends it again)")
         frame = d["_frames"][-1] if d["_frames"] else None
+        self._tell_local_event(event, frame[1] if frame is not None else None, receiver)
         d["_depth"] += 1
         frames, d["_frames"] = d["_frames"], []
         try:
@@ -567,6 +568,15 @@ class Execution:
             d["_depth"] -= 1
         if frame is not None and self._returns_early(frame):
             raise EarlyReturn
+
+    def _tell_local_event(self: TickChart, event: str, sender: Node | None, receiver: Node | None) -> None:
+        """Listeners with ``on_local_event(machine, event, source, target)`` hear every local event
+        (a trace, the debugger's event breakpoints, a scenario's ``expect_events``)."""
+        for listener in list(self._listeners.values()):
+            hook = getattr(listener, "on_local_event", None)
+            if hook is not None:
+                hook(machine=self, event=event, source=sender.state if sender is not None else None,
+                     target=receiver.state if receiver is not None else None)
 
     def _returns_early(self: TickChart, frame: tuple[str, Node, Any]) -> bool:
         """Stateflow's early-return rule for the action that just broadcast."""

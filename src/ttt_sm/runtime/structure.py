@@ -293,7 +293,8 @@ def states_entered_by(chart: StateChart, transition: Transition) -> list[State]:
     """
     path, entered = vars(chart).get("_entered_path", ((), None))
     if entered is not None and any(seg.transition is transition for seg in path):
-        return list(entered)
+        # the path's last segment enters them; the segments before it only lead there
+        return list(entered) if path[-1].transition is transition else []
     if not transition.targets:
         return []
     domain = chart._engine.get_transition_domain(transition)

@@ -37,6 +37,7 @@ from .model import (
     BareCharts,
     Catalog,
     ChartRef,
+    ExpectEventsStep,
     ExpectStatesStep,
     ExpectStep,
     MarkStep,
@@ -64,6 +65,7 @@ STEP_OPTIONS: dict[str, tuple[str, ...]] = {
     "run_until": (),
     "expect": (),
     "expect_states": (),
+    "expect_events": (),
     "mark": (),
 }
 MATCH_MODES = ("subsequence", "exact")
@@ -440,6 +442,32 @@ class _Checker:
                                              " sequence lists the leaf states entered (use match: subsequence"
                                              " to include compound states)")
         return ExpectStatesStep(where, chart, tuple(seq), match)
+
+    def step_expect_events(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        if not isinstance(value, MarkedDict):
+            raise self.error(line, "expect_events: expected {chart: ..., sequence: [...]}, got "
+                                   f"{_type_name(value)}")
+        self.keys(value, ("chart", "sequence", "match"), "expect_events")
+        for key in ("chart", "sequence"):
+            if key not in value:
+                raise self.error(value.line, f"expect_events: missing {key}:")
+        chart = self.chart_name(value["chart"], value.line_of("chart"), "expect_events")
+        match = value.get("match", "subsequence")
+        if match not in MATCH_MODES:
+            raise self.error(value.line_of("match"), f"expect_events: match expected one of"
+                                                     f" {', '.join(MATCH_MODES)}, got {_type_name(match)}")
+        seq = value["sequence"]
+        if not isinstance(seq, MarkedList):
+            raise self.error(value.line_of("sequence"), "expect_events: sequence expected a list of event"
+                                                        f" names, got {_type_name(seq)}")
+        events = self.charts[chart].structure().user_events
+        for name, n_line in zip(seq, seq.item_lines, strict=True):
+            if name not in events:
+                with self.going_on():
+                    listed = ", ".join(events) or "(none)"
+                    raise self.error(n_line, f"expect_events: {chart} has no event {_r(name)}"
+                                             f"{suggest(name, events)}; events: {listed}")
+        return ExpectEventsStep(where, chart, tuple(seq), match)
 
     def step_mark(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
         if value is not None and not isinstance(value, str):

@@ -143,6 +143,16 @@ class ExpectStatesStep(Step):
 
 
 @dataclass(frozen=True)
+class ExpectEventsStep(Step):
+    """The local events a chart broadcast (``send`` in its actions) since the start or the last ``mark``."""
+
+    chart: str
+    sequence: tuple[str, ...]
+    match: Literal["subsequence", "exact"] = "subsequence"
+    kind = "expect_events"
+
+
+@dataclass(frozen=True)
 class MarkStep(Step):
     """Start a new window for ``expect_states``: states entered before it no longer count."""
 
@@ -227,10 +237,11 @@ class Catalog:
 
 
 def chart_states(cls: type[TickChart]) -> dict[str, str]:
-    """A chart's states by id: ``"leaf"``, ``"compound"`` or ``"history"``."""
+    """A chart's states by id: ``"leaf"``, ``"compound"``, ``"history"`` or ``"junction"``."""
     out: dict[str, str] = {}
     for s in cls.structure().states:
-        out[s.id] = "history" if s.history else ("compound" if s.is_compound else "leaf")
+        out[s.id] = ("history" if s.history else "junction" if s.junction
+                     else "compound" if s.is_compound else "leaf")
     return out
 
 

@@ -33,6 +33,7 @@ from ..runtime.listeners import Coverage
 from .model import (
     BareCharts,
     ChartRef,
+    ExpectEventsStep,
     ExpectStatesStep,
     ExpectStep,
     MarkStep,
@@ -197,6 +198,8 @@ class StateLog:
 
     def __init__(self) -> None:
         self.entries: dict[str, list[Entry]] = {}
+        #: the local events each chart broadcast, in order (``expect_events``)
+        self.events: dict[str, list[Entry]] = {}
         self.clock: Callable[[], float] = lambda: 0.0
 
     def record_initial(self, charts: Iterable[TickChart]) -> None:
@@ -211,6 +214,9 @@ class StateLog:
         log = self.entries.setdefault(machine.chart_name, [])
         now = self.clock()
         log += [Entry(s.id, machine.tick_count, now) for s in states_entered_by(machine, transition)]
+
+    def on_local_event(self, machine: TickChart, event: str, source: Any, target: Any) -> None:
+        self.events.setdefault(machine.chart_name, []).append(Entry(event, machine.tick_count, self.clock()))
 
 
 class _Stop(Exception):
@@ -288,6 +294,7 @@ class _Run:
         self.chart_dt = robot.params.control.chart_dt
         self.failures: list[Failure] = []
         self.mark: dict[str, int] = {name: 0 for name in robot.charts}  # the initial states count
+        self.event_mark: dict[str, int] = {name: 0 for name in robot.charts}
         self.mark_label = "the start"
         self.pending_sets: list[tuple[SetStep, ChartRef, Any]] = []
         self.inputs_fed = scenario.bare is None  # the wiring feeds some inputs; bare charts' only the steps
@@ -499,7 +506,31 @@ class _Run:
                        f" sequence){after}, got {_listed(actual[start:])}")
         self.fail(step, f"expect_states: {problem}; {self.where_is(chart)}")
 
+    def do_expect_events(self, step: ExpectEventsStep) -> None:
+        """Fail at the first local event that is not as expected."""
+        chart, since = step.chart, self.mark_label
+        actual = [e.state for e in self.log.events.get(chart, [])[self.event_mark.get(chart, 0):]]
+        expected = list(step.sequence)
+        if step.match == "exact":
+            k = _first_difference(expected, actual)
+            if k is None:
+                return
+            want = expected[k] if k < len(expected) else "none"
+            got = actual[k] if k < len(actual) else "none"
+            problem = (f"{chart}'s {_ordinal(k + 1)} local event since {since}: expected {want}, got {got}"
+                       f" (expected {_around(expected, k)}; sent {_around(actual, k)})")
+        else:
+            gap = _subsequence_gap(expected, actual)
+            if gap is None:
+                return
+            k, start = gap
+            after = f" after {expected[k - 1]}" if k else ""
+            problem = (f"{chart} since {since}: expected local event {expected[k]} ({_ordinal(k + 1)} of the"
+                       f" sequence){after}, got {_listed(actual[start:])}")
+        self.fail(step, f"expect_events: {problem}; {self.where_is(chart)}")
+
     def do_mark(self, step: MarkStep) -> None:
+        self.event_mark = {name: len(self.log.events.get(name, [])) for name in self.robot.charts}
         self.mark = {name: len(self.log.entries.get(name, [])) for name in self.robot.charts}
         self.mark_label = f"mark {step.label!r} (line {step.where.line})" if step.label else \
             f"the mark on line {step.where.line}"

@@ -198,7 +198,8 @@ def test_a_tick_with_a_posted_event_is_one_wake_up_on_it_where_eventless_transit
     lamp.post("button")
     # off's transitions in the order written: [switch] (no event, valid on any wake-up) before button
     taken = lamp.tick()
-    assert (taken.source.id, taken.target.id) == ("off", "on") and [str(e) for e in taken.events][0].startswith("_tick_off_")
+    assert (taken.source.id, taken.target.id) == ("off", "on")
+    assert [str(e) for e in taken.events][0].startswith("_tick_off_")
     assert lamp.calls == ["exit off", "count_on", "enter on"] and lamp.presses == 0
     assert lamp.configuration_values == {"on", "dim"}  # one wake-up: dim -> bright waits for the next
     taken = lamp.tick()

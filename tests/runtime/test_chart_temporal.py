@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from statemachine import State
 
-from ttt_sm.runtime import ChartDefinitionError, Data, TemporalLogicError, TickChart, after, after_s
+from ttt_sm.runtime import Data, TemporalLogicError, TickChart, after, after_s
 from ttt_sm.runtime.structure import states_entered_by
 
 

@@ -15,9 +15,9 @@ from .errors import (
     UnknownDataError,
     UnknownEventError,
 )
-from .structure import ChartStructure, StateInfo, TransitionInfo, states_entered_by
 from .junction import Junction
 from .state_actions import action_on
+from .structure import ChartStructure, StateInfo, TransitionInfo, states_entered_by
 from .temporal import after, after_s, at, before, duration, every
 
 __all__ = [

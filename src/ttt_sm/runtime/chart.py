@@ -42,7 +42,7 @@ from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, buffers, check_values, coll
 from .engine import EarlyReturn, Execution
 from .errors import ChartDefinitionError, TemporalLogicError, UnknownEventError
 from .guards import Guard, compile_condition, compile_guard
-from .program import Node, Program, Seg, build_program
+from .program import Node, Seg, build_program
 from .structure import (
     DURING_PREFIX,
     ChartStructure,
@@ -50,7 +50,7 @@ from .structure import (
     states_entered_by,
     tag_tick_transitions,
 )
-from .temporal import DurationSpec, Temporal, duration_of, temporal_of
+from .temporal import DurationSpec, Temporal
 
 _NO_PLAN = object()
 #: The key of the chart's own clock in ``_entered_at``: temporal logic on a junction outside every state.
@@ -257,7 +257,6 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
     _taken: list[Transition]
 
     _structure: ClassVar[ChartStructure]
-    _program: ClassVar[Program]
     _data_decls: ClassVar[tuple[Data, ...]] = ()
     _prev_pairs: ClassVar[tuple[tuple[str, str], ...]] = ()
     _dict_prev_pairs: ClassVar[tuple[tuple[str, str], ...]] = ()
@@ -569,7 +568,7 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
     def temporal_holds(self, spec: Temporal, state: Any) -> bool:
         """Whether a temporal operator holds for `state` (a state or its id) now."""
         state_id = getattr(state, "id", state)
-        return spec.holds(self.temporal_count(spec.unit, state_id, raw=True), spec.ticks(self.tick_period_s))
+        return spec.holds(int(self.temporal_count(spec.unit, state_id, raw=True)), spec.ticks(self.tick_period_s))
 
     def temporal_count(self, unit: str = "tick", state: Any = None, raw: bool = False) -> float:
         """Stateflow's ``temporalCount(unit)``: ticks, seconds (``sec``, ``msec``, ``usec``) or events E

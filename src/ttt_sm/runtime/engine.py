@@ -41,7 +41,7 @@ microsecond and a transition in a few.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from statemachine.callbacks import allways_true
 from statemachine.event import Event
@@ -50,11 +50,8 @@ from statemachine.orderedset import OrderedSet
 from statemachine.state import State
 from statemachine.transition import Transition
 
-from .errors import ChartDefinitionError, ChartExecutionError
+from .errors import ChartExecutionError
 from .program import Node, Program, Seg
-
-if TYPE_CHECKING:
-    from .chart import TickChart
 
 #: The path of a transition ended at a terminal junction (a flow chart: nothing exited or entered).
 TERMINAL = object()
@@ -84,11 +81,26 @@ class Execution:
     and ``_event_kwargs`` (the wake-up's event), ``_taken`` (transitions taken this tick).
     """
 
+    # what the chart class gives the mixin (TickChart and python-statemachine's StateChart)
     _program: Program
+    _callbacks: Any
+    _config: Any
+    _listeners: dict[int, Any]
+    chart_name: str
+    states_map: dict[Any, State]
+    start_configuration_values: list[Any]
+
+    def _compile_guard(self, seg: Seg) -> Callable[[], Any] | None:
+        """The guard of a segment as a plain call (None: no guard); the chart compiles it."""
+        raise NotImplementedError
+
+    def _duration_condition(self, node: Node, spec: Any) -> Callable[[], Any]:
+        """A ``duration`` condition as a plain call; the chart compiles it."""
+        raise NotImplementedError
 
     # -- the library's callbacks ---------------------------------------------------------------
 
-    def _runner(self: TickChart, key: str) -> _Action:
+    def _runner(self, key: str) -> _Action:
         """What the library would call for a callback key, as one function of a context.
 
         The chart's own methods that take no argument are called directly; anything
@@ -144,14 +156,14 @@ class Execution:
         runners[key] = run
         return run
 
-    def _kwargs(self: TickChart, ctx: tuple[Transition | None, State | None, Any]) -> dict[str, Any]:
+    def _kwargs(self, ctx: tuple[Transition | None, State | None, Any]) -> dict[str, Any]:
         """The keyword arguments python-statemachine gives a callback, for a context."""
         transition, state, event = ctx[:3]
         role = ctx[3] if len(ctx) > 3 else None
         d = self.__dict__
         if isinstance(event, str):
             event = self._program.events.get(event) or Event(event)
-        trigger = TriggerData(machine=self, event=event, kwargs=dict(d["_event_kwargs"]))
+        trigger = TriggerData(machine=self, event=event, kwargs=dict(d["_event_kwargs"]))  # type: ignore[arg-type]
         if transition is None:
             transition = _NO_TRANSITION
         data = EventData(trigger_data=trigger, transition=transition)
@@ -164,7 +176,7 @@ class Execution:
                 data.source = state
         return data.extended_kwargs
 
-    def _forget_runners(self: TickChart) -> None:
+    def _forget_runners(self) -> None:
         """Listeners changed: callbacks are looked up again (and the tick plans rebuilt)."""
         self.__dict__["_runners"].clear()
         self.__dict__["_plans"].clear()
@@ -172,7 +184,7 @@ class Execution:
 
     # -- activation ----------------------------------------------------------------------------
 
-    def _activate(self: TickChart) -> None:
+    def _activate(self) -> None:
         """Enter the chart: its default transitions (or the states it was asked to start in)."""
         program = self._program
         starts = [self.states_map[v] for v in self.start_configuration_values]
@@ -191,7 +203,7 @@ class Execution:
 
     # -- one wake-up ----------------------------------------------------------------------------
 
-    def _wake(self: TickChart, event: str | None, kwargs: dict[str, Any] | None = None,
+    def _wake(self, event: str | None, kwargs: dict[str, Any] | None = None,
               receiver: Node | None = None) -> None:
         """One wake-up of the chart on `event` (None: a tick), or of `receiver` (a directed event)."""
         d = self.__dict__
@@ -215,7 +227,7 @@ class Execution:
             d["_stepping"] -= 1
             d["_event"], d["_event_kwargs"] = saved
 
-    def _exec(self: TickChart, node: Node, phase: str = "outer", start: int = 0, held: bool = False) -> None:
+    def _exec(self, node: Node, phase: str = "outer", start: int = 0, held: bool = False) -> None:
         """Execute an active state: outer transitions, during and on actions, inner transitions, children.
 
         `phase`, `start` and `held` resume a wake-up that a tick plan began: at the
@@ -233,7 +245,7 @@ class Execution:
             return
         self._exec_children(node)
 
-    def _exec_children(self: TickChart, node: Node, after: Node | None = None) -> None:
+    def _exec_children(self, node: Node, after: Node | None = None) -> None:
         """Execute the active children of `node` (a parallel state's regions after `after`, if given)."""
         active = self.__dict__["_active"]
         if node.parallel:
@@ -251,7 +263,7 @@ class Execution:
                     self._exec(child)
                     return
 
-    def _during(self: TickChart, node: Node) -> None:
+    def _during(self, node: Node) -> None:
         """The during action, then the ``on`` actions whose event or condition matches."""
         d = self.__dict__
         frames = d["_frames"]
@@ -277,11 +289,11 @@ class Execution:
 
     # -- transitions ------------------------------------------------------------------------------
 
-    def _matches(self: TickChart, seg: Seg) -> bool:
+    def _matches(self, seg: Seg) -> bool:
         events = seg.events
         return events is None or self.__dict__["_event"] in events
 
-    def _guard(self: TickChart, seg: Seg) -> bool:
+    def _guard(self, seg: Seg) -> bool:
         guards = self.__dict__["_guards"]
         t = seg.transition
         guard = guards.get(id(t), _UNSET)
@@ -289,7 +301,7 @@ class Execution:
             guard = guards[id(t)] = self._compile_guard(seg)
         return guard is None or bool(guard())
 
-    def _try(self: TickChart, node: Node, segs: Sequence[Seg], start: int = 0, held: bool = False) -> bool:
+    def _try(self, node: Node, segs: Sequence[Seg], start: int = 0, held: bool = False) -> bool:
         """Try `segs` of `node` in order from `start`; take the first valid path.
 
         `held`: the guard of ``segs[start]`` was evaluated already and held.
@@ -307,11 +319,12 @@ class Execution:
                 continue  # every way on from a junction failed: try the next transition
             if path is TERMINAL:
                 return True
+            assert isinstance(path, list)
             self._take(node, path)
             return True
         return node.id not in d["_active"]
 
-    def _condition_action(self: TickChart, node: Node, seg: Seg) -> None:
+    def _condition_action(self, node: Node, seg: Seg) -> None:
         key = seg.transition.before.key
         run = self._runner(key)
         if run is _no_action:
@@ -323,7 +336,7 @@ class Execution:
         finally:
             frames.pop()
 
-    def _follow(self: TickChart, node: Node, path: list[Seg]) -> list[Seg] | object | None:
+    def _follow(self, node: Node, path: list[Seg]) -> list[Seg] | object | None:
         """A path whose last segment's condition held: run its condition action, follow junctions.
 
         Returns the whole path to a state, :data:`TERMINAL` for a path that ended at a
@@ -348,7 +361,7 @@ class Execution:
                     return found
         return None
 
-    def _transition_actions(self: TickChart, path: Sequence[Seg]) -> None:
+    def _transition_actions(self, path: Sequence[Seg]) -> None:
         frames = self.__dict__["_frames"]
         for seg in path:
             run = self._runner(seg.transition.on.key)
@@ -360,7 +373,7 @@ class Execution:
             finally:
                 frames.pop()
 
-    def _take(self: TickChart, source: Node, path: list[Seg]) -> None:
+    def _take(self, source: Node, path: list[Seg]) -> None:
         """Take a valid path: exit, transition actions, enter; then the library's after-callbacks."""
         d = self.__dict__
         active = d["_active"]
@@ -410,7 +423,7 @@ class Execution:
         d["_entered_path"] = (path, entered)
         self._after(path)
 
-    def _after(self: TickChart, path: Sequence[Seg]) -> None:
+    def _after(self, path: Sequence[Seg]) -> None:
         """The library's after-transition callbacks of every segment (listeners, ``after=``)."""
         d = self.__dict__
         taken = d["_taken"]
@@ -422,7 +435,7 @@ class Execution:
 
     # -- entering and exiting -----------------------------------------------------------------------
 
-    def _enter(self: TickChart, node: Node, targets: set[Node], path: Sequence[Seg] | None) -> None:
+    def _enter(self, node: Node, targets: set[Node], path: Sequence[Seg] | None) -> None:
         """Enter `node` (inactive) and below it towards `targets`, else by default or history."""
         d = self.__dict__
         d["_active"].add(node.id)
@@ -448,7 +461,7 @@ class Execution:
         if node.children:
             self._enter_children(node, targets, path)
 
-    def _enter_children(self: TickChart, node: Node, targets: set[Node] | None,
+    def _enter_children(self, node: Node, targets: set[Node] | None,
                         path: Sequence[Seg] | None) -> None:
         if node.parallel:
             for region in node.children:
@@ -465,7 +478,7 @@ class Execution:
             return
         self._enter_default_of(node, node.default, path)
 
-    def _enter_default_of(self: TickChart, node: Node | None, default: Node | None,
+    def _enter_default_of(self, node: Node | None, default: Node | None,
                           path: Sequence[Seg] | None) -> None:
         """Follow the default transition of `node` (None: the chart) into a state."""
         if default is None:
@@ -481,11 +494,8 @@ class Execution:
                     end = found[-1].target
                     assert end is not None
                     self._transition_actions(found)
-                    if node is None:
-                        top = end if end.parent is None else next(a for a in [end, *end.ancestors()]
-                                                                  if a.parent is None)
-                    else:
-                        top = _child_towards(node, end)
+                    top = _child_towards(node, end)
+                    assert top is not None
                     self._enter(top, {end}, found)
                     self._after(found)
                     return
@@ -494,7 +504,7 @@ class Execution:
             f"{self.chart_name}: no default transition of {where} is valid (from junction {default.id!r}):"
             " a state must enter one of its sub-states; add a segment without a condition")
 
-    def _follow_default(self: TickChart, node: Node | None, path: list[Seg]) -> list[Seg] | None:
+    def _follow_default(self, node: Node | None, path: list[Seg]) -> list[Seg] | None:
         seg = path[-1]
         run = self._runner(seg.transition.before.key)
         if run is not _no_action:
@@ -510,7 +520,7 @@ class Execution:
                     return found
         return None
 
-    def _exit(self: TickChart, node: Node, path: Sequence[Seg] | None = None) -> None:
+    def _exit(self, node: Node, path: Sequence[Seg] | None = None) -> None:
         """Exit an active state: its active children first (a parallel state's in reverse order)."""
         d = self.__dict__
         active = d["_active"]
@@ -531,7 +541,7 @@ class Execution:
                 raise EarlyReturn
         active.discard(node.id)
 
-    def _record_history(self: TickChart, node: Node) -> None:
+    def _record_history(self, node: Node) -> None:
         """Remember the active child of a state with a history junction (all below it, for deep history)."""
         if node.history is None:
             return
@@ -542,7 +552,7 @@ class Execution:
         rest = [i for i in _ids_below(child) if i in active] if node.deep else []
         self.__dict__["_recorded"][node.id] = (child.id, *rest)
 
-    def _sync_configuration(self: TickChart) -> None:
+    def _sync_configuration(self) -> None:
         """Write the active states to python-statemachine's configuration (document order)."""
         nodes = self._program.nodes
         active = sorted((nodes[i] for i in self.__dict__["_active"]), key=_by_index)
@@ -550,7 +560,7 @@ class Execution:
 
     # -- local events -------------------------------------------------------------------------------
 
-    def _broadcast(self: TickChart, event: str, receiver: Node | None, kwargs: dict[str, Any]) -> None:
+    def _broadcast(self, event: str, receiver: Node | None, kwargs: dict[str, Any]) -> None:
         """A local event from an action: a nested wake-up now; then Stateflow's early return."""
         d = self.__dict__
         if d["_depth"] >= MAX_BROADCAST_DEPTH:
@@ -569,7 +579,7 @@ class Execution:
         if frame is not None and self._returns_early(frame):
             raise EarlyReturn
 
-    def _tell_local_event(self: TickChart, event: str, sender: Node | None, receiver: Node | None) -> None:
+    def _tell_local_event(self, event: str, sender: Node | None, receiver: Node | None) -> None:
         """Listeners with ``on_local_event(machine, event, source, target)`` hear every local event
         (a trace, the debugger's event breakpoints, a scenario's ``expect_events``)."""
         for listener in list(self._listeners.values()):
@@ -578,7 +588,7 @@ class Execution:
                 hook(machine=self, event=event, source=sender.state if sender is not None else None,
                      target=receiver.state if receiver is not None else None)
 
-    def _returns_early(self: TickChart, frame: tuple[str, Node, Any]) -> bool:
+    def _returns_early(self, frame: tuple[str, Node, Any]) -> bool:
         """Stateflow's early-return rule for the action that just broadcast."""
         kind, node, path = frame
         active = self.__dict__["_active"]
@@ -598,14 +608,14 @@ class Execution:
 
     # -- temporal logic ---------------------------------------------------------------------------------
 
-    def _count_event(self: TickChart, event: str) -> None:
+    def _count_event(self, event: str) -> None:
         """Count `event` for every active state (``after(n, E)``, ``temporal_count(E)``)."""
         counts = self.__dict__["_counts"]
         for state_id in self.__dict__["_active"]:
             seen = counts[state_id]
             seen[event] = seen.get(event, 0) + 1
 
-    def _sample_durations(self: TickChart) -> None:
+    def _sample_durations(self) -> None:
         d = self.__dict__
         since, active = d["_since"], d["_active"]
         for node in self._program.ordered:
@@ -621,7 +631,7 @@ class Execution:
 
     # -- helpers ------------------------------------------------------------------------------------------
 
-    def _event_object(self: TickChart, seg: Seg) -> Any:
+    def _event_object(self, seg: Seg) -> Any:
         """The event a callback of `seg` is told about: the wake-up's, or the tick event of an eventless one."""
         event = self.__dict__["_event"]
         if event is not None and seg.events is not None:

@@ -23,7 +23,8 @@ from statemachine.state import State
 from statemachine.transition_list import TransitionList
 
 
-def action_on(states: State | Sequence[State], action: str | Callable[..., Any], cond: Any = None) -> TransitionList:
+def action_on(states: State | type | Sequence[State | type], action: str | Callable[..., Any],
+              cond: Any = None) -> TransitionList:
     """The ``on`` action of a state (or of each of several): run `action` in its during phase when
     the event (or `cond`) matches.
 
@@ -31,7 +32,8 @@ def action_on(states: State | Sequence[State], action: str | Callable[..., Any],
     joined with ``|`` to that event's transitions) for ``on button:``; leave it
     unassigned with a temporal `cond` for ``on after(3, tick):`` or ``on every(...)``.
     """
-    many = [states] if isinstance(states, State) else list(states)
+    # (a compound state written as a class body is a State to the library, a type to a type checker)
+    many = [states] if isinstance(states, (State, type)) else list(states)
     if not many or not all(isinstance(s, State) for s in many):
         raise TypeError(f"action_on(states, action): {states!r} is not a state or a sequence of states")
     kwargs: dict[str, Any] = {"on": action}
@@ -39,5 +41,5 @@ def action_on(states: State | Sequence[State], action: str | Callable[..., Any],
         kwargs["cond"] = cond
     result = TransitionList()
     for state in many:
-        result = result | state.to(None, **kwargs)  # type: ignore[arg-type]  # a targetless transition
+        result = result | state.to(None, **kwargs)  # type: ignore[arg-type,union-attr]  # a targetless transition
     return result

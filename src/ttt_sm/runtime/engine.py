@@ -305,8 +305,9 @@ class Execution:
         """Try `segs` of `node` in order from `start`; take the first valid path.
 
         `held`: the guard of ``segs[start]`` was evaluated already and held.
-        Returns True when the state's step ended here: a path was taken, or
-        ended at a terminal junction.
+        Returns True when the state's step ended here (a path was taken).  A path
+        that ends at a terminal junction ends the trying (no later transition of
+        `segs` is tried, nothing is left): the state's step goes on.
         """
         d = self.__dict__
         for seg in segs[start:] if start else segs:
@@ -318,7 +319,7 @@ class Execution:
             if path is None:
                 continue  # every way on from a junction failed: try the next transition
             if path is TERMINAL:
-                return True
+                return node.id not in d["_active"]
             assert isinstance(path, list)
             self._take(node, path)
             return True
@@ -340,8 +341,9 @@ class Execution:
         """A path whose last segment's condition held: run its condition action, follow junctions.
 
         Returns the whole path to a state, :data:`TERMINAL` for a path that ended at a
-        terminal junction (its transition actions run), or None when every way on
-        failed (the caller backtracks).
+        terminal junction (its transition actions run: the path is complete, as
+        MathWorks' "Modeling Guidelines for Stateflow Charts" says), or None when every
+        way on failed (the caller backtracks).
         """
         seg = path[-1]
         self._condition_action(node, seg)

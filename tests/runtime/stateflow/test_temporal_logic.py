@@ -12,7 +12,7 @@ of behaviour).  Each becomes a test: the chart is the example's label on a state
 to B), driven by events or ticks, asserting the event count / tick / chart time at which the
 action runs or the transition is taken.
 
-Conventions of these tests (the runtime's reading of the pages; see EXAMPLES_B.md):
+Conventions of these tests (the runtime's reading of the pages; see README.md):
 - Construction is the chart's first wake-up, at chart time 0; it activates A.  ``chart.tick()``
   advances chart time by ``tick_period_s`` and wakes the chart; ``chart.send("E")`` wakes it on E
   without advancing time.
@@ -404,16 +404,10 @@ def test_at_7_tick_fires_only_at_the_seventh_wake_up():
     assert missed.active_ids == frozenset({"A"})
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="the at page supports at(n,sec) only in standalone MATLAB charts; charts in Simulink "
-    "models must use after instead (their at(n,sec) is an error).  If the runtime follows the "
-    "Simulink rule it should reject this chart; if it follows the standalone rule the test passes",
-)
 def test_on_at_2_sec_runs_once_when_exactly_two_seconds_have_elapsed():
     """at page: at(n,sec) is true if exactly n seconds have elapsed since A became active.  With a
-    0.25 s tick: only at tick 8.  (Chart class built inside the test: a runtime that follows the
-    Simulink rule may refuse it at class creation.)"""
+    0.25 s tick: only at tick 8.  (The page allows at(n,sec) in standalone MATLAB charts and refuses
+    it in charts inside Simulink models; the runtime follows the standalone rule, docs/runtime.md.)"""
 
     class OnAtSec(TickChart):
         """A: ``on at(2,sec): disp("ON")``.  <REF at.html>"""
@@ -670,7 +664,7 @@ def test_duration_restarts_when_the_condition_becomes_false():
     condition is evaluated at each time step.  x >= 0 at tick 1, x < 0 at tick 2, x >= 0 again from
     tick 3: at tick 3 the duration is at most one tick (0.0625 s): stay; by tick 5 it exceeds 0.1 s:
     gone.  (Tick 4 is not asserted: the pages do not say whether the first true sample counts 0 or
-    one period; see EXAMPLES_B.md.)"""
+    one period; see README.md.)"""
     chart = DurationGuard(tick_period_s=0.0625)
     chart.tick()
     chart.x = -1.0

@@ -34,6 +34,13 @@ from statemachine import HistoryState, State
 
 from ..runtime import Data, TickChart
 
+#: Data every DriveInit chart declares alike (thesis fig. 3.2-3.4: pos_in in, pos_out and the offset out).
+_POS_IN = Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)")
+_INDEX = Data("index", "bool", False, "index switch level, from the Encoder block")
+_INDEX_POS = Data("index_pos", "rad", 0.0, "encoder angle latched at the index switch's last edge")
+_POS_OUT = Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller")
+_OFFSET = Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle")
+_INDEX_ANGLE = Data("index_angle", "rad", 0.0, "true angle of the index switch")
 #: Outputs every DriveInit chart declares: what the application reads of its state.
 _STATUS = (
     Data("passing", "bool", False, "initialised: passes pos_in through (pass_pos)"),
@@ -104,24 +111,24 @@ class DriveInit1(_IndexSearch):
     timed = True
 
     inputs = (
-        Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
+        _POS_IN,
         Data("stop", "bool", False, "a non-zero value stops the drive where it is"),
-        Data("index", "bool", False, "index switch level, from the Encoder block"),
+        _INDEX,
         Data("pos_Encoder", "rad", 0.0, "drive angle from the encoder (relative until initialised)"),
-        Data("index_pos", "rad", 0.0, "encoder angle latched at the index switch's last edge"),
+        _INDEX_POS,
         Data("ini2", "bool", False, "drive 2 is initialised"),
         Data("ini3", "bool", False, "drive 3 is initialised"),
     )
     outputs = (
-        Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
-        Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
+        _POS_OUT,
+        _OFFSET,
         Data("ini_23", "bool", False, "drive 1 initialised and parked: drives 2 and 3 may start"),
         *_STATUS,
     )
     local = (
         Data("search_speed", "rad/s", 1.0, "how fast the setpoint turns while searching and parking"),
         Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period"),
-        Data("index_angle", "rad", 0.0, "true angle of the index switch"),
+        _INDEX_ANGLE,
         Data("park", "rad", 0.0, "angle to wait at while drives 2 and 3 initialise"),
         Data("still_speed", "rad/s", 0.25, "encoder slower than this (a quarter of search_speed): stalled"),
         Data("stall_lag", "rad", 0.06, "setpoint this far ahead of a still encoder: stalled (a start at a stop)"),
@@ -228,22 +235,22 @@ class DriveInit2(_IndexSearch):
     timed = True
 
     inputs = (
-        Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
-        Data("index", "bool", False, "index switch level, from the Encoder block"),
-        Data("index_pos", "rad", 0.0, "encoder angle latched at the index switch's last edge"),
+        _POS_IN,
+        _INDEX,
+        _INDEX_POS,
         Data("ini1", "bool", False, "drive 1 is initialised and parked (its ini_23)"),
         Data("ini3", "bool", False, "drive 3 is initialised"),
     )
     outputs = (
-        Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
-        Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
+        _POS_OUT,
+        _OFFSET,
         Data("ini2", "bool", False, "drive 2 is initialised"),
         *_STATUS,
     )
     local = (
         Data("search_speed", "rad/s", 0.75, "how fast the setpoint turns while searching and parking"),
         Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period"),
-        Data("index_angle", "rad", 0.0, "true angle of the index switch"),
+        _INDEX_ANGLE,
         Data("turn_angle", "rad", 0.6, "how far to turn one way before turning back"),
         Data("max_back", "rad", 2.0, "how far to turn back before giving up"),
         Data("travel", "rad", 0.0, "turned so far in the current direction"),
@@ -295,15 +302,15 @@ class DriveInit3(_HomeAndPass):
     timed = True
 
     inputs = (
-        Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)"),
+        _POS_IN,
         Data("index", "bool", False, "index-and-limit switch level, from the Encoder block"),
         Data("index_pos", "rad", 0.0, "encoder angle latched at the switch's last edge"),
         Data("ini1", "bool", False, "drive 1 is initialised and parked (its ini_23)"),
         Data("ini2", "bool", False, "drive 2 is initialised"),
     )
     outputs = (
-        Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller"),
-        Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
+        _POS_OUT,
+        _OFFSET,
         Data("ini3", "bool", False, "drive 3 is initialised and parked"),
         *_STATUS,
     )

@@ -283,19 +283,6 @@ class Safety(TickChart):
     def on_exit_safe(self) -> None:
         self.tripped = False
 
-    # the encoder-still timers (and the servo's) run wherever a drive fault can still trip the chart
-    def during_monitoring(self) -> None:
-        self._count_still()
-
-    def during_lift(self) -> None:
-        self._count_still()
-
-    def during_hold(self) -> None:
-        self._count_still()
-
-    def during_reinitialising(self) -> None:
-        self._count_still()
-
     def _count_still(self) -> None:
         """still_k: how long drive k's encoder has run at most stall_ratio of its commanded speed (0 while
         initialising); servo_off: how long the servo's feedback has been off its model."""
@@ -307,6 +294,10 @@ class Safety(TickChart):
         d["still_2"] = d["still_2"] + dt if c2 > moving and d["speed_2"] <= ratio * c2 else 0.0
         d["still_3"] = d["still_3"] + dt if c3 > moving and d["speed_3"] <= ratio * c3 else 0.0
         d["servo_off"] = d["servo_off"] + dt if abs(d["servo_err"]) > d["max_servo_error"] else 0.0
+
+
+    # the encoder-still timers (and the servo's) run wherever a drive fault can still trip the chart
+    during_monitoring = during_lift = during_hold = during_reinitialising = _count_still
 
 
 __all__ = ["Safety"]

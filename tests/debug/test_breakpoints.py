@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import pytest
 
@@ -216,3 +217,45 @@ def test_values_that_cannot_be_compared_are_debug_errors(text, message):
 def test_an_empty_condition_says_what_to_write():
     with pytest.raises(DebugError, match="empty condition: write e.g. 'DriveInit1.pos_Encoder > 1.0'"):
         parse_condition("  ", _Values())
+
+
+def test_breakpoints_on_a_junction_segment_and_on_a_local_event_hit_where_they_happen():
+    """A transition breakpoint names a junction as the source of one way out of a decision; an event
+    breakpoint hits on a local event an action broadcasts (it takes no transition of its own here)."""
+    from statemachine import State
+
+    from ttt_sm.debug.breakpoints import BreakListener, ChartIndex, parse_breakpoint
+    from ttt_sm.runtime import Data, Junction, TickChart
+
+    class Sorter(TickChart):
+        inputs = (Data("size", "1", 0, "size of the request"),)
+        idle = State(initial=True)
+        small = State()
+        large = State()
+        j = Junction()
+        request = idle.to(j)
+        j.to(large, cond="size > 10", on="tell")
+        j.to(small)
+        back = small.to(idle) | large.to(idle)
+        noted = idle.to(idle)  # handled only while idle: the broadcast from large finds no taker
+
+        def tell(self) -> None:
+            self.send("noted")
+
+    chart = Sorter(chart_name="Sorter")
+    index = ChartIndex({"Sorter": chart})
+    names: Any = None  # only a `when` breakpoint reads names
+    bps = [parse_breakpoint(1, "transition Sorter j->large", index, names),
+           parse_breakpoint(2, "event Sorter.noted", index, names),
+           parse_breakpoint(3, "transition Sorter j->small", index, names)]
+    listener = BreakListener(bps)
+    chart.add_listener(listener)
+    chart.size = 3
+    chart.send("request")
+    assert [h.breakpoint for h in listener.hits] == [3]
+    chart.send("back")
+    chart.size = 12
+    chart.send("request")
+    assert [h.breakpoint for h in listener.hits] == [3, 2, 1]
+    assert listener.hits[1].detail == "local event noted sent from idle"
+    assert listener.hits[2].detail == "j -> large"

@@ -6,10 +6,12 @@ Five kinds, written as in the REPL:
   the state (``on_enter_state`` / ``on_exit_state``), including re-entries
   and the states a history pseudo-state restores;
 - ``transition Chart source->target``: a transition from ``source`` to
-  ``target`` is taken (``after_transition``); ``*`` stands for any state;
-- ``event Chart.name``: an event posted to the chart is handled at a tick, or
-  a transition with that trigger is taken (``tick`` for tick transitions, as
-  the trace names them);
+  ``target`` is taken (``after_transition``); ``*`` stands for any state; a
+  junction is a source or a target too, so a breakpoint can watch one way out
+  of a decision (``transition Chart j->large``);
+- ``event Chart.name``: an event posted to the chart is handled at a tick, a
+  transition with that trigger is taken (``tick`` for tick transitions, as
+  the trace names them), or an action broadcasts it as a local event;
 - ``when condition``: the condition (see :mod:`.expr`) *becomes* true; it is
   checked after every chart tick.
 
@@ -222,6 +224,15 @@ class BreakListener:
         for bp in self._watching("event", chart):
             if bp.event == trigger:
                 self._hit(bp, machine, f"{trigger}: {source} -> {target}")
+
+    def on_local_event(self, machine: StateChart, event: str, source: State | None, target: State | None) -> None:
+        """A chart's action broadcast a local event (``self.send``): an event breakpoint on it hits."""
+        chart = machine.chart_name  # type: ignore[attr-defined]
+        for bp in self._watching("event", chart):
+            if bp.event == event:
+                where = f" from {source.id}" if source is not None else ""
+                to = f" to {target.id}" if target is not None else ""
+                self._hit(bp, machine, f"local event {event} sent{where}{to}")
 
     def events_handled(self, machine: StateChart, events: Iterable[str]) -> None:
         """Posted events the chart handled in its last tick (taken or not)."""

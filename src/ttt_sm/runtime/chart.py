@@ -532,7 +532,8 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
             node = chain[-1]
             if transitions(chain, node.outer, "outer"):
                 return True
-            if node.actions:
+            if any(seg.events is None for seg in node.actions):
+                # an `on` action without an event (on after(...), on every(...)) may run at a tick
                 steps.append(("act", (node, partial(self._during, node))))
             elif node.during is not None:
                 steps.append(("act", (node, getattr(self, node.during))))

@@ -45,11 +45,34 @@ class Interrupted(KeyboardInterrupt):
         self.signal = signal_name
 
 
+#: Packages whose code calls back into Python from C (numba's compiler through llvmlite's ctypes
+#: callbacks): an exception raised there is printed and swallowed, so a signal waits until they return.
+_FOREIGN_PACKAGES = frozenset({"numba", "llvmlite", "ctypes"})
+#: How often a signal that waits looks again whether the foreign code has returned, s.
+_RETRY_S = 0.05
+
+
+def _in_foreign_code(frame: Any) -> bool:
+    """Whether the Python stack at `frame` runs inside a package that calls back from C (see above)."""
+    while frame is not None:
+        if str(frame.f_globals.get("__name__", "")).partition(".")[0] in _FOREIGN_PACKAGES:
+            return True
+        frame = frame.f_back
+    return False
+
+
 def terminate_interrupts() -> Callable[[], None]:
-    """Make SIGTERM raise :class:`Interrupted` (in the main thread); returns what restores the handler.
+    """Make SIGTERM and Ctrl-C stop the command at a safe point (in the main thread); returns what
+    restores the handlers.
 
     Without it SIGTERM ends the process at once, in the middle of whatever it
-    wrote, with no line saying so.  Commands that stop in a gentler way
+    wrote, with no line saying so.  A signal is raised as :class:`Interrupted`
+    (``KeyboardInterrupt`` for Ctrl-C) where Python is, unless that is inside
+    numba's compiler or another package that calls back into Python from C:
+    there the exception would be swallowed (``Exception ignored in ctypes
+    callback``) and the command would go on.  Then the handler only notes the
+    signal and looks again every 50 ms (``SIGALRM``) until the stack has left
+    that code, and raises there.  Commands that stop in a gentler way
     (``ttt-sm play`` at the end of a chart step, ``ttt-sm gui`` through its
     server) put handlers of their own in place while they run.
     """
@@ -59,16 +82,40 @@ def terminate_interrupts() -> Callable[[], None]:
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
 
-    def raise_interrupted(_signum: int, _frame: object) -> None:
-        raise Interrupted("SIGTERM")
+    pending: list[int] = []
+
+    def raise_now(signum: int) -> None:
+        pending.clear()
+        if signum == signal.SIGTERM:
+            raise Interrupted("SIGTERM")
+        raise KeyboardInterrupt
+
+    def on_signal(signum: int, frame: object) -> None:
+        if _in_foreign_code(frame):
+            if not pending:
+                pending.append(signum)
+                signal.setitimer(signal.ITIMER_REAL, _RETRY_S)
+            return
+        raise_now(signum)
+
+    def look_again(_signum: int, frame: object) -> None:
+        if not pending:
+            return
+        if _in_foreign_code(frame):
+            signal.setitimer(signal.ITIMER_REAL, _RETRY_S)
+            return
+        raise_now(pending[0])
 
     try:
-        previous = signal.signal(signal.SIGTERM, raise_interrupted)
+        previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGTERM, signal.SIGINT)}
+        previous[signal.SIGALRM] = signal.signal(signal.SIGALRM, look_again)
     except ValueError:  # not the main interpreter
         return lambda: None
 
     def restore() -> None:
-        signal.signal(signal.SIGTERM, previous)
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     return restore
 
 

@@ -36,8 +36,7 @@ from ttt_sm.app.drawing import DrawSession
 from ttt_sm.hardware.firmware import firmware_root
 from ttt_sm.hardware.native import NativeCascade
 from ttt_sm.params import load_params
-from ttt_sm.twin import _cascade as C
-from ttt_sm.twin import _plant as PL
+from ttt_sm.twin import layout
 from ttt_sm.twin.plant import REST_POSE, Plant
 from ttt_sm.twin.sim import ArmSim
 
@@ -92,10 +91,10 @@ class Recording:
         for _ in range(n):
             self.counts.append(plant.counts.copy())
             self.modes.append(ctrl.modes.copy())
-            self.state.append((ctrl.cs[:, :C.N_CS].copy(), ctrl.cgs[:C.N_CGS].copy()))
+            self.state.append((ctrl.cs[:, :layout.N_CS].copy(), ctrl.cgs[:layout.N_CGS].copy()))
             self._step_one(1)
-            self.act.append(ctrl.act[:C.N_ACT].copy())
-            self.q.append(plant.ps[:, PL.PS_Q].copy())
+            self.act.append(ctrl.act[:layout.N_ACT].copy())
+            self.q.append(plant.ps[:, layout.PS_Q].copy())
 
 
 def replay(rec: Recording, native: NativeCascade, plant: Plant | None = None) -> np.ndarray:
@@ -104,11 +103,11 @@ def replay(rec: Recording, native: NativeCascade, plant: Plant | None = None) ->
     With `plant`, the C controller's outputs drive it (closed loop) and the
     plant's joint angles after each step are returned instead.
     """
-    out = np.empty((len(rec.counts), C.N_ACT if plant is None else 3))
+    out = np.empty((len(rec.counts), layout.N_ACT if plant is None else 3))
     commands = iter(rec.commands)
     pending = next(commands, None)
     act, modes = native.act, native.modes
-    applied = np.zeros(C.N_ACT)
+    applied = np.zeros(layout.N_ACT)
     for k, counts in enumerate(rec.counts):
         while pending is not None and pending[0] == k:
             getattr(native, pending[1])(*pending[2])
@@ -121,7 +120,7 @@ def replay(rec: Recording, native: NativeCascade, plant: Plant | None = None) ->
             native.step(plant.counts)
             applied[:] = act
             plant.step(applied)
-            out[k] = plant.ps[:, PL.PS_Q]
+            out[k] = plant.ps[:, layout.PS_Q]
     return out
 
 
@@ -145,8 +144,8 @@ def test_the_recording_covers_a_whole_drawing(drawing):
     assert len(drawing.counts) > 90_000
     assert {"set_setpoints", "set_offset_estimate"} <= names  # the init charts' offsets, the drawing
     act = np.array(drawing.act)
-    assert np.abs(act[:, C.ACT_DUTY:C.ACT_DUTY + 3]).max() > 0.2  # the drives worked
-    assert len(np.unique(act[:, C.ACT_SV_DUTY])) >= 2  # the pen went down and up
+    assert np.abs(act[:, layout.ACT_DUTY:layout.ACT_DUTY + 3]).max() > 0.2  # the drives worked
+    assert len(np.unique(act[:, layout.ACT_SV_DUTY])) >= 2  # the pen went down and up
 
 
 def test_the_double_build_is_the_pc_step_bit_for_bit(firmware_libs, drawing):
@@ -157,12 +156,12 @@ def test_the_double_build_is_the_pc_step_bit_for_bit(firmware_libs, drawing):
 def test_one_float_step_computes_the_pc_steps_duty_within_tolerance(firmware_libs, drawing):
     native = _native(firmware_libs["float"], drawing)
     cs, cgs, modes = native.cs, native.cgs, native.modes
-    computed = np.empty((len(drawing.counts), C.N_ACT))
+    computed = np.empty((len(drawing.counts), layout.N_ACT))
     for k, counts in enumerate(drawing.counts):
         cs[:], cgs[:] = drawing.state[k]  # the PC's state before step k (float64 -> float32)
         modes[:] = drawing.modes[k]
         native.step(counts)
-        computed[k, :3] = cs[:, C.CS_DUTY_CMD]  # the duty computed now, applied next step
+        computed[k, :3] = cs[:, layout.CS_DUTY_CMD]  # the duty computed now, applied next step
         computed[k, 3:] = native.act[3:]
     py_act = np.array(drawing.act)
     duty = np.abs(computed[:-1, :3] - py_act[1:, :3])
@@ -170,8 +169,9 @@ def test_one_float_step_computes_the_pc_steps_duty_within_tolerance(firmware_lib
     assert worst <= FLOAT_STEP_TOLERANCE, (
         f"float32 step: max |duty difference| {worst:.3g} at step {int(duty.max(axis=1).argmax())} "
         f"of {len(duty)}")
-    assert np.array_equal(computed[:, C.ACT_BRIDGE:C.ACT_BRIDGE + 3], py_act[:, C.ACT_BRIDGE:C.ACT_BRIDGE + 3])
-    assert np.abs(computed[:, C.ACT_SV_DUTY] - py_act[:, C.ACT_SV_DUTY]).max() <= FLOAT_SERVO_TOLERANCE
+    bridges = slice(layout.ACT_BRIDGE, layout.ACT_BRIDGE + 3)
+    assert np.array_equal(computed[:, bridges], py_act[:, bridges])
+    assert np.abs(computed[:, layout.ACT_SV_DUTY] - py_act[:, layout.ACT_SV_DUTY]).max() <= FLOAT_SERVO_TOLERANCE
     assert np.count_nonzero(py_act[1:, :3]) > 0.5 * duty.size  # the duties compared are mostly not 0
 
 

@@ -182,18 +182,3 @@ def test_the_float_build_closing_the_loop_on_the_twins_plant_follows_the_twin(fi
     gap = np.abs(q - np.array(drawing.q)).max(axis=0)
     assert (gap <= FLOAT_LOOP_TOLERANCE_RAD).all(), f"float32 firmware on the plant: max |dq| {gap} rad"
     assert np.abs(np.diff(q, axis=0)).sum(axis=0).min() > 0.5  # every drive travelled (rad)
-
-
-def test_the_headers_layout_is_the_pc_steps(firmware_libs):
-    """Every index of cascade.h has the value of its namesake in _cascade.py (docs/model.md's table)."""
-    header = (firmware_root() / "include" / "ttt_fw" / "cascade.h").read_text()
-    defines = dict(re.findall(r"#define TTT_((?:CP|CG|CS|CGS|ACT|N|MODE)_\w+) (\d+)", header))
-    assert len(defines) >= 40
-    for name, value in defines.items():
-        assert getattr(C, name) == int(value), name
-    for prefix in ("CP_", "CG_", "CS_", "CGS_", "ACT_", "MODE_", "N_"):
-        python = {n for n in vars(C) if n.startswith(prefix) and n.isupper()}
-        if prefix == "N_":
-            python -= {"N_CR"}  # the twin's one-buffer packing, not part of the step's layout
-        assert python <= set(defines), python - set(defines)
-    assert Path(firmware_libs["float"].path).exists()

@@ -25,15 +25,12 @@ shows.
 
 from __future__ import annotations
 
-import re
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
 from ttt_sm.app.drawing import DrawSession
-from ttt_sm.hardware.firmware import firmware_root
 from ttt_sm.hardware.native import NativeCascade
 from ttt_sm.params import load_params
 from ttt_sm.twin import layout

@@ -187,3 +187,39 @@ def cascade_step(cp: np.ndarray, cg: np.ndarray, cs: np.ndarray, cgs: np.ndarray
         cgs[CGS_SV_DUTY] = servo_duty_for_angle(sv_set, cg)
         cgs[CGS_SV_DUTY_OF] = sv_set
     act[ACT_SV_DUTY] = cgs[CGS_SV_DUTY]
+
+
+# ---- the commands between steps: plain Python, as cascade.c's ttt_cascade_* do them ------------------------
+# (CascadeController calls them with its numpy rows; nothing compiled calls them)
+
+def hold(cs: np.ndarray, d: int, q: float) -> None:
+    """Make drive d hold the encoder angle `q` (rad) with no bump: filters and integrators reset."""
+    cs[d, CS_R_RAW] = q
+    cs[d, CS_R_F] = q
+    cs[d, CS_R_FD] = 0.0
+    cs[d, CS_Q_PREV] = q
+    cs[d, CS_W_MEAS] = 0.0
+    cs[d, CS_INT_POS] = 0.0
+    cs[d, CS_INT_SPD] = 0.0
+
+
+def set_offset(cs: np.ndarray, d: int, offset: float) -> None:
+    """Set drive d's encoder offset (rad); its setpoints and speed-estimate state move with it (no jump)."""
+    shift = offset - cs[d, CS_OFFSET]
+    cs[d, CS_OFFSET] = offset
+    cs[d, CS_R_RAW] += shift
+    cs[d, CS_R_F] += shift
+    cs[d, CS_Q_PREV] += shift
+
+
+def set_mode(cs: np.ndarray, cm: np.ndarray, d: int, mode: int, hold_q: float) -> None:
+    """Switch drive d to `mode`; entering closed loop holds `hold_q` (its encoder angle now)."""
+    if mode == MODE_CLOSED and cm[d] != MODE_CLOSED:
+        hold(cs, d, hold_q)
+    cm[d] = mode
+
+
+def set_open_duty(cs: np.ndarray, cm: np.ndarray, d: int, duty: float) -> None:
+    """Drive d open loop at a fixed duty (the step clips it to -1..1)."""
+    cs[d, CS_OPEN_DUTY] = duty
+    cm[d] = MODE_OPEN

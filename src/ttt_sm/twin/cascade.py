@@ -144,12 +144,7 @@ class CascadeController:
 
         The physical target stays where it was, so the arm does not jump.
         """
-        d = check_drive(drive) - 1
-        cs = self.cs
-        shift = float(offset_rad) - cs[d, layout.CS_OFFSET]
-        cs[d, layout.CS_OFFSET] = float(offset_rad)
-        for k in (layout.CS_R_RAW, layout.CS_R_F, layout.CS_Q_PREV):
-            cs[d, k] += shift
+        C.set_offset(self.cs, check_drive(drive) - 1, float(offset_rad))
 
     def enabled(self) -> tuple[bool, bool, bool]:
         """True per drive while its cascade runs."""
@@ -163,29 +158,17 @@ class CascadeController:
     def set_mode(self, drive: int, mode: int, hold_rad: float | None = None) -> None:
         """Switch drive `drive` to `mode`; entering closed loop holds `hold_rad` (its encoder angle), bumplessly."""
         d = check_drive(drive) - 1
-        if mode == layout.MODE_CLOSED and self.modes[d] != layout.MODE_CLOSED:
-            if hold_rad is None:
-                raise SimError(f"drive {drive}: closing the loop needs the angle to hold")
-            self.hold(drive, hold_rad)
-        self.modes[d] = mode
+        if mode == layout.MODE_CLOSED and self.modes[d] != layout.MODE_CLOSED and hold_rad is None:
+            raise SimError(f"drive {drive}: closing the loop needs the angle to hold")
+        C.set_mode(self.cs, self.modes, d, mode, math.nan if hold_rad is None else hold_rad)
 
     def set_open_duty(self, drive: int, duty: float) -> None:
         """Drive open loop with a fixed PWM duty (clipped to -1..1 by the step)."""
-        d = check_drive(drive) - 1
-        self.cs[d, layout.CS_OPEN_DUTY] = float(duty)
-        self.modes[d] = layout.MODE_OPEN
+        C.set_open_duty(self.cs, self.modes, check_drive(drive) - 1, float(duty))
 
     def hold(self, drive: int, q_rad: float) -> None:
         """Make drive `drive`'s cascade hold the encoder angle `q_rad`, with no bump: filters and integrators reset."""
-        d = check_drive(drive) - 1
-        cs = self.cs
-        cs[d, layout.CS_R_RAW] = q_rad
-        cs[d, layout.CS_R_F] = q_rad
-        cs[d, layout.CS_R_FD] = 0.0
-        cs[d, layout.CS_Q_PREV] = q_rad
-        cs[d, layout.CS_W_MEAS] = 0.0
-        cs[d, layout.CS_INT_POS] = 0.0
-        cs[d, layout.CS_INT_SPD] = 0.0
+        C.hold(self.cs, check_drive(drive) - 1, q_rad)
 
     # ---- outputs ------------------------------------------------------------------
 

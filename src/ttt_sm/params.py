@@ -149,13 +149,18 @@ class Servo:
         """The ADC reading (counts, not rounded) of the feedback wire at `angle_rad`, by the calibration."""
         return self.feedback_cal_a_counts + (angle_rad - self.feedback_cal_a_rad) * self.feedback_counts_per_rad
 
+    @property
+    def calibration(self) -> tuple[float, float, float, float, float]:
+        """``(min_rad, max_rad, pulse_min_s, pulse_max_s, period_s)``: :func:`servo_duty`'s arguments after angle."""
+        return self.min_rad, self.max_rad, self.pulse_min_s, self.pulse_max_s, self.period_s
+
     def duty_for_angle(self, angle_rad: float) -> float:
         """PWM duty (0..1) that commands `angle_rad` (clipped to the range): :func:`servo_duty`."""
-        return servo_duty(angle_rad, self.min_rad, self.max_rad, self.pulse_min_s, self.pulse_max_s, self.period_s)
+        return servo_duty(angle_rad, *self.calibration)
 
     def angle_for_duty(self, duty: float) -> float:
         """Angle (rad) a PWM duty commands; pulses outside the range clip: :func:`servo_angle`."""
-        return servo_angle(duty, self.min_rad, self.max_rad, self.pulse_min_s, self.pulse_max_s, self.period_s)
+        return servo_angle(duty, *self.calibration)
 
 
 @dataclass(frozen=True)

@@ -78,11 +78,7 @@ class CascadeController:
         cg[layout.CG_DT] = c.dt
         cg[layout.CG_SF_NORMAL:layout.CG_SF_NORMAL + 6] = setpoint_filter_row(c.setpoint_cutoff_hz, c.dt)
         cg[layout.CG_SF_SLOW:layout.CG_SF_SLOW + 6] = setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt)
-        cg[layout.CG_SV_MIN] = s.min_rad
-        cg[layout.CG_SV_MAX] = s.max_rad
-        cg[layout.CG_SV_PMIN] = s.pulse_min_s
-        cg[layout.CG_SV_PMAX] = s.pulse_max_s
-        cg[layout.CG_SV_PERIOD] = s.period_s
+        cg[layout.CG_SV_MIN:layout.CG_SV_MIN + layout.SERVO_CALIBRATION_SIZE] = s.calibration
         self.cgs[layout.CGS_SV_SET] = servo_angle
         self.cgs[layout.CGS_SV_DUTY_OF] = math.nan  # the first step computes the servo's duty
         # Flat views for the per-chart-step commands: a memoryview reads and

@@ -138,6 +138,16 @@ def forget_stale_compilations(module_file: str, *depends_on: str | Path) -> None
 
 # ==== the controller (_cascade.py; firmware/src/cascade.c) ==========================================
 
+#: The servo's calibration, five numbers in the order of ``params.servo_duty``'s arguments after the
+#: angle (``params.Servo.calibration``): the controller's ``cg`` and the plant's ``pg`` hold it alike.
+SERVO_CALIBRATION = (
+    ("SV_MIN", "servo: angle range (rad) ..."),
+    ("SV_MAX", ""),
+    ("SV_PMIN", "... the pulse widths at its ends and the PWM period (s)"),
+    ("SV_PMAX", ""),
+    ("SV_PERIOD", ""),
+)
+
 CP = block("CP", "per-drive parameter row cp[d, CP_*] (SI units; joint side)", [
     ("RPC", "joint angle of one encoder count (rad)"),
     ("KP_POS", "outer position PID: speed setpoint per rad (1/s), ..."),
@@ -154,11 +164,7 @@ CG = block("CG", "global parameters cg[CG_*]", [
     ("DT", "control step (s)"),
     ("SF_NORMAL", "setpoint filter, normal: a11 a12 b1 a21 a22 b2", 6),
     ("SF_SLOW", "setpoint filter, slow (fr_sw on): same layout", 6),
-    ("SV_MIN", "servo: angle range (rad) ..."),
-    ("SV_MAX", ""),
-    ("SV_PMIN", "... the pulse widths at its ends and the PWM period (s)"),
-    ("SV_PMAX", ""),
-    ("SV_PERIOD", ""),
+    *SERVO_CALIBRATION,
 ])
 CS = block("CS", "per-drive state cs[d, CS_*]", [
     ("R_RAW", "position setpoint as given (encoder coordinates, rad)"),
@@ -236,14 +242,10 @@ PG = block("PG", "global parameters pg[PG_*]", [
     ("NSUB", "sub-steps per control step (stored as a float)"),
     ("GRAV2", "g * (m2 c2 + (m3 + m_tool) L2): joint-2 gravity from sin(q2) (N m)"),
     ("GRAV23", "g * (m3 c3 + m_tool L3): gravity from sin(q2 + q3) on joints 2 and 3 (N m)"),
-    ("SV_MIN", "servo: range (rad), pulse widths and period (s), slew rate (rad/s),"),
-    ("SV_MAX", "lag time constant (s), gear clearance (rad)"),
-    ("SV_PMIN", ""),
-    ("SV_PMAX", ""),
-    ("SV_PERIOD", ""),
-    ("SV_RATE", ""),
-    ("SV_TAU", ""),
-    ("SV_CLEAR", ""),
+    *SERVO_CALIBRATION,
+    ("SV_RATE", "servo: slew rate (rad/s), ..."),
+    ("SV_TAU", "... lag time constant (s), ..."),
+    ("SV_CLEAR", "... gear clearance (rad)"),
     ("I_NOISE", "standard deviation of the current measurement noise (A)"),
     ("SV_INV_TAU", "1 / PG_SV_TAU"),
     ("H", "the sub-step, PG_DT / PG_NSUB (s)"),
@@ -304,6 +306,8 @@ REC = block("REC", "record buffer rec[k, REC_*], one row per control step (after
 BLOCKS = (CP, CG, CS, CGS, ACT, MODE, CR, PP, PG, PS, PGS, PI, PR, REC)
 #: Every constant of the tables, by name.
 CONSTANTS = export(globals(), BLOCKS)
+#: Numbers in the servo's calibration (``CG_SV_MIN`` and ``PG_SV_MIN`` on).
+SERVO_CALIBRATION_SIZE = len(SERVO_CALIBRATION)
 #: Columns of the controller's buffer (its longest block) and of the plant's.
 CONTROLLER_WIDTH = max(b.size for b in (CP, CS, CG, CGS, ACT))
 PLANT_WIDTH = max(b.size for b in (PP, PS, PG, PGS))

@@ -179,11 +179,7 @@ class Plant:
         pg[layout.PG_DT] = params.control.dt
         pg[layout.PG_NSUB] = substeps
         pg[layout.PG_GRAV2], pg[layout.PG_GRAV23] = gravity_coefficients(params)
-        pg[layout.PG_SV_MIN] = s.min_rad
-        pg[layout.PG_SV_MAX] = s.max_rad
-        pg[layout.PG_SV_PMIN] = s.pulse_min_s
-        pg[layout.PG_SV_PMAX] = s.pulse_max_s
-        pg[layout.PG_SV_PERIOD] = s.period_s
+        pg[layout.PG_SV_MIN:layout.PG_SV_MIN + layout.SERVO_CALIBRATION_SIZE] = s.calibration
         pg[layout.PG_SV_RATE] = s.rate_rad_s
         pg[layout.PG_SV_TAU] = s.time_constant_s
         pg[layout.PG_SV_CLEAR] = s.clearance_rad

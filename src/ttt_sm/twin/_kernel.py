@@ -94,8 +94,8 @@ def _compile_run_steps(fingerprint: str) -> Any:
     def run_steps(n: int, cf: np.ndarray, cm: np.ndarray, pf: np.ndarray, pi: np.ndarray, rec: np.ndarray) -> None:
         """Run `n` control steps in place; fill `rec[:n]` if it has at least n rows.
 
-        `cf`: the controller's float buffer (rows ``_cascade.CR_*``), `cm`: its modes;
-        `pf`: the plant's float buffer (rows ``_plant.PR_*``), `pi`: its integer state.
+        `cf`: the controller's float buffer (rows ``layout.CR_*``), `cm`: its modes;
+        `pf`: the plant's float buffer (rows ``layout.PR_*``), `pi`: its integer state.
         """
         fingerprint  # noqa: B018  (a closure variable: part of numba's cache key)
         # the blocks are rows: slicing them costs nothing (a reshape would call into numba's runtime)

@@ -2,7 +2,7 @@
 
 One call of :func:`plant_step` is one control step of the physical arm: it
 reads the actuator commands ``act`` (H-bridge duties and on/off flags, the
-servo's PWM duty: the layout of ``_cascade.ACT_*``) and integrates over
+servo's PWM duty: the layout ``ACT_*`` of ``layout.py``) and integrates over
 ``n_sub`` sub-steps, per DC drive: armature current (exact exponential over
 each sub-step), motor with implicit viscous and Coulomb friction (stick
 without chattering), gear clearance as a dead-zone spring with contact

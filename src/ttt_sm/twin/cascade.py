@@ -5,7 +5,7 @@
 ``fr_sw``, a speed estimate from the encoder, an outer position PID and an
 inner speed PID with PWM saturation; and the servo's PWM.  It holds the
 controller's parameters (from the parameter file and the gains), its state
-and its outputs in the layout of ``_cascade.py`` (docs/model.md, "The
+and its outputs in the layout of ``layout.py`` (docs/model.md, "The
 controller step"), takes setpoints, offsets and modes, and runs
 ``_cascade.cascade_step``: encoder counts in, actuator commands out.  It
 never sees the plant: the simulated arm (:class:`ttt_sm.twin.sim.ArmSim`)
@@ -48,9 +48,9 @@ class CascadeController:
 
     Attributes
     ----------
-    buffer : ndarray, shape (``_cascade.N_CR``, ``_cascade.WIDTH``)
+    buffer : ndarray, shape (``layout.N_CR``, ``layout.CONTROLLER_WIDTH``)
         The controller's float memory; ``cp``, ``cs`` (3 rows each), ``cg``,
-        ``cgs`` and ``act`` are views of its rows (``_cascade.CR_*``).
+        ``cgs`` and ``act`` are views of its rows (``layout.CR_*``).
     modes : ndarray of int64, shape (3,)
         ``MODE_OFF``, ``MODE_CLOSED`` or ``MODE_OPEN`` per drive; all drives
         start closed, holding where they power on.

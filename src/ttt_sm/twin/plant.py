@@ -117,10 +117,10 @@ class Plant:
 
     Attributes
     ----------
-    buffer : ndarray, shape (``_plant.N_PR``, ``_plant.WIDTH``)
+    buffer : ndarray, shape (``layout.N_PR``, ``layout.PLANT_WIDTH``)
         The plant's float memory; ``pp``, ``ps`` (3 rows each), ``pg`` and
-        ``pgs`` are views of its rows (``_plant.PR_*``).
-    ints : ndarray of int64, shape (3, ``_plant.N_PI``)
+        ``pgs`` are views of its rows (``layout.PR_*``).
+    ints : ndarray of int64, shape (3, ``layout.N_PI``)
         Counters, index switches, hard-stop contact, noise generators.
     """
 
@@ -214,7 +214,7 @@ class Plant:
     # ---- stepping and sensors ---------------------------------------------------
 
     def step(self, act: np.ndarray) -> None:
-        """One control step on its own under the actuator commands `act` (``_cascade.ACT_*`` layout).
+        """One control step on its own under the actuator commands `act` (``layout.ACT_*``).
 
         The simulated arm does not call this: its fused loop runs the same
         compiled step beside the controller's (``_kernel.run_steps``).

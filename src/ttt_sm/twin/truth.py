@@ -59,7 +59,7 @@ class ArmTruth:
     plant : Plant
         The simulated plant.
     act : ndarray
-        The actuator commands the plant receives (``_cascade.ACT_*``), for :attr:`stalled`.
+        The actuator commands the plant receives (``layout.ACT_*``), for :attr:`stalled`.
     """
 
     def __init__(self, params: ArmParams, plant: Plant, act: np.ndarray) -> None:

@@ -84,8 +84,9 @@ from .layout import (
     MODE_OPEN,
 )
 
-# the offsets above are frozen into the cached machine code: recompile when the tables change
-layout.forget_stale_compilations(__file__)
+# the offsets above, and the servo's formula from params.py, are frozen into the cached machine code:
+# recompile when either changes
+layout.forget_stale_compilations(__file__, servo_duty.__code__.co_filename)
 
 
 @njit(cache=True)

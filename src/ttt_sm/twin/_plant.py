@@ -101,8 +101,9 @@ from .layout import (
     PS_WQ,
 )
 
-# the offsets above are frozen into the cached machine code: recompile when the tables change
-layout.forget_stale_compilations(__file__)
+# the offsets above, and the servo's formula from params.py, are frozen into the cached machine code:
+# recompile when either changes
+layout.forget_stale_compilations(__file__, servo_angle.__code__.co_filename)
 
 LCG_MASK = 0x7FFFFFFF  # a 31-bit linear congruential generator (glibc's constants),
 _LCG_A = 1103515245  # exact in int64 both compiled and as plain Python; no division

@@ -244,8 +244,9 @@ def gravity_torques(g2: float, g23: float, q2: float, q3: float) -> tuple[float,
     step, ``plant.gravity_torques`` and the gear-play compensation
     (``app/compensation.py``) all use this function.
     """
+    t2 = g2 * sin(q2)
     t23 = g23 * sin(q2 + q3)
-    return -g2 * sin(q2) - t23, -t23
+    return -t2 - t23, -t23
 
 
 @njit(cache=True, inline="always")

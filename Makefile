@@ -42,8 +42,10 @@ tune: setup
 	$(TTT) tune
 
 # The firmware's portable C (firmware/), built with the system compiler as the tests
-# load it, both precisions, every warning an error (flags: ttt_sm.hardware.firmware).
+# load it, both precisions, every warning an error (flags: ttt_sm.hardware.firmware),
+# after checking its generated layout.h is what twin/layout.py's tables make.
 firmware: setup
+	$(PY) -m ttt_sm.hardware.generate --check
 	$(PY) -m ttt_sm.hardware.firmware out/firmware
 
 clean:

@@ -90,6 +90,31 @@ class Sponge:
     compliance: float
 
 
+def servo_duty(angle_rad: float, min_rad: float, max_rad: float, pulse_min_s: float, pulse_max_s: float,
+               period_s: float) -> float:
+    """PWM duty (0..1) that commands `angle_rad`: the pulse width linear in the angle, clipped to the range.
+
+    The one definition of the servo's calibration: :meth:`Servo.duty_for_angle` calls it, and the
+    controller's compiled step (``twin/_cascade.py``) compiles this very function (plain arithmetic on
+    floats, so numba can).  The firmware's C port (``firmware/src/cascade.c``) is held to it bit for bit
+    by ``tests/hardware/test_cascade_c.py``.
+    """
+    a = min_rad if angle_rad < min_rad else (max_rad if angle_rad > max_rad else angle_rad)
+    frac = (a - min_rad) / (max_rad - min_rad)
+    return (pulse_min_s + frac * (pulse_max_s - pulse_min_s)) / period_s
+
+
+def servo_angle(duty: float, min_rad: float, max_rad: float, pulse_min_s: float, pulse_max_s: float,
+                period_s: float) -> float:
+    """Angle (rad) a PWM duty commands, the inverse of :func:`servo_duty`; pulses outside the range clip.
+
+    :meth:`Servo.angle_for_duty` calls it; the plant's compiled step (``twin/_plant.py``) compiles it.
+    """
+    frac = (duty * period_s - pulse_min_s) / (pulse_max_s - pulse_min_s)
+    frac = 0.0 if frac < 0.0 else (1.0 if frac > 1.0 else frac)
+    return min_rad + frac * (max_rad - min_rad)
+
+
 @dataclass(frozen=True)
 class Servo:
     """Hobby servo on joint 4: pulse width to angle, with a rate limit."""
@@ -124,18 +149,18 @@ class Servo:
         """The ADC reading (counts, not rounded) of the feedback wire at `angle_rad`, by the calibration."""
         return self.feedback_cal_a_counts + (angle_rad - self.feedback_cal_a_rad) * self.feedback_counts_per_rad
 
+    @property
+    def calibration(self) -> tuple[float, float, float, float, float]:
+        """``(min_rad, max_rad, pulse_min_s, pulse_max_s, period_s)``: :func:`servo_duty`'s arguments after angle."""
+        return self.min_rad, self.max_rad, self.pulse_min_s, self.pulse_max_s, self.period_s
+
     def duty_for_angle(self, angle_rad: float) -> float:
-        """PWM duty (0..1) that commands `angle_rad` (clipped to the range)."""
-        a = min(max(angle_rad, self.min_rad), self.max_rad)
-        frac = (a - self.min_rad) / (self.max_rad - self.min_rad)
-        return (self.pulse_min_s + frac * (self.pulse_max_s - self.pulse_min_s)) / self.period_s
+        """PWM duty (0..1) that commands `angle_rad` (clipped to the range): :func:`servo_duty`."""
+        return servo_duty(angle_rad, *self.calibration)
 
     def angle_for_duty(self, duty: float) -> float:
-        """Angle (rad) a PWM duty commands; pulses outside the range clip."""
-        pulse = duty * self.period_s
-        frac = (pulse - self.pulse_min_s) / (self.pulse_max_s - self.pulse_min_s)
-        frac = min(max(frac, 0.0), 1.0)
-        return self.min_rad + frac * (self.max_rad - self.min_rad)
+        """Angle (rad) a PWM duty commands; pulses outside the range clip: :func:`servo_angle`."""
+        return servo_angle(duty, *self.calibration)
 
 
 @dataclass(frozen=True)

@@ -74,8 +74,8 @@ def test_a_blocked_drive_mid_line_is_held_and_the_game_ends_with_the_reason_in_i
     sim = robot.sim
     assert sim is not None
     k = int(np.argmax(np.abs(robot.safety_stage.commanded_speed())))
-    from ttt_sm.twin import _plant as Pl
-    sim.plant.pp[k, Pl.PP_QMIN] = sim.plant.pp[k, Pl.PP_QMAX] = float(sim.truth.q[k])
+    from ttt_sm.twin import layout
+    sim.plant.pp[k, layout.PP_QMIN] = sim.plant.pp[k, layout.PP_QMAX] = float(sim.truth.q[k])
     t0 = robot.t
     assert robot.run_until(lambda: robot.tripped, 0.2)
     assert robot.t - t0 <= 0.1

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from ttt_sm.app import _monitor
+from ttt_sm.app import _monitor_layout as ML
 from ttt_sm.app.robot import Robot
 from ttt_sm.app.safety_wiring import make_safety_chart
 from ttt_sm.faults.twin import FaultyArm
@@ -43,9 +44,9 @@ def test_the_compiled_quiet_tick_decides_and_does_what_the_charts_tick_does() ->
     stage, chart = robot.safety_stage, robot.safety
     rng = np.random.default_rng(11)
     base = stage._m.copy()
-    counts = base[_monitor.M_COUNTS:_monitor.M_COUNTS + 3].astype(np.int64)
+    counts = base[ML.M_COUNTS:ML.M_COUNTS + 3].astype(np.int64)
     defaults = {name: getattr(chart, name) for name in THRESHOLDS}
-    angles = counts * base[_monitor.M_RPC:_monitor.M_RPC + 3] + base[_monitor.M_OFFSET:_monitor.M_OFFSET + 3]
+    angles = counts * base[ML.M_RPC:ML.M_RPC + 3] + base[ML.M_OFFSET:ML.M_OFFSET + 3]
     outcomes: Counter[str] = Counter()
     for _ in range(1200):
         data = {name: float(v * rng.uniform(0.2, 1.8)) for name, v in defaults.items()}
@@ -57,20 +58,20 @@ def test_the_compiled_quiet_tick_decides_and_does_what_the_charts_tick_does() ->
             setattr(chart, name, value)
         own = make_safety_chart(P)  # in monitoring, ticked by its own code
         m = base.copy()
-        m[_monitor.M_R:_monitor.M_R + 3] += rng.normal(0.0, 0.03, 3)
-        m[_monitor.M_P:_monitor.M_P + 3] += rng.normal(0.0, 0.02, 3)
-        m[_monitor.M_DP:_monitor.M_DP + 3] = rng.normal(0.0, 0.004, 3)
-        m[_monitor.M_FAST:_monitor.M_FAST + 3] = rng.integers(0, 2, 3)
+        m[ML.M_R:ML.M_R + 3] += rng.normal(0.0, 0.03, 3)
+        m[ML.M_P:ML.M_P + 3] += rng.normal(0.0, 0.02, 3)
+        m[ML.M_DP:ML.M_DP + 3] = rng.normal(0.0, 0.004, 3)
+        m[ML.M_FAST:ML.M_FAST + 3] = rng.integers(0, 2, 3)
         c = counts + rng.integers(-40, 40, 3) * rng.choice([1, 8], 3, p=[0.8, 0.2])
         i = rng.normal(0.0, 2.5, 3)
         flags = [bool(rng.random() < p) for p in (0.8, 0.06, 0.97, 0.97)]  # initialised, init_failed, link, camera
         u = rng.normal(0.0, 0.5, 4)
         # the readings, as an arm without memory to read in place gives them (no calibration: rad already)
-        m[_monitor.M_FB_CAL:_monitor.M_FB_CAL + 3] = (0.0, 0.0, 1.0)
+        m[ML.M_FB_CAL:ML.M_FB_CAL + 3] = (0.0, 0.0, 1.0)
         fsrc = np.array([*i, rng.normal(0.0, 0.3)])
-        csrc = np.array([*base[_monitor.M_OFFSET:_monitor.M_OFFSET + 3], rng.normal(0.0, 0.3)])
+        csrc = np.array([*base[ML.M_OFFSET:ML.M_OFFSET + 3], rng.normal(0.0, 0.3)])
         ix = stage._ix.copy()
-        ix[_monitor.IX_SRC:_monitor.IX_PREV] = [0, 1, 2, 0, 1, 2, 3, 0, 1, 2, 3]
+        ix[ML.IX_SRC:ML.IX_PREV] = [0, 1, 2, 0, 1, 2, 3, 0, 1, 2, 3]
         k = _monitor.step(m, stage._b, ix, fsrc, c, csrc, *flags, True, float(u[0]), float(u[1]), float(u[2]),
                           False, float(u[3]))
         # the twin gets what the step fed, and the data the step started from

@@ -29,7 +29,7 @@ from ttt_sm.faults.twin import TWIN_FAULTS
 from ttt_sm.hardware.emulator import ArmEmulator
 from ttt_sm.hardware.serial_arm import SerialArm
 from ttt_sm.params import load_params
-from ttt_sm.twin import _plant as Pl
+from ttt_sm.twin import layout
 from ttt_sm.twin.plant import REST_POSE, Plant
 from ttt_sm.twin.tuning import design_gains
 
@@ -58,7 +58,7 @@ def test_a_frozen_encoder_is_the_count_the_c_controller_reads_while_the_motor_tu
     q = arm.encoder_angles()
     arm.set_setpoints([q[0] + 0.3, q[1], q[2], arm.servo_setpoint])
     arm.step(20 * DIVIDER)
-    frozen = int(emu.plant.ints[0, Pl.PI_COUNTS])
+    frozen = int(emu.plant.ints[0, layout.PI_COUNTS])
     emu.inject_fault(_fault("encoder_frozen", 1))
     q_true = arm.truth.q[0]
     arm.step(100 * DIVIDER)
@@ -85,10 +85,10 @@ def test_a_blocked_motor_and_a_power_cut_change_the_emulators_plant_and_clearing
     emu, arm = linked
     pp, pg = emu.plant.pp.copy(), emu.plant.pg.copy()
     emu.inject_fault(_fault("motor_blocked", 3))
-    assert emu.plant.pp[2, Pl.PP_QMIN] == emu.plant.pp[2, Pl.PP_QMAX]
+    assert emu.plant.pp[2, layout.PP_QMIN] == emu.plant.pp[2, layout.PP_QMAX]
     emu.inject_fault(_fault("power_cut"))  # one fault at a time: the block is lifted first
-    assert np.all(emu.plant.pp[:, Pl.PP_SUPPLY] == 0.0) and emu.plant.pg[Pl.PG_SV_RATE] == 0.0
-    assert emu.plant.pp[2, Pl.PP_QMIN] == pp[2, Pl.PP_QMIN]
+    assert np.all(emu.plant.pp[:, layout.PP_SUPPLY] == 0.0) and emu.plant.pg[layout.PG_SV_RATE] == 0.0
+    assert emu.plant.pp[2, layout.PP_QMIN] == pp[2, layout.PP_QMIN]
     arm.step(10 * DIVIDER)
     emu.clear_fault()
     assert np.array_equal(emu.plant.pp, pp) and np.array_equal(emu.plant.pg, pg)

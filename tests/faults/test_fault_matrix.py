@@ -17,7 +17,7 @@ from ttt_sm.cli import main
 from ttt_sm.faults.matrix import DETECT_TARGET_S, PHASES, WATCH_S, FaultMatrixError, fault_matrix, reach_phase, run_cell
 from ttt_sm.faults.twin import ENCODER_JUMP_RAD, TWIN_FAULTS, FaultError, FaultyArm
 from ttt_sm.params import load_params
-from ttt_sm.twin import _plant as Pl
+from ttt_sm.twin import layout
 from ttt_sm.twin.sim import ArmSim
 from ttt_sm.twin.tuning import design_gains
 
@@ -62,10 +62,10 @@ def test_a_blocked_motor_and_a_power_cut_change_the_plant_and_clearing_puts_it_b
     pp = arm.sim.plant.pp.copy()
     pg = arm.sim.plant.pg.copy()
     arm.inject("motor_blocked", 3)
-    assert arm.sim.plant.pp[2, Pl.PP_QMIN] == arm.sim.plant.pp[2, Pl.PP_QMAX]
+    assert arm.sim.plant.pp[2, layout.PP_QMIN] == arm.sim.plant.pp[2, layout.PP_QMAX]
     arm.inject("power_cut")  # one fault at a time: the block is lifted first
-    assert np.all(arm.sim.plant.pp[:, Pl.PP_SUPPLY] == 0.0) and arm.sim.plant.pg[Pl.PG_SV_RATE] == 0.0
-    assert arm.sim.plant.pp[2, Pl.PP_QMIN] == pp[2, Pl.PP_QMIN]
+    assert np.all(arm.sim.plant.pp[:, layout.PP_SUPPLY] == 0.0) and arm.sim.plant.pg[layout.PG_SV_RATE] == 0.0
+    assert arm.sim.plant.pp[2, layout.PP_QMIN] == pp[2, layout.PP_QMIN]
     arm.clear()
     assert np.array_equal(arm.sim.plant.pp, pp) and np.array_equal(arm.sim.plant.pg, pg)
 

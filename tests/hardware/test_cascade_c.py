@@ -25,19 +25,15 @@ shows.
 
 from __future__ import annotations
 
-import re
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
 from ttt_sm.app.drawing import DrawSession
-from ttt_sm.hardware.firmware import firmware_root
 from ttt_sm.hardware.native import NativeCascade
 from ttt_sm.params import load_params
-from ttt_sm.twin import _cascade as C
-from ttt_sm.twin import _plant as PL
+from ttt_sm.twin import layout
 from ttt_sm.twin.plant import REST_POSE, Plant
 from ttt_sm.twin.sim import ArmSim
 
@@ -92,10 +88,10 @@ class Recording:
         for _ in range(n):
             self.counts.append(plant.counts.copy())
             self.modes.append(ctrl.modes.copy())
-            self.state.append((ctrl.cs[:, :C.N_CS].copy(), ctrl.cgs[:C.N_CGS].copy()))
+            self.state.append((ctrl.cs[:, :layout.N_CS].copy(), ctrl.cgs[:layout.N_CGS].copy()))
             self._step_one(1)
-            self.act.append(ctrl.act[:C.N_ACT].copy())
-            self.q.append(plant.ps[:, PL.PS_Q].copy())
+            self.act.append(ctrl.act[:layout.N_ACT].copy())
+            self.q.append(plant.ps[:, layout.PS_Q].copy())
 
 
 def replay(rec: Recording, native: NativeCascade, plant: Plant | None = None) -> np.ndarray:
@@ -104,11 +100,11 @@ def replay(rec: Recording, native: NativeCascade, plant: Plant | None = None) ->
     With `plant`, the C controller's outputs drive it (closed loop) and the
     plant's joint angles after each step are returned instead.
     """
-    out = np.empty((len(rec.counts), C.N_ACT if plant is None else 3))
+    out = np.empty((len(rec.counts), layout.N_ACT if plant is None else 3))
     commands = iter(rec.commands)
     pending = next(commands, None)
     act, modes = native.act, native.modes
-    applied = np.zeros(C.N_ACT)
+    applied = np.zeros(layout.N_ACT)
     for k, counts in enumerate(rec.counts):
         while pending is not None and pending[0] == k:
             getattr(native, pending[1])(*pending[2])
@@ -121,7 +117,7 @@ def replay(rec: Recording, native: NativeCascade, plant: Plant | None = None) ->
             native.step(plant.counts)
             applied[:] = act
             plant.step(applied)
-            out[k] = plant.ps[:, PL.PS_Q]
+            out[k] = plant.ps[:, layout.PS_Q]
     return out
 
 
@@ -145,8 +141,8 @@ def test_the_recording_covers_a_whole_drawing(drawing):
     assert len(drawing.counts) > 90_000
     assert {"set_setpoints", "set_offset_estimate"} <= names  # the init charts' offsets, the drawing
     act = np.array(drawing.act)
-    assert np.abs(act[:, C.ACT_DUTY:C.ACT_DUTY + 3]).max() > 0.2  # the drives worked
-    assert len(np.unique(act[:, C.ACT_SV_DUTY])) >= 2  # the pen went down and up
+    assert np.abs(act[:, layout.ACT_DUTY:layout.ACT_DUTY + 3]).max() > 0.2  # the drives worked
+    assert len(np.unique(act[:, layout.ACT_SV_DUTY])) >= 2  # the pen went down and up
 
 
 def test_the_double_build_is_the_pc_step_bit_for_bit(firmware_libs, drawing):
@@ -157,12 +153,12 @@ def test_the_double_build_is_the_pc_step_bit_for_bit(firmware_libs, drawing):
 def test_one_float_step_computes_the_pc_steps_duty_within_tolerance(firmware_libs, drawing):
     native = _native(firmware_libs["float"], drawing)
     cs, cgs, modes = native.cs, native.cgs, native.modes
-    computed = np.empty((len(drawing.counts), C.N_ACT))
+    computed = np.empty((len(drawing.counts), layout.N_ACT))
     for k, counts in enumerate(drawing.counts):
         cs[:], cgs[:] = drawing.state[k]  # the PC's state before step k (float64 -> float32)
         modes[:] = drawing.modes[k]
         native.step(counts)
-        computed[k, :3] = cs[:, C.CS_DUTY_CMD]  # the duty computed now, applied next step
+        computed[k, :3] = cs[:, layout.CS_DUTY_CMD]  # the duty computed now, applied next step
         computed[k, 3:] = native.act[3:]
     py_act = np.array(drawing.act)
     duty = np.abs(computed[:-1, :3] - py_act[1:, :3])
@@ -170,8 +166,9 @@ def test_one_float_step_computes_the_pc_steps_duty_within_tolerance(firmware_lib
     assert worst <= FLOAT_STEP_TOLERANCE, (
         f"float32 step: max |duty difference| {worst:.3g} at step {int(duty.max(axis=1).argmax())} "
         f"of {len(duty)}")
-    assert np.array_equal(computed[:, C.ACT_BRIDGE:C.ACT_BRIDGE + 3], py_act[:, C.ACT_BRIDGE:C.ACT_BRIDGE + 3])
-    assert np.abs(computed[:, C.ACT_SV_DUTY] - py_act[:, C.ACT_SV_DUTY]).max() <= FLOAT_SERVO_TOLERANCE
+    bridges = slice(layout.ACT_BRIDGE, layout.ACT_BRIDGE + 3)
+    assert np.array_equal(computed[:, bridges], py_act[:, bridges])
+    assert np.abs(computed[:, layout.ACT_SV_DUTY] - py_act[:, layout.ACT_SV_DUTY]).max() <= FLOAT_SERVO_TOLERANCE
     assert np.count_nonzero(py_act[1:, :3]) > 0.5 * duty.size  # the duties compared are mostly not 0
 
 
@@ -182,18 +179,3 @@ def test_the_float_build_closing_the_loop_on_the_twins_plant_follows_the_twin(fi
     gap = np.abs(q - np.array(drawing.q)).max(axis=0)
     assert (gap <= FLOAT_LOOP_TOLERANCE_RAD).all(), f"float32 firmware on the plant: max |dq| {gap} rad"
     assert np.abs(np.diff(q, axis=0)).sum(axis=0).min() > 0.5  # every drive travelled (rad)
-
-
-def test_the_headers_layout_is_the_pc_steps(firmware_libs):
-    """Every index of cascade.h has the value of its namesake in _cascade.py (docs/model.md's table)."""
-    header = (firmware_root() / "include" / "ttt_fw" / "cascade.h").read_text()
-    defines = dict(re.findall(r"#define TTT_((?:CP|CG|CS|CGS|ACT|N|MODE)_\w+) (\d+)", header))
-    assert len(defines) >= 40
-    for name, value in defines.items():
-        assert getattr(C, name) == int(value), name
-    for prefix in ("CP_", "CG_", "CS_", "CGS_", "ACT_", "MODE_", "N_"):
-        python = {n for n in vars(C) if n.startswith(prefix) and n.isupper()}
-        if prefix == "N_":
-            python -= {"N_CR"}  # the twin's one-buffer packing, not part of the step's layout
-        assert python <= set(defines), python - set(defines)
-    assert Path(firmware_libs["float"].path).exists()

@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from ttt_sm.hardware import link as L
 from ttt_sm.hardware.native import NativeFirmware, board_for
 from ttt_sm.params import load_params
-from ttt_sm.twin import _cascade as C
+from ttt_sm.twin import layout
 from ttt_sm.twin.cascade import CascadeController
 from ttt_sm.twin.tuning import design_gains
 
@@ -121,7 +121,8 @@ class Session:
 
     def configure(self, gains) -> list[L.Message]:
         pc = CascadeController(P, gains, servo_angle=0.0)
-        blocks = [L.Gains(d, tuple(pc.cp[d, :C.N_CP])) for d in range(3)] + [L.Gains(3, tuple(pc.cg[:C.N_CG]))]
+        blocks = [L.Gains(d, tuple(pc.cp[d, :layout.N_CP])) for d in range(3)]
+        blocks.append(L.Gains(3, tuple(pc.cg[:layout.N_CG])))
         return self.send(L.Hello(), *blocks, L.Start())
 
 
@@ -143,12 +144,12 @@ def test_a_whole_session_hello_gains_start_setpoints_status_heartbeat(lib, gains
     assert sorted(readback) == [0, 1, 2, 3]
     dtype = np.float32 if lib.precision == "float" else np.float64
     for d in range(3):  # read back as the firmware holds them: its number type, nothing else lost
-        assert np.array_equal(readback[d], pc.cp[d, :C.N_CP].astype(dtype))
-    assert np.array_equal(readback[3], pc.cg[:C.N_CG].astype(dtype))
+        assert np.array_equal(readback[d], pc.cp[d, :layout.N_CP].astype(dtype))
+    assert np.array_equal(readback[3], pc.cg[:layout.N_CG].astype(dtype))
     assert s.fw.state == 1
     s.send(L.Setpoints(0, (0.2, 0.0, -0.2, 0.4), fr_sw=True))
     cs = np.ctypeslib.as_array(s.fw.cascade.cs)
-    assert cs[:, C.CS_R_RAW] == pytest.approx([0.2, 0.0, -0.2])
+    assert cs[:, layout.CS_R_RAW] == pytest.approx([0.2, 0.0, -0.2])
     statuses = s.step(3) + s.step(1, counts=(10, -20, 30))
     assert s.fw.act[0] > 0 and s.fw.act[2] < 0  # the cascade drives towards the setpoints
     assert [m.step for m in statuses if isinstance(m, L.Status)] == [2, 4]
@@ -216,13 +217,13 @@ def test_late_setpoints_and_state_refusals_are_never_acted_on(lib, gains):
     s.step(10)  # the firmware is at step 10
     cs = np.ctypeslib.as_array(s.fw.cascade.cs)
     s.send(L.Setpoints(7, (0.3, 0.3, 0.3, 0.0)))  # 3 steps late (the limit is 2)
-    assert s.fw.rejections()[R.LATE] == 1 and np.all(cs[:, C.CS_R_RAW] == 0.0)
+    assert s.fw.rejections()[R.LATE] == 1 and np.all(cs[:, layout.CS_R_RAW] == 0.0)
     s.send(L.Setpoints(8, (0.3, 0.3, 0.3, 0.0)))  # 2 steps: in time
-    assert cs[:, C.CS_R_RAW] == pytest.approx([0.3] * 3)
-    s.send(L.Gains(0, (1.0,) * C.N_CP))  # gains while running: refused, not changed
-    assert s.fw.rejections()[R.REFUSED] == 1 and s.fw.cascade.cp[0][C.CP_RPC] != 1.0
+    assert cs[:, layout.CS_R_RAW] == pytest.approx([0.3] * 3)
+    s.send(L.Gains(0, (1.0,) * layout.N_CP))  # gains while running: refused, not changed
+    assert s.fw.rejections()[R.REFUSED] == 1 and s.fw.cascade.cp[0][layout.CP_RPC] != 1.0
     s.send(L.Setpoints(12, (float("nan"), 0.0, 0.0, 0.0)))
-    assert s.fw.rejections()[R.VALUE] == 1 and cs[0, C.CS_R_RAW] == pytest.approx(0.3)
+    assert s.fw.rejections()[R.VALUE] == 1 and cs[0, layout.CS_R_RAW] == pytest.approx(0.3)
 
 
 def test_the_pc_counts_lost_frames_and_refuses_replays_from_the_firmware(lib, gains):
@@ -282,7 +283,7 @@ def broken_streams(draw):
                         "sp": L.Setpoints(draw(st.integers(0, 50)), (0.1, -0.1, 0.2, 0.0)),
                         "read": L.GainsRead(draw(st.integers(0, 5))),
                         "drive": L.Drive(draw(st.integers(0, 3)), draw(st.integers(0, 4)), 0.0),
-                        "gains": L.Gains(3, (0.5,) * C.N_CG), "start": L.Start(), "hello": L.Hello()}[k]
+                        "gains": L.Gains(3, (0.5,) * layout.N_CG), "start": L.Start(), "hello": L.Hello()}[k]
         frames.append(bytearray(tx.frame(m)))
     for _ in range(draw(st.integers(0, 8))):
         i = draw(st.integers(0, len(frames) - 1))

@@ -22,7 +22,7 @@ from ttt_sm.hardware import link as L
 from ttt_sm.hardware.emulator import ArmEmulator
 from ttt_sm.hardware.serial_arm import SerialArm, SerialArmError
 from ttt_sm.params import load_params
-from ttt_sm.twin import _plant as PL
+from ttt_sm.twin import layout
 from ttt_sm.twin.plant import REST_POSE
 from ttt_sm.twin.sim import ArmSim
 from ttt_sm.twin.tuning import design_gains
@@ -85,7 +85,7 @@ def test_the_arm_behind_the_link_moves_as_the_twin_does(emulator, gains):
         gap = np.abs(link - sim).max(axis=0)
         assert (gap <= LINK_VS_TWIN_RAD).all(), f"max |encoder angle difference| {gap} rad"
         assert np.abs(link[-1] - np.array(moves[1][0][:3])).max() < 0.01  # it got there
-        assert arm.sensors().counts == tuple(int(c) for c in emulator.plant.ints[:, PL.PI_COUNTS])
+        assert arm.sensors().counts == tuple(int(c) for c in emulator.plant.ints[:, layout.PI_COUNTS])
         stats = arm.link_stats
         assert stats["rejected"] == 0 and stats["lost"] == 0 and emulator.firmware.rejections()[L.Reason.LATE] == 0
         # bytes each way per chart step: one SETPOINTS (28) out, one STATUS (52) back

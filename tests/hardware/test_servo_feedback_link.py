@@ -15,8 +15,7 @@ from ttt_sm.app.robot import Robot
 from ttt_sm.hardware import link as L
 from ttt_sm.hardware.emulator import ArmEmulator, FirmwareOnPlant
 from ttt_sm.hardware.serial_arm import SerialArm, SerialArmError
-from ttt_sm.twin import _cascade as C
-from ttt_sm.twin import _plant as PL
+from ttt_sm.twin import layout
 from ttt_sm.twin.cascade import CascadeController
 from ttt_sm.twin.plant import REST_POSE
 from ttt_sm.twin.tuning import design_gains
@@ -29,8 +28,8 @@ def test_the_status_carries_the_adc_counts_the_board_read_of_the_servo(firmware_
     bench = FirmwareOnPlant(P, firmware_libs["float"], seed=2)
     tx, rx = L.Sender(), L.Receiver()
     pc = CascadeController(P, design_gains(P), servo_angle=REST_POSE[3])
-    messages = [L.Hello(), *[L.Gains(d, tuple(pc.cp[d, :C.N_CP])) for d in range(3)],
-                L.Gains(3, tuple(pc.cg[:C.N_CG])), L.Start()]
+    messages = [L.Hello(), *[L.Gains(d, tuple(pc.cp[d, :layout.N_CP])) for d in range(3)],
+                L.Gains(3, tuple(pc.cg[:layout.N_CG])), L.Start()]
     bench.sense()
     bench.firmware.rx(b"".join(tx.frame(m) for m in messages))
     assert bench.firmware.state == 1
@@ -95,8 +94,8 @@ def test_a_servo_stuck_while_initialising_trips_the_safety_chart_over_the_emulat
             moved: list[float] = []
             robot.safety_stage.listeners.append(lambda kind, data: moved.append(arm.servo_setpoint))
             robot.run_for(0.5)  # the servo turns to the angle the init charts hold it at
-            emu.plant.pg[PL.PG_SV_RATE] = 0.0  # the servo's gears stuck (the twin's servo_stuck)
-            stuck = float(emu.plant.pgs[PL.PGS_SV_Q])
+            emu.plant.pg[layout.PG_SV_RATE] = 0.0  # the servo's gears stuck (the twin's servo_stuck)
+            stuck = float(emu.plant.pgs[layout.PGS_SV_Q])
             t_stuck = robot.t
             assert robot.run_until(lambda: robot.tripped, 120.0)
             # no trip while the servo was held still (the drives initialising, 10 s and more): a stuck servo

@@ -16,8 +16,7 @@ import pytest
 from ttt_sm.hardware import link as L
 from ttt_sm.hardware.native import NativeFirmware, board_for
 from ttt_sm.params import load_params
-from ttt_sm.twin import _cascade as C
-from ttt_sm.twin import _plant as PL
+from ttt_sm.twin import layout
 from ttt_sm.twin.cascade import CascadeController
 from ttt_sm.twin.plant import REST_POSE, Plant
 from ttt_sm.twin.tuning import design_gains
@@ -34,11 +33,11 @@ class Bench:
         self.plant = Plant(P, np.array(REST_POSE), np.random.default_rng(0))
         self.fw = NativeFirmware(lib, board_for(P, PEN_UP))
         self.tx, self.rx = L.Sender(), L.Receiver()
-        self.act = np.zeros(C.N_ACT)
+        self.act = np.zeros(layout.N_ACT)
         self.statuses: list[L.Status] = []
         pc = CascadeController(P, design_gains(P), servo_angle=REST_POSE[3])
-        self.send(L.Hello(), *[L.Gains(d, tuple(pc.cp[d, :C.N_CP])) for d in range(3)],
-                  L.Gains(3, tuple(pc.cg[:C.N_CG])), L.Start())
+        self.send(L.Hello(), *[L.Gains(d, tuple(pc.cp[d, :layout.N_CP])) for d in range(3)],
+                  L.Gains(3, tuple(pc.cg[:layout.N_CG])), L.Start())
         assert self.fw.state == STATE["running"]
 
     def send(self, *messages: L.Message) -> None:
@@ -54,7 +53,7 @@ class Bench:
 
     @property
     def speeds(self) -> np.ndarray:
-        return self.plant.ps[:, PL.PS_WQ].copy()
+        return self.plant.ps[:, layout.PS_WQ].copy()
 
 
 def test_setpoints_missing_for_50_ms_stop_the_arm_and_lift_the_pen(firmware_libs):
@@ -74,13 +73,13 @@ def test_setpoints_missing_for_50_ms_stop_the_arm_and_lift_the_pen(firmware_libs
     b.step()
     assert b.fw.state == STATE["safe_stop"]  # the 50th silent step (50 ms) trips it
     cs, cgs = np.ctypeslib.as_array(b.fw.cascade.cs), np.ctypeslib.as_array(b.fw.cascade.cgs)
-    assert cgs[C.CGS_SV_SET] == pytest.approx(PEN_UP)  # the pen goes up
-    stop_q = cs[:, C.CS_R_RAW].copy()  # each drive holds where it was
+    assert cgs[layout.CGS_SV_SET] == pytest.approx(PEN_UP)  # the pen goes up
+    stop_q = cs[:, layout.CS_R_RAW].copy()  # each drive holds where it was
     for _ in range(300):
         b.step()
     assert np.abs(b.speeds[:3]).max() < 0.01  # the arm has stopped
-    assert np.all(np.ctypeslib.as_array(b.fw.cascade.cs)[:, C.CS_R_RAW] == stop_q)
-    assert b.plant.pgs[PL.PGS_SV_Q] == pytest.approx(PEN_UP, abs=0.01)
+    assert np.all(np.ctypeslib.as_array(b.fw.cascade.cs)[:, layout.CS_R_RAW] == stop_q)
+    assert b.plant.pgs[layout.PGS_SV_Q] == pytest.approx(PEN_UP, abs=0.01)
     # late setpoints after the stop are refused, not acted on, until the PC re-arms with START
     b.send(L.Setpoints(b.fw.steps, (0.0, 0.0, 0.0, REST_POSE[3])))
     assert b.fw.rejections()[L.Reason.REFUSED] == 1 and b.fw.state == STATE["safe_stop"]

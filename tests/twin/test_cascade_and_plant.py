@@ -16,6 +16,7 @@ import pytest
 from ttt_sm.params import load_params
 from ttt_sm.twin import _cascade as C
 from ttt_sm.twin import _plant as P
+from ttt_sm.twin import layout
 from ttt_sm.twin.cascade import CascadeController
 from ttt_sm.twin.plant import Plant
 from ttt_sm.twin.sim import ArmSim
@@ -63,8 +64,8 @@ def test_the_controller_step_alone_reproduces_the_fused_loop(params, gains):
     for c in counts:
         ctrl.step(c)
         duty.append([*ctrl.duty, ctrl.servo_duty])
-        w_ref.append(ctrl.cs[:, C.CS_W_REF].copy())
-        r_f.append(ctrl.cs[:, C.CS_R_F].copy())
+        w_ref.append(ctrl.cs[:, layout.CS_W_REF].copy())
+        r_f.append(ctrl.cs[:, layout.CS_R_F].copy())
     assert np.array_equal(np.array(duty), trace.duty)
     assert np.array_equal(np.array(w_ref), trace.speed_ref)
     assert np.array_equal(np.array(r_f), trace.setpoint_filtered[:, :3])
@@ -75,14 +76,14 @@ def test_the_plant_step_alone_reproduces_the_fused_loop_from_its_duties(params, 
     fused = _moving(params, gains)
     trace = fused.run(STEPS)
     plant = Plant(params, np.array(POSE), np.random.default_rng(7))
-    act = np.zeros(C.N_ACT)
-    act[C.ACT_BRIDGE:C.ACT_BRIDGE + 3] = 1.0
+    act = np.zeros(layout.N_ACT)
+    act[layout.ACT_BRIDGE:layout.ACT_BRIDGE + 3] = 1.0
     q, counts = [], []
     for k in range(STEPS):
-        act[C.ACT_DUTY:C.ACT_DUTY + 3] = trace.duty[k, :3]
-        act[C.ACT_SV_DUTY] = trace.duty[k, 3]
+        act[layout.ACT_DUTY:layout.ACT_DUTY + 3] = trace.duty[k, :3]
+        act[layout.ACT_SV_DUTY] = trace.duty[k, 3]
         plant.step(act)
-        q.append([*plant.ps[:, P.PS_Q], plant.pgs[P.PGS_SV_Q]])
+        q.append([*plant.ps[:, layout.PS_Q], plant.pgs[layout.PGS_SV_Q]])
         counts.append(plant.counts.copy())
     assert np.array_equal(np.array(q), trace.q_true)
     assert plant.sensors() == fused.sensors()
@@ -92,28 +93,28 @@ def test_the_plant_step_alone_reproduces_the_fused_loop_from_its_duties(params, 
 def test_the_plant_alone_turns_a_duty_into_motion(params):
     d1 = params.drives[0]
     plant = Plant(params, np.array((0.0, 0.04, -0.08, 0.0)), np.random.default_rng(0))
-    act = np.zeros(C.N_ACT)
-    act[C.ACT_BRIDGE:C.ACT_BRIDGE + 3] = 1.0  # bridges on at duty 0: drives 2 and 3 brake
-    act[C.ACT_DUTY] = 0.5
-    act[C.ACT_SV_DUTY] = params.servo.duty_for_angle(0.3)
-    q0, c0 = float(plant.ps[0, P.PS_Q]), int(plant.counts[0])
+    act = np.zeros(layout.N_ACT)
+    act[layout.ACT_BRIDGE:layout.ACT_BRIDGE + 3] = 1.0  # bridges on at duty 0: drives 2 and 3 brake
+    act[layout.ACT_DUTY] = 0.5
+    act[layout.ACT_SV_DUTY] = params.servo.duty_for_angle(0.3)
+    q0, c0 = float(plant.ps[0, layout.PS_Q]), int(plant.counts[0])
     for _ in range(1000):
         plant.step(act)
     # half the supply: the joint runs near half the no-load speed, less friction
     no_load_half = 0.5 * d1.supply_v / (d1.torque_constant * d1.gear_ratio)
-    assert 0.8 * no_load_half < plant.ps[0, P.PS_WQ] < no_load_half
-    moved = float(plant.ps[0, P.PS_Q]) - q0
+    assert 0.8 * no_load_half < plant.ps[0, layout.PS_WQ] < no_load_half
+    moved = float(plant.ps[0, layout.PS_Q]) - q0
     assert moved > 0.5 * no_load_half
     # the encoder counted the motor's turn (it sits on the motor side: within the clearance)
     assert (int(plant.counts[0]) - c0) * d1.rad_per_count == pytest.approx(moved, abs=d1.gear_clearance)
     # the servo went where its duty points, within its play
-    assert plant.pgs[P.PGS_SV_Q] == pytest.approx(0.3, abs=params.servo.clearance_rad)
+    assert plant.pgs[layout.PGS_SV_Q] == pytest.approx(0.3, abs=params.servo.clearance_rad)
     assert plant.t == pytest.approx(1.0)
     # bridge off: the current dies out and the drive coasts to a stop
-    act[C.ACT_BRIDGE] = 0.0
+    act[layout.ACT_BRIDGE] = 0.0
     for _ in range(2000):
         plant.step(act)
-    assert plant.ps[0, P.PS_I] == 0.0 and plant.ps[0, P.PS_WQ] == pytest.approx(0.0, abs=1e-3)
+    assert plant.ps[0, layout.PS_I] == 0.0 and plant.ps[0, layout.PS_WQ] == pytest.approx(0.0, abs=1e-3)
 
 
 def test_the_controller_alone_closes_no_loop_it_commands_with_a_step_of_delay(params, gains):
@@ -130,16 +131,16 @@ def test_the_controller_alone_closes_no_loop_it_commands_with_a_step_of_delay(pa
         ctrl.step(still)
     # the position error stays: the duty saturates, and anti-windup holds the integrators there
     assert ctrl.duty[0] == 1.0 and ctrl.duty[2] == -1.0
-    held = ctrl.cs[:, [C.CS_INT_POS, C.CS_INT_SPD]].copy()
+    held = ctrl.cs[:, [layout.CS_INT_POS, layout.CS_INT_SPD]].copy()
     for _ in range(300):
         ctrl.step(still)
-    assert np.array_equal(ctrl.cs[:, [C.CS_INT_POS, C.CS_INT_SPD]], held)
+    assert np.array_equal(ctrl.cs[:, [layout.CS_INT_POS, layout.CS_INT_SPD]], held)
     # bridge off: duty 0 and the off flag; closing again holds where the drive is
-    ctrl.set_mode(1, C.MODE_OFF)
+    ctrl.set_mode(1, layout.MODE_OFF)
     ctrl.step(still)
     ctrl.step(still)
-    assert ctrl.act[C.ACT_BRIDGE] == 0.0 and ctrl.duty[0] == 0.0 and ctrl.act[C.ACT_BRIDGE + 1] == 1.0
-    ctrl.set_mode(1, C.MODE_CLOSED, hold_rad=0.0)
+    assert ctrl.act[layout.ACT_BRIDGE] == 0.0 and ctrl.duty[0] == 0.0 and ctrl.act[layout.ACT_BRIDGE + 1] == 1.0
+    ctrl.set_mode(1, layout.MODE_CLOSED, hold_rad=0.0)
     ctrl.step(still)
     ctrl.step(still)
     assert ctrl.duty[0] == 0.0  # holding where it stands: nothing to correct
@@ -152,17 +153,20 @@ def test_the_controller_and_the_plant_keep_their_own_memory(params, gains):
     assert cf is sim.controller.buffer and pf is sim.plant.buffer
     # the controller's and the plant's memories are apart: no block of one is a view of the other
     assert not np.shares_memory(cf, pf) and not np.shares_memory(cm, pi)
-    assert cf.shape == (C.N_CR, C.WIDTH) and pf.shape == (P.N_PR, P.WIDTH) and pi.shape == (3, P.N_PI)
+    assert cf.shape == (layout.N_CR, layout.CONTROLLER_WIDTH) and pf.shape == (layout.N_PR, layout.PLANT_WIDTH)
+    assert pi.shape == (3, layout.N_PI)
 
 
 def test_the_fused_loop_is_compiled_for_the_steps_sources_it_runs():
     # numba's disk cache checks only the fused loop's own file; the loop closes over a
-    # fingerprint of both steps' files, so an edit of either compiles the loop afresh
+    # fingerprint of both steps' files, their layout and the servo's formula (params.py),
+    # so an edit of any of them compiles the loop afresh
     import hashlib
     from pathlib import Path
 
+    from ttt_sm import params
     from ttt_sm.twin import _kernel as K
 
-    expected = hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in (C, P))).hexdigest()
+    expected = hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in (C, P, layout, params))).hexdigest()
     cells = [c.cell_contents for c in K.run_steps.py_func.__closure__]
     assert cells == [expected]

@@ -16,8 +16,7 @@ import numpy as np
 import pytest
 
 from ttt_sm.params import load_params
-from ttt_sm.twin import _cascade as C
-from ttt_sm.twin import _plant as PL
+from ttt_sm.twin import layout
 from ttt_sm.twin.plant import REST_POSE, Plant
 
 P = load_params()
@@ -36,8 +35,8 @@ def _plant(params, q4: float, seed: int = 0) -> Plant:
 
 def _hold(q4: float) -> np.ndarray:
     """Actuator commands: the bridges off (the drives rest on friction), the servo commanded to `q4`."""
-    act = np.zeros(C.N_ACT)
-    act[C.ACT_SV_DUTY] = SERVO.duty_for_angle(q4)
+    act = np.zeros(layout.N_ACT)
+    act[layout.ACT_SV_DUTY] = SERVO.duty_for_angle(q4)
     return act
 
 
@@ -57,7 +56,7 @@ def test_without_noise_the_adc_reads_the_rounded_counts_of_the_servo_angle(q4):
     act = _hold(q4)
     for _ in range(50):
         plant.step(act)
-    q_true = float(plant.pgs[PL.PGS_SV_Q])
+    q_true = float(plant.pgs[layout.PGS_SV_Q])
     want = math.floor(SERVO.feedback_counts(q_true) + 0.5)
     assert plant.feedback_counts == want
     s = plant.sensors()
@@ -80,7 +79,7 @@ def test_the_noise_is_about_one_count_rms_around_the_true_reading_and_independen
     act = _hold(q4)
     for _ in range(200):  # the servo settles
         plant.step(act)
-    ideal = SERVO.feedback_counts(float(plant.pgs[PL.PGS_SV_Q]))
+    ideal = SERVO.feedback_counts(float(plant.pgs[layout.PGS_SV_Q]))
     counts = []
     for _ in range(4000):
         plant.step(act)
@@ -109,7 +108,7 @@ def test_the_rc_filter_lags_a_move_by_its_time_constant():
     lags = []
     for _ in range(400):
         plant.step(act)
-        q = float(plant.pgs[PL.PGS_SV_Q])
+        q = float(plant.pgs[layout.PGS_SV_Q])
         lags.append(q - SERVO.feedback_angle(plant.feedback_counts))
     lags_a = np.array(lags)
     # moving at the servo's slew rate (7 rad/s), a first-order filter trails by rate * tau (0.14 rad)
@@ -120,13 +119,13 @@ def test_the_rc_filter_lags_a_move_by_its_time_constant():
     worst = 0.0
     for _ in range(400):
         plant.step(act)
-        worst = max(worst, float(plant.pgs[PL.PGS_SV_Q]) - SERVO.feedback_angle(plant.feedback_counts))
+        worst = max(worst, float(plant.pgs[layout.PGS_SV_Q]) - SERVO.feedback_angle(plant.feedback_counts))
     assert worst == pytest.approx(SERVO.rate_rad_s * SERVO.feedback_tau_s, abs=1.0 / SERVO.feedback_counts_per_rad)
 
 
 def test_a_stuck_servo_reads_where_it_stopped():
     plant = _plant(_quiet(), 0.0)
-    plant.pg[PL.PG_SV_RATE] = 0.0  # what the fault matrix's servo_stuck does
+    plant.pg[layout.PG_SV_RATE] = 0.0  # what the fault matrix's servo_stuck does
     for _ in range(100):
         plant.step(_hold(0.8))
     assert plant.sensors().servo_rad == pytest.approx(0.0, abs=1.0 / SERVO.feedback_counts_per_rad)

@@ -285,7 +285,7 @@ def test_a_blocked_drive_mid_stroke_shows_the_safety_stop_and_its_reason(browser
         page.wait_for_function("!document.querySelector('[data-cmd=run]').disabled", timeout=30_000)
 
         def block_drive_2_mid_stroke(d: Debugger) -> None:
-            from ttt_sm.twin import _plant as P
+            from ttt_sm.twin import layout
 
             d.delete(None)
             while not d.robot.board.contact.pen_touching:
@@ -293,7 +293,7 @@ def test_a_blocked_drive_mid_stroke_shows_the_safety_stop_and_its_reason(browser
             d.step(200)
             sim = d.robot.sim
             assert sim is not None
-            sim.plant.pp[1, P.PP_QMIN] = sim.plant.pp[1, P.PP_QMAX] = float(sim.plant.ps[1, P.PS_Q])
+            sim.plant.pp[1, layout.PP_QMIN] = sim.plant.pp[1, layout.PP_QMAX] = float(sim.plant.ps[1, layout.PS_Q])
 
         session.call(block_drive_2_mid_stroke)
         page.get_by_role("button", name="Run", exact=True).click()

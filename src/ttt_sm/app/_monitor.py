@@ -4,7 +4,8 @@ The Monitor block (:class:`~ttt_sm.app.safety_wiring.SafetyStage`) runs on
 every chart step of every robot.  Written as plain Python it cost more than
 the Safety chart it feeds (~15 µs a chart step of a game); here its
 arithmetic is compiled functions over one float buffer ``m[M_*]``, the
-stage's whole state:
+stage's whole state (its layout, and those of ``OUT_*``, ``ix[IX_*]`` and
+``SRC_*``, are tables in ``_monitor_layout.py``):
 
 - :func:`monitor`, before the chart ticks: the encoder angles from this chart
   step's counts and the offsets (``counts * rad_per_count + offset``, as the
@@ -15,7 +16,8 @@ stage's whole state:
   minus its feedback reading) and the tool pose by forward kinematics
   (:func:`~ttt_sm.twin.kinematics.chain.arm_chain`) of the encoder angles;
 - :func:`advance`, after the chart ticked: the model of the controller's
-  setpoint filters stepped with the setpoints sent to the drives, followed no
+  setpoint filters (the controller's own :func:`~ttt_sm.twin._cascade.setpoint_filter`,
+  with its coefficients over a chart step) stepped with the setpoints sent to the drives, followed no
   faster than the speed clamp; and the model of the pen servo, its first-order
   lag and slew-rate limit of ``[servo]``, stepped with the servo's setpoint.
 
@@ -38,39 +40,101 @@ The model moves with the encoder offsets when the init charts change them
 
 from __future__ import annotations
 
-import hashlib
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numba import njit
 
+from ..twin import _cascade, layout
+from ..twin._cascade import setpoint_filter
 from ..twin.kinematics import chain
 from ..twin.kinematics.chain import arm_chain
+from . import _monitor_layout
+from ._monitor_layout import (
+    IX_CAMERA_OK,
+    IX_CMD_SPEED_1,
+    IX_CMD_SPEED_2,
+    IX_CMD_SPEED_3,
+    IX_CURRENT_1,
+    IX_CURRENT_2,
+    IX_CURRENT_3,
+    IX_ERR_1,
+    IX_ERR_2,
+    IX_ERR_3,
+    IX_FAST_1,
+    IX_FAST_2,
+    IX_FAST_3,
+    IX_INIT_FAILED,
+    IX_INITIALISED,
+    IX_LIMIT_MARGIN,
+    IX_LINK_OK,
+    IX_MAX_CURRENT,
+    IX_MAX_CURRENT_INIT,
+    IX_MAX_FOLLOWING_ERROR,
+    IX_MAX_FOLLOWING_ERROR_FAST,
+    IX_MAX_FOLLOWING_ERROR_INIT,
+    IX_MAX_SERVO_ERROR,
+    IX_MAX_SPEED,
+    IX_MOVING_SPEED,
+    IX_PREV,
+    IX_Q_1,
+    IX_Q_2,
+    IX_Q_3,
+    IX_Q_MAX_1,
+    IX_Q_MAX_2,
+    IX_Q_MAX_3,
+    IX_Q_MIN_1,
+    IX_Q_MIN_2,
+    IX_Q_MIN_3,
+    IX_SERVO_ERR,
+    IX_SERVO_ERROR_S,
+    IX_SERVO_OFF,
+    IX_SILENT_S,
+    IX_SPEED_1,
+    IX_SPEED_2,
+    IX_SPEED_3,
+    IX_SRC,
+    IX_STALL_RATIO,
+    IX_STILL_1,
+    IX_STILL_2,
+    IX_STILL_3,
+    M_CHART_DT,
+    M_COUNTS,
+    M_DP,
+    M_FAST,
+    M_FAST_STEPS,
+    M_FB_CAL,
+    M_GEOMETRY,
+    M_OFFSET,
+    M_OUT,
+    M_P,
+    M_R,
+    M_ROW,
+    M_ROW_SLOW,
+    M_RPC,
+    M_SPEED_PER_COUNT,
+    M_STEP_MAX,
+    M_SV,
+    M_SV_INV_TAU,
+    M_SV_RATE,
+    M_TICK_S,
+    M_V,
+    N_OUT,
+    OUT_CMD_SPEED,
+    OUT_CURRENT,
+    OUT_ERR,
+    OUT_FAST,
+    OUT_Q,
+    OUT_SERVO_ERR,
+    OUT_SERVO_Q,
+    OUT_SPEED,
+    OUT_TOOL,
+    SRC_CURRENTS,
+    SRC_OFFSETS,
+    SRC_SERVO,
+    SRC_SERVO_Q,
+)
 
-# ---- the buffer m[M_*]: three numbers per drive unless said ------------------
-M_R = 0  # the model of the setpoint filter: angle (encoder coordinates), rad
-M_V = 3  # its rate, rad/s
-M_P = 6  # where the drive can be: the filter's angle followed no faster than the speed clamp, rad
-M_DP = 9  # how far M_P moved over the last chart step, rad
-M_FAST = 12  # chart steps the drive still counts as at its speed clamp
-M_COUNTS = 15  # the encoder counts of the last chart step
-M_OFFSET = 18  # the encoder offsets the model's angles are in, rad
-M_STEP_MAX = 21  # the speed clamp times the chart period, rad
-M_SPEED_PER_COUNT = 24  # rad/s of one count over a chart step
-M_RPC = 27  # rad per count
-M_ROW = 30  # 6: the fast setpoint filter over one chart step (a11 a12 b1 a21 a22 b2)
-M_ROW_SLOW = 36  # 6: the slow one (fr_sw)
-M_GEOMETRY = 42  # 5: L1 L2 L3 L4 l_f
-M_FAST_STEPS = 47  # 1: chart steps a drive counts as at its clamp after the model left it
-M_CHART_DT = 48  # 1: the chart period, s
-M_SV = 49  # 1: the model of the pen servo: where its output shaft should be, rad
-M_SV_RATE = 50  # 1: the servo's slew rate, rad/s
-M_SV_INV_TAU = 51  # 1: 1 / the time constant of its position loop, 1/s
-M_TICK_S = 52  # 1: the Safety chart's tick period (its still timers count it), s
-M_FB_CAL = 53  # 3: the servo feedback's calibration a0, c0, 1/k: a0 + (counts - c0) / k rad (app/_monitor.py: SRC_*)
-M_OUT = 56  # N_OUT: what :func:`monitor` (or :func:`step`) computed this chart step, OUT_* by position
-N_M = M_OUT + 24
 #: Sub-steps of the servo's model over one chart step (its time constant, 20 ms, is 10 chart steps).
 SV_SUBSTEPS = 4
 
@@ -78,42 +142,18 @@ SV_SUBSTEPS = 4
 #: the tool's phi after them is the stage's own).
 PORTS = ("Monitor.err", "Monitor.speed", "Monitor.cmd_speed", "Monitor.current", "Monitor.q", "Monitor.fast",
          "Monitor.servo_err", "Monitor.servo_q", "FK.X", "FK.Y", "FK.Z")
-#: What :func:`monitor` returns, by position: following errors, encoder speeds, commanded speeds,
-#: currents (magnitudes), encoder angles, at the speed clamp (three each), the servo's error and its
-#: feedback angle, then the tool's x, y, z, phi.
-OUT_ERR, OUT_SPEED, OUT_CMD_SPEED, OUT_CURRENT, OUT_Q, OUT_FAST = 0, 3, 6, 9, 12, 15
-OUT_SERVO_ERR, OUT_SERVO_Q, OUT_TOOL = 18, 19, 20
-N_OUT = 24
-
-#: The Safety chart's data :func:`step` reads and writes in the chart's buffer, by their places in the
-#: int array ``ix`` (``IX_*``): first where each of the ``N_OUT`` outputs goes (-1: wired elsewhere),
-#: then the inputs wired from the Link, Camera and Homing blocks, then these data by name.
-FLAGS = ("initialised", "init_failed", "link_ok", "camera_ok")
-NAMES = ("err_1", "err_2", "err_3", "speed_1", "speed_2", "speed_3", "cmd_speed_1", "cmd_speed_2", "cmd_speed_3",
-         "current_1", "current_2", "current_3", "q_1", "q_2", "q_3", "fast_1", "fast_2", "fast_3", "servo_err",
-         "max_following_error", "max_following_error_init", "max_following_error_fast", "max_current",
-         "max_current_init", "max_speed", "moving_speed", "stall_ratio", "silent_s", "limit_margin",
-         "q_min_1", "q_min_2", "q_min_3", "q_max_1", "q_max_2", "q_max_3",
-         "still_1", "still_2", "still_3", "max_servo_error", "servo_error_s", "servo_off")
-IX_FLAGS = N_OUT
-IX_NAMES = IX_FLAGS + len(FLAGS)
-#: Where :func:`step` reads the arm: counts (3, in the int source), currents (3, float source), the servo
-#: feedback (float source, through ``M_FB_CAL``), offsets (3, controller source), the servo's setpoint (same).
-IX_SRC = IX_NAMES + len(NAMES)
-SRC_COUNTS, SRC_CURRENTS, SRC_SERVO_Q, SRC_OFFSETS, SRC_SERVO = 0, 3, 6, 7, 10
-N_SRC = 11
-IX_PREV = IX_SRC + N_SRC  # then the number of (output, previous) pairs, and the pairs
 #: What :func:`step` returns when it only fed the chart (a guard of ``monitoring`` holds, or not asked to tick).
 FED = -2
 
 
-def _chain_fingerprint() -> str:
-    """SHA-256 of the forward kinematics' source: numba's disk cache checks only this file (see twin/_kernel.py)."""
-    return hashlib.sha256(Path(str(chain.__file__)).read_bytes()).hexdigest()
+def _sources_fingerprint() -> str:
+    """SHA-256 of the sources the functions are compiled from beside this file: numba's disk cache checks only
+    this file (see twin/_kernel.py): the forward kinematics, the setpoint filter, the layouts."""
+    return layout.fingerprint(*(str(m.__file__) for m in (chain, _cascade, _monitor_layout, layout)))
 
 
 def _compile(fingerprint: str) -> tuple[Any, Any, Any]:
-    """The three functions, compiled (or loaded from numba's cache) for this forward kinematics."""
+    """The three functions, compiled (or loaded from numba's cache) for these sources (:func:`_sources_fingerprint`)."""
 
     @njit(cache=True, error_model="numpy")
     def monitor_(m: np.ndarray, c1: int, c2: int, c3: int, i1: float, i2: float, i3: float,
@@ -165,13 +205,9 @@ def _compile(fingerprint: str) -> tuple[Any, Any, Any]:
             sv += h * (rate if w > rate else (-rate if w < -rate else w))
         m[M_SV] = sv
         row = M_ROW_SLOW if slow else M_ROW
-        a11, a12, b1 = m[row], m[row + 1], m[row + 2]
-        a21, a22, b2 = m[row + 3], m[row + 4], m[row + 5]
         for i, u in ((0, u1), (1, u2), (2, u3)):
-            r, v = m[M_R + i], m[M_V + i]
-            rn = a11 * r + a12 * v + b1 * u
+            rn, m[M_V + i] = setpoint_filter(m, row, m[M_R + i], m[M_V + i], u)  # the controller's own filter
             m[M_R + i] = rn
-            m[M_V + i] = a21 * r + a22 * v + b2 * u
             step = m[M_STEP_MAX + i]
             d = rn - m[M_P + i]
             if d > step:
@@ -215,54 +251,54 @@ def _compile(fingerprint: str) -> tuple[Any, Any, Any]:
         for j in range(N_OUT):
             if ix[j] >= 0:
                 b[ix[j]] = m[M_OUT + j]
-        f = IX_FLAGS
-        b[ix[f]], b[ix[f + 1]], b[ix[f + 2]], b[ix[f + 3]] = initialised, init_failed, link_ok, camera_ok
+        b[ix[IX_INITIALISED]], b[ix[IX_INIT_FAILED]] = initialised, init_failed
+        b[ix[IX_LINK_OK]], b[ix[IX_CAMERA_OK]] = link_ok, camera_ok
         if not quiet:
             return FED
-        n = IX_NAMES
-        err1, err2, err3 = b[ix[n]], b[ix[n + 1]], b[ix[n + 2]]
-        sp1, sp2, sp3 = b[ix[n + 3]], b[ix[n + 4]], b[ix[n + 5]]
-        cmd1, cmd2, cmd3 = b[ix[n + 6]], b[ix[n + 7]], b[ix[n + 8]]
-        cu1, cu2, cu3 = b[ix[n + 9]], b[ix[n + 10]], b[ix[n + 11]]
-        q1, q2, q3 = b[ix[n + 12]], b[ix[n + 13]], b[ix[n + 14]]
-        fa1, fa2, fa3 = b[ix[n + 15]] != 0.0, b[ix[n + 16]] != 0.0, b[ix[n + 17]] != 0.0
-        servo_err = b[ix[n + 18]]
-        ini = b[ix[f]] != 0.0
-        still1, still2, still3 = b[ix[n + 35]], b[ix[n + 36]], b[ix[n + 37]]
-        max_servo_error, servo_error_s, servo_off = b[ix[n + 38]], b[ix[n + 39]], b[ix[n + 40]]
+        err1, err2, err3 = b[ix[IX_ERR_1]], b[ix[IX_ERR_2]], b[ix[IX_ERR_3]]
+        sp1, sp2, sp3 = b[ix[IX_SPEED_1]], b[ix[IX_SPEED_2]], b[ix[IX_SPEED_3]]
+        cmd1, cmd2, cmd3 = b[ix[IX_CMD_SPEED_1]], b[ix[IX_CMD_SPEED_2]], b[ix[IX_CMD_SPEED_3]]
+        cu1, cu2, cu3 = b[ix[IX_CURRENT_1]], b[ix[IX_CURRENT_2]], b[ix[IX_CURRENT_3]]
+        q1, q2, q3 = b[ix[IX_Q_1]], b[ix[IX_Q_2]], b[ix[IX_Q_3]]
+        fa1, fa2, fa3 = b[ix[IX_FAST_1]] != 0.0, b[ix[IX_FAST_2]] != 0.0, b[ix[IX_FAST_3]] != 0.0
+        servo_err = b[ix[IX_SERVO_ERR]]
+        ini = b[ix[IX_INITIALISED]] != 0.0
+        still1, still2, still3 = b[ix[IX_STILL_1]], b[ix[IX_STILL_2]], b[ix[IX_STILL_3]]
+        max_servo_error, servo_error_s = b[ix[IX_MAX_SERVO_ERROR]], b[ix[IX_SERVO_ERROR_S]]
+        servo_off = b[ix[IX_SERVO_OFF]]
         # Safety.arm_fault
-        fault = b[ix[f + 2]] == 0.0 or b[ix[f + 1]] != 0.0
+        fault = b[ix[IX_LINK_OK]] == 0.0 or b[ix[IX_INIT_FAILED]] != 0.0
         if not fault:
-            cur_max = b[ix[n + 22]] if ini else b[ix[n + 23]]
-            speed_max, silent = b[ix[n + 24]], b[ix[n + 27]]
+            cur_max = b[ix[IX_MAX_CURRENT]] if ini else b[ix[IX_MAX_CURRENT_INIT]]
+            speed_max, silent = b[ix[IX_MAX_SPEED]], b[ix[IX_SILENT_S]]
             fault = (sp1 > speed_max or sp2 > speed_max or sp3 > speed_max
                      or cu1 > cur_max or cu2 > cur_max or cu3 > cur_max
                      or still1 >= silent or still2 >= silent or still3 >= silent)
         if not fault:
-            err_max = b[ix[n + 19]] if ini else b[ix[n + 20]]
-            fast = b[ix[n + 21]]
+            err_max = b[ix[IX_MAX_FOLLOWING_ERROR]] if ini else b[ix[IX_MAX_FOLLOWING_ERROR_INIT]]
+            fast = b[ix[IX_MAX_FOLLOWING_ERROR_FAST]]
             fault = (abs(err1) > (fast if fa1 and fast > err_max else err_max)
                      or abs(err2) > (fast if fa2 and fast > err_max else err_max)
                      or abs(err3) > (fast if fa3 and fast > err_max else err_max))
         if not fault and ini:
-            mg = b[ix[n + 28]]
-            fault = not (b[ix[n + 29]] - mg <= q1 <= b[ix[n + 32]] + mg
-                         and b[ix[n + 30]] - mg <= q2 <= b[ix[n + 33]] + mg
-                         and b[ix[n + 31]] - mg <= q3 <= b[ix[n + 34]] + mg)
+            mg = b[ix[IX_LIMIT_MARGIN]]
+            fault = not (b[ix[IX_Q_MIN_1]] - mg <= q1 <= b[ix[IX_Q_MAX_1]] + mg
+                         and b[ix[IX_Q_MIN_2]] - mg <= q2 <= b[ix[IX_Q_MAX_2]] + mg
+                         and b[ix[IX_Q_MIN_3]] - mg <= q3 <= b[ix[IX_Q_MAX_3]] + mg)
         # not camera_ok (and initialised); Safety.servo_stuck (and initialised)
-        if fault or b[ix[f + 3]] == 0.0 or servo_off >= servo_error_s:
+        if fault or b[ix[IX_CAMERA_OK]] == 0.0 or servo_off >= servo_error_s:
             return FED
         # the quiet tick: outputs to their previous values, then during_monitoring
         p = IX_PREV
         for k in range(ix[p]):
             b[ix[p + 1 + 2 * k + 1]] = b[ix[p + 1 + 2 * k]]
-        dt, moving = m[M_TICK_S], b[ix[n + 25]]
-        ratio = b[ix[n + 26]] if ini else 0.0
+        dt, moving = m[M_TICK_S], b[ix[IX_MOVING_SPEED]]
+        ratio = b[ix[IX_STALL_RATIO]] if ini else 0.0
         a1, a2, a3 = abs(cmd1), abs(cmd2), abs(cmd3)
-        b[ix[n + 35]] = still1 + dt if a1 > moving and sp1 <= ratio * a1 else 0.0
-        b[ix[n + 36]] = still2 + dt if a2 > moving and sp2 <= ratio * a2 else 0.0
-        b[ix[n + 37]] = still3 + dt if a3 > moving and sp3 <= ratio * a3 else 0.0
-        b[ix[n + 40]] = servo_off + dt if abs(servo_err) > max_servo_error else 0.0
+        b[ix[IX_STILL_1]] = still1 + dt if a1 > moving and sp1 <= ratio * a1 else 0.0
+        b[ix[IX_STILL_2]] = still2 + dt if a2 > moving and sp2 <= ratio * a2 else 0.0
+        b[ix[IX_STILL_3]] = still3 + dt if a3 > moving and sp3 <= ratio * a3 else 0.0
+        b[ix[IX_SERVO_OFF]] = servo_off + dt if abs(servo_err) > max_servo_error else 0.0
         advance(m, u1, u2, u3, slow, u4)
         return -1
 
@@ -271,4 +307,4 @@ def _compile(fingerprint: str) -> tuple[Any, Any, Any]:
     return monitor_, advance_, step
 
 
-monitor, advance, step = _compile(_chain_fingerprint())
+monitor, advance, step = _compile(_sources_fingerprint())

@@ -18,14 +18,13 @@ no gravity preloads its gear, so its play cannot be compensated this way.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 
 import numpy as np
 
 from ..params import ArmParams
 from ..sched.scheduler import Signals
-from ..twin.plant import gravity_coefficients, gravity_torques
+from ..twin.plant import gear_play, gravity_coefficients, gravity_torques, gravity_torques_py
 
 
 def play_offsets(params: ArmParams, q: np.ndarray) -> np.ndarray:
@@ -33,12 +32,8 @@ def play_offsets(params: ArmParams, q: np.ndarray) -> np.ndarray:
     tau = gravity_torques(params, q)
     out = np.zeros(3)
     for d in (1, 2):
-        out[d] = _offset(tau[d], params.drives[d].gear_clearance, params.drives[d].gear_stiffness)
+        out[d] = gear_play(tau[d], params.drives[d].gear_clearance, params.drives[d].gear_stiffness)
     return out
-
-
-def _offset(tau: float, clearance: float, stiffness: float) -> float:
-    return 0.0 if tau == 0.0 else math.copysign(clearance / 2 + abs(tau) / stiffness, tau)
 
 
 class GearPlayCompensation:
@@ -58,14 +53,11 @@ class GearPlayCompensation:
             return
         q1, q2, q3, q4 = signals.q_set
         g2, g23 = self._gravity
-        tau23 = -g23 * math.sin(q2 + q3)  # as gravity_torques, on plain floats
-        tau2 = -g2 * math.sin(q2) + tau23
+        tau2, tau3 = gravity_torques_py(g2, g23, q2, q3)  # on plain floats: it runs every chart step
         c2, k2, c3, k3 = self._play
         gain = self.gain
-        # _offset written out (it runs every chart step): the play taken up towards the gravity torque
-        if tau2 != 0.0:
-            q2 -= gain * math.copysign(c2 / 2 + abs(tau2) / k2, tau2)
-        if tau23 != 0.0:
-            q3 -= gain * math.copysign(c3 / 2 + abs(tau23) / k3, tau23)
+        # the play taken up towards the gravity torque
+        q2 -= gain * gear_play(tau2, c2, k2)
+        q3 -= gain * gear_play(tau3, c3, k3)
         signals.q_set = [float(q1), float(q2), float(q3), float(q4)]
 

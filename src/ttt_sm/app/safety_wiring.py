@@ -44,6 +44,7 @@ from ..sched.scheduler import Scheduler, Signals
 from ..twin.control import max_joint_speed, setpoint_filter_row
 from ..twin.kinematics import IKError
 from . import _monitor
+from . import _monitor_layout as ML
 from .wiring import Wiring, WiringError, not_wired
 
 
@@ -125,26 +126,26 @@ class SafetyStage:
         # the Monitor block's state, one buffer for its compiled functions (app/_monitor.py): the model
         # of the controller's setpoint filters (angle and rate per drive, in encoder coordinates), and
         # where the drive can be (the filter's angle followed no faster than the speed clamp)
-        self._m = m = np.zeros(_monitor.N_M)
+        self._m = m = np.zeros(ML.N_M)
         # the same memory, read and written as plain numbers (numpy's stubs lack __buffer__)
         self._mv: Any = memoryview(m)  # type: ignore[arg-type]
-        m[_monitor.M_ROW:_monitor.M_ROW + 6] = _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_hz, c.dt),
+        m[ML.M_ROW:ML.M_ROW + 6] = _chart_step_row(setpoint_filter_row(c.setpoint_cutoff_hz, c.dt),
                                                                c.chart_divider)
-        m[_monitor.M_ROW_SLOW:_monitor.M_ROW_SLOW + 6] = _chart_step_row(
+        m[ML.M_ROW_SLOW:ML.M_ROW_SLOW + 6] = _chart_step_row(
             setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt), c.chart_divider)
         rpc = [float(d.rad_per_count) for d in params.drives]
         g = params.geometry
-        m[_monitor.M_RPC:_monitor.M_RPC + 3] = rpc
-        m[_monitor.M_SPEED_PER_COUNT:_monitor.M_SPEED_PER_COUNT + 3] = [r / c.chart_dt for r in rpc]
-        m[_monitor.M_STEP_MAX:_monitor.M_STEP_MAX + 3] = [max_joint_speed(d) * c.chart_dt for d in params.drives]
-        m[_monitor.M_GEOMETRY:_monitor.M_GEOMETRY + 5] = [g.L1, g.L2, g.L3, g.L4, g.l_f]
-        m[_monitor.M_FAST_STEPS] = max(1, round(FAST_HOLD_S / c.chart_dt))
-        m[_monitor.M_CHART_DT] = c.chart_dt
-        m[_monitor.M_TICK_S] = chart.tick_period_s
+        m[ML.M_RPC:ML.M_RPC + 3] = rpc
+        m[ML.M_SPEED_PER_COUNT:ML.M_SPEED_PER_COUNT + 3] = [r / c.chart_dt for r in rpc]
+        m[ML.M_STEP_MAX:ML.M_STEP_MAX + 3] = [max_joint_speed(d) * c.chart_dt for d in params.drives]
+        m[ML.M_GEOMETRY:ML.M_GEOMETRY + 5] = [g.L1, g.L2, g.L3, g.L4, g.l_f]
+        m[ML.M_FAST_STEPS] = max(1, round(FAST_HOLD_S / c.chart_dt))
+        m[ML.M_CHART_DT] = c.chart_dt
+        m[ML.M_TICK_S] = chart.tick_period_s
         enc = arm.encoder_angles()
-        m[_monitor.M_R:_monitor.M_R + 3] = enc
-        m[_monitor.M_P:_monitor.M_P + 3] = enc
-        m[_monitor.M_OFFSET:_monitor.M_OFFSET + 3] = arm.offset_estimates()
+        m[ML.M_R:ML.M_R + 3] = enc
+        m[ML.M_P:ML.M_P + 3] = enc
+        m[ML.M_OFFSET:ML.M_OFFSET + 3] = arm.offset_estimates()
         sensors = arm.sensors()
         # where _monitor.step reads the arm: the simulated arm's own memory, or copies of the protocol's readings
         inplace = getattr(arm, "readings_in_place", None)
@@ -152,17 +153,17 @@ class SafetyStage:
             src = inplace()
             self._src = (src.plant_floats, src.plant_ints, src.controller_floats)
             self._src_ix = [*src.counts, *src.currents, src.servo_counts, *src.offsets, src.servo_setpoint]
-            m[_monitor.M_FB_CAL:_monitor.M_FB_CAL + 3] = src.servo_calibration
+            m[ML.M_FB_CAL:ML.M_FB_CAL + 3] = src.servo_calibration
             self._copied: tuple[Any, Any, Any] | None = None
         else:
             self._src = (np.zeros(4), np.zeros(3, dtype=np.int64), np.zeros(4))
             self._src_ix = [0, 1, 2, 0, 1, 2, 3, 0, 1, 2, 3]  # counts, currents, servo_q; offsets, setpoint
-            m[_monitor.M_FB_CAL:_monitor.M_FB_CAL + 3] = (0.0, 0.0, 1.0)  # the reading is in rad already
+            m[ML.M_FB_CAL:ML.M_FB_CAL + 3] = (0.0, 0.0, 1.0)  # the reading is in rad already
             self._copied = tuple(memoryview(a) for a in self._src)  # type: ignore[arg-type,assignment]
-        m[_monitor.M_COUNTS:_monitor.M_COUNTS + 3] = sensors.counts
-        m[_monitor.M_SV] = sensors.servo_rad
-        m[_monitor.M_SV_RATE] = params.servo.rate_rad_s
-        m[_monitor.M_SV_INV_TAU] = 1.0 / params.servo.time_constant_s
+        m[ML.M_COUNTS:ML.M_COUNTS + 3] = sensors.counts
+        m[ML.M_SV] = sensors.servo_rad
+        m[ML.M_SV_RATE] = params.servo.rate_rad_s
+        m[ML.M_SV_INV_TAU] = 1.0 / params.servo.time_constant_s
         self._tool = (0.0, 0.0, 0.0)
         self._pose: list[float] | None = None  # what the drives hold while the chart trips
         self._lift_for = math.nan  # the lift_z the pose was solved for
@@ -178,7 +179,7 @@ class SafetyStage:
         self.listeners: list[Callable[[str, dict[str, Any]], object]] = []
         # the Safety chart's numbers, in place (the chart is buffered), and where _monitor.step finds them
         self._b = np.frombuffer(chart.data_buffer(), dtype=np.float64)
-        self._ix = np.full(_monitor.IX_PREV + 1, -1, dtype=np.int64)
+        self._ix = np.full(ML.IX_PREV + 1, -1, dtype=np.int64)
         self._chart_d = vars(chart)
         # the configuration _monitor.step ticks (a state reference, not its name: a rename fails here)
         self._watching = Safety.monitoring.value
@@ -200,17 +201,17 @@ class SafetyStage:
     def commanded_speed(self) -> list[float]:
         """Each drive's commanded speed, rad/s: the rate of the model of its setpoint filter."""
         mv, dt = self._mv, self._chart_dt
-        return [mv[_monitor.M_DP + i] / dt for i in range(3)]
+        return [mv[ML.M_DP + i] / dt for i in range(3)]
 
     @property
     def _out(self) -> tuple[float, ...]:
         """The Monitor block's outputs as this chart step computed them (app/_monitor.py: OUT_*)."""
-        return tuple(self._mv[_monitor.M_OUT:_monitor.M_OUT + _monitor.N_OUT])
+        return tuple(self._mv[ML.M_OUT:ML.M_OUT + ML.N_OUT])
 
     @property
     def err(self) -> list[float]:
         """The Monitor block's following errors, as this chart step computed them, rad."""
-        return list(self._out[_monitor.OUT_ERR:_monitor.OUT_ERR + 3])
+        return list(self._out[ML.OUT_ERR:ML.OUT_ERR + 3])
 
     def blocks(self) -> dict[str, object]:
         """The objects holding the outputs of this stage's blocks (Link, Camera); Monitor and FK are arguments."""
@@ -228,20 +229,20 @@ class SafetyStage:
         ix = self._ix
         for element, datum in wiring.routes(name, ("Monitor", "FK")):
             ix[element] = slots[datum]
-        ix[_monitor.IX_FLAGS:_monitor.IX_NAMES] = [slots[f] for f in _monitor.FLAGS]
-        self._flags = wiring.collect(*(f"{name}.{f}" for f in _monitor.FLAGS))
+        ix[ML.IX_FLAGS:ML.IX_NAMES] = [slots[f] for f in ML.FLAGS]
+        self._flags = wiring.collect(*(f"{name}.{f}" for f in ML.FLAGS))
         flag_sources = {row.source.block for row in wiring.rows
-                        if row.target.block == name and row.target.port in _monitor.FLAGS}
+                        if row.target.block == name and row.target.port in ML.FLAGS}
         others = wiring.sources(name) - {"Monitor", "FK"} - flag_sources
         if others:
             raise WiringError(f"the Safety stage writes the {name} chart's inputs from the Monitor and FK blocks and"
-                              f" its flags ({', '.join(_monitor.FLAGS)}); the wiring table also feeds it from"
+                              f" its flags ({', '.join(ML.FLAGS)}); the wiring table also feeds it from"
                               f" {', '.join(sorted(others))}")
-        ix[_monitor.IX_NAMES:_monitor.IX_SRC] = [slots[n] for n in _monitor.NAMES]
-        ix[_monitor.IX_SRC:_monitor.IX_PREV] = self._src_ix
+        ix[ML.IX_NAMES:ML.IX_SRC] = [slots[n] for n in ML.NAMES]
+        ix[ML.IX_SRC:ML.IX_PREV] = self._src_ix
         pairs = type(self.chart)._slot_prev_pairs
         self._ix = ix = np.concatenate([ix, [v for pair in pairs for v in pair]]).astype(np.int64)
-        ix[_monitor.IX_PREV] = len(pairs)
+        ix[ML.IX_PREV] = len(pairs)
         self._dict_prev = type(self.chart)._dict_prev_pairs
         self._outputs = wiring.collect("SafeState.tripped", "SafeState.hold", "SafeState.lift_z",
                                        "SafeState.bridge_off", "SafeState.reinit")
@@ -310,7 +311,7 @@ class SafetyStage:
         if hold:
             if self._pose is None:
                 self._pose = [out[12], out[13], out[14], servo]
-                self._tool = (out[_monitor.OUT_TOOL], out[_monitor.OUT_TOOL + 1], out[_monitor.OUT_TOOL + 3])
+                self._tool = (out[ML.OUT_TOOL], out[ML.OUT_TOOL + 1], out[ML.OUT_TOOL + 3])
             if lift_z == lift_z and lift_z != self._lift_for:  # a lift to solve (not NaN, not solved yet)
                 self._lift_for = lift_z
                 self._lift_from = list(self._pose)
@@ -342,10 +343,10 @@ class SafetyStage:
         """The encoder offsets changed to `offsets`: the model's angles move with them."""
         mv = self._mv
         for i in range(3):
-            delta = offsets[i] - mv[_monitor.M_OFFSET + i]
-            mv[_monitor.M_R + i] += delta
-            mv[_monitor.M_P + i] += delta
-            mv[_monitor.M_OFFSET + i] = offsets[i]
+            delta = offsets[i] - mv[ML.M_OFFSET + i]
+            mv[ML.M_R + i] += delta
+            mv[ML.M_P + i] += delta
+            mv[ML.M_OFFSET + i] = offsets[i]
 
     def _lift_pose(self, lift_z: float) -> list[float]:
         """Joint setpoints with the tool where it was at the trip, at height `lift_z`; the held pose if out of reach."""
@@ -363,13 +364,13 @@ class SafetyStage:
         self._reinitialise()
         arm, mv = self.arm, self._mv
         self._shift(arm.offset_estimates())  # they changed: the setpoints moved with them
-        mv[_monitor.M_SV] = arm.sensors().servo_rad  # the servo's model starts again where the servo stands
+        mv[ML.M_SV] = arm.sensors().servo_rad  # the servo's model starts again where the servo stands
         enc = arm.encoder_angles()
         for i, on in enumerate(arm.enabled()):
             if not on:  # switched on, a drive holds where it stands, its filter reset there
                 arm.set_enabled(i + 1, True)
-                mv[_monitor.M_R + i], mv[_monitor.M_V + i] = enc[i], 0.0
-                mv[_monitor.M_P + i], mv[_monitor.M_DP + i] = enc[i], 0.0
+                mv[ML.M_R + i], mv[ML.M_V + i] = enc[i], 0.0
+                mv[ML.M_P + i], mv[ML.M_DP + i] = enc[i], 0.0
         self._tell("safety_reset")
 
     def _tell(self, kind: str, **data: Any) -> None:

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..twin import _plant as P
+from ..twin import layout
 from ..twin.plant import Plant
 
 #: The faults of the arm, in the order the matrix lists them.
@@ -81,27 +81,27 @@ class PlantFault:
         self.spike_until = -1.0
         self._saved: list[tuple[np.ndarray, int | None, int, float]] = []  # (array, row, column, value)
         d = drive - 1
-        self._frozen_counts = int(plant.ints[d, P.PI_COUNTS])
+        self._frozen_counts = int(plant.ints[d, layout.PI_COUNTS])
         if fault == "encoder_jump":
             rpc = plant.params.drives[d].rad_per_count
-            plant.ints[d, P.PI_C0] -= int(round(ENCODER_JUMP_RAD / rpc))  # counts = floor(angle) - C0
+            plant.ints[d, layout.PI_C0] -= int(round(ENCODER_JUMP_RAD / rpc))  # counts = floor(angle) - C0
         elif fault == "motor_blocked":
-            q = float(plant.ps[d, P.PS_Q])
-            self._set(plant.pp, d, P.PP_QMIN, q)
-            self._set(plant.pp, d, P.PP_QMAX, q)
+            q = float(plant.ps[d, layout.PS_Q])
+            self._set(plant.pp, d, layout.PP_QMIN, q)
+            self._set(plant.pp, d, layout.PP_QMAX, q)
         elif fault == "current_spike":
             self.spike_until = plant.t + SPIKE_S
         elif fault == "servo_stuck":
-            self._set(plant.pg, None, P.PG_SV_RATE, 0.0)
+            self._set(plant.pg, None, layout.PG_SV_RATE, 0.0)
         elif fault == "power_cut":
             for k in range(3):
-                self._set(plant.pp, k, P.PP_SUPPLY, 0.0)
-            self._set(plant.pg, None, P.PG_SV_RATE, 0.0)
+                self._set(plant.pp, k, layout.PP_SUPPLY, 0.0)
+            self._set(plant.pg, None, layout.PG_SV_RATE, 0.0)
 
     def after_step(self) -> None:
         """After a control step of the plant, before the controller reads it: a frozen counter stays put."""
         if self.every_step:
-            self.plant.ints[self.drive - 1, P.PI_COUNTS] = self._frozen_counts
+            self.plant.ints[self.drive - 1, layout.PI_COUNTS] = self._frozen_counts
 
     def current_a(self, drive: int, reading: float, t: float) -> float:
         """The current drive `drive` (1-3) reads at time `t` (s), its sensor's `reading` (A) with the fault."""

@@ -45,8 +45,7 @@ import numpy as np
 
 from ..params import ArmParams
 from ..ptylink import PtyLink, PtyLinkError, realtime_priority
-from ..twin import _cascade as C
-from ..twin import _plant as PL
+from ..twin import layout
 from ..twin.plant import REST_POSE, Plant, check_pose
 from . import link as L
 from .firmware import Precision, build
@@ -103,7 +102,7 @@ class FirmwareOnPlant:
         self.plant = Plant(params, q_start, np.random.default_rng(seed))
         safe = float(q_start[3]) if servo_safe_rad is None else servo_safe_rad
         self.firmware = NativeFirmware(lib, board_for(params, safe))
-        self._act = np.zeros(C.N_ACT)
+        self._act = np.zeros(layout.N_ACT)
         self._ints = self.plant.ints
         self._ps = self.plant.ps
         #: A fault of the arm acting on the plant and the readings (None: none); set by the emulator's thread.
@@ -113,13 +112,13 @@ class FirmwareOnPlant:
         """The plant's sensors into the firmware's input (no step)."""
         s, ints, fault = self.firmware.sensors, self._ints, self.fault
         for d in range(3):
-            s.counts[d] = int(ints[d, PL.PI_COUNTS])
-            s.index_count[d] = int(ints[d, PL.PI_INDEX_COUNT])
-            s.index_edges[d] = int(ints[d, PL.PI_INDEX_EDGES]) & 0xFFFF
-            current = float(self._ps[d, PL.PS_I_MEAS])
+            s.counts[d] = int(ints[d, layout.PI_COUNTS])
+            s.index_count[d] = int(ints[d, layout.PI_INDEX_COUNT])
+            s.index_edges[d] = int(ints[d, layout.PI_INDEX_EDGES]) & 0xFFFF
+            current = float(self._ps[d, layout.PS_I_MEAS])
             s.current_a[d] = current if fault is None else fault.current_a(d + 1, current, self.plant.t)
         s.servo_adc = self.plant.feedback_counts  # the twin's ADC reading of the servo's feedback wire
-        s.index = sum(1 << d for d in range(3) if ints[d, PL.PI_INDEX] == 1)
+        s.index = sum(1 << d for d in range(3) if ints[d, layout.PI_INDEX] == 1)
 
     def sense(self) -> None:
         """The firmware takes the plant's sensors without a step (a gated clock, before START)."""
@@ -178,7 +177,7 @@ class ArmEmulator:
         self.bench = FirmwareOnPlant(params, self._lib, seed=seed, q0=q0)
         # The plant's compiled step is loaded on its first call (a third of a second): on a scratch plant
         # now, not on the first control step, which a PC would wait for in vain.
-        Plant(params, check_pose(params, REST_POSE), np.random.default_rng(0)).step(np.zeros(C.N_ACT))
+        Plant(params, check_pose(params, REST_POSE), np.random.default_rng(0)).step(np.zeros(layout.N_ACT))
         self.firmware = self.bench.firmware
         #: The physics (simulation only): ground truth for tests.
         self.plant = self.bench.plant
@@ -356,10 +355,11 @@ class ArmEmulator:
             data = self.tap.to_pc(data, time.monotonic())
         if data and self.truth:  # before the firmware's frames: the PC has it when it reads their status
             ps, pgs, ints, rpc = self.plant.ps, self.plant.pgs, self.plant.ints, self._rpc
+            q, c0 = layout.PS_Q, layout.PI_C0
             frame = self._truth_tx.frame(L.EmuTruth(self.firmware.steps, int(self.pace == "gated"), (
-                float(ps[0, PL.PS_Q]), float(ps[1, PL.PS_Q]), float(ps[2, PL.PS_Q]), float(pgs[PL.PGS_SV_Q])),
-                ((ints[0, PL.PI_C0] + 0.5) * rpc[0], (ints[1, PL.PI_C0] + 0.5) * rpc[1],
-                 (ints[2, PL.PI_C0] + 0.5) * rpc[2])))  # (live: a jumped encoder moves its offset)
+                float(ps[0, q]), float(ps[1, q]), float(ps[2, q]), float(pgs[layout.PGS_SV_Q])),
+                ((ints[0, c0] + 0.5) * rpc[0], (ints[1, c0] + 0.5) * rpc[1],
+                 (ints[2, c0] + 0.5) * rpc[2])))  # (live: a jumped encoder moves its offset)
             self.truth_bytes += len(frame)
             self._out += frame
         self._out += data

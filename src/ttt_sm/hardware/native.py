@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..params import ArmParams
-from ..twin import _cascade as C
+from ..twin import layout
 from ..twin.cascade import CascadeController
 from ..twin.control import Gains, check_drive
 from .firmware import FirmwareError, Precision
@@ -31,11 +31,11 @@ _NUMPY = {"float": np.float32, "double": np.float64}
 def _struct(real: Any) -> type[ctypes.Structure]:
     class Cascade(ctypes.Structure):
         _fields_ = [
-            ("cp", (real * C.N_CP) * 3),
-            ("cg", real * C.N_CG),
-            ("cs", (real * C.N_CS) * 3),
-            ("cgs", real * C.N_CGS),
-            ("act", real * C.N_ACT),
+            ("cp", (real * layout.N_CP) * 3),
+            ("cg", real * layout.N_CG),
+            ("cs", (real * layout.N_CS) * 3),
+            ("cgs", real * layout.N_CGS),
+            ("act", real * layout.N_ACT),
             ("cm", ctypes.c_int32 * 3),
         ]
     return Cascade
@@ -172,9 +172,9 @@ class NativeCascade:
         self._ref = ctypes.byref(self.c)
         lib.lib.ttt_cascade_init(self._ref)
         pc = CascadeController(params, gains, servo_angle)
-        self.cp[:] = pc.cp[:, :C.N_CP]
-        self.cg[:] = pc.cg[:C.N_CG]
-        self.cgs[C.CGS_SV_SET] = servo_angle
+        self.cp[:] = pc.cp[:, :layout.N_CP]
+        self.cg[:] = pc.cg[:layout.N_CG]
+        self.cgs[layout.CGS_SV_SET] = servo_angle
         self._counts = (ctypes.c_int32 * 3)()
         self._q = (lib.real * 4)()
 

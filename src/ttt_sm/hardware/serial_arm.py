@@ -52,7 +52,7 @@ import serial
 
 from ..arm import Sensors
 from ..params import ArmParams
-from ..twin import _cascade as C
+from ..twin import layout
 from ..twin.cascade import CascadeController
 from ..twin.control import Gains, check_drive
 from ..twin.kinematics import fk
@@ -267,7 +267,7 @@ class SerialArm:
             raise SerialArmError(f"the firmware steps every {hs.control_period_us} us, the parameter file every "
                                  f"{self.dt * 1e6:g} us")
         pc = CascadeController(self.params, self.gains, servo_angle=self._q[3])
-        rows = [pc.cp[d, :C.N_CP] for d in range(3)] + [pc.cg[:C.N_CG]]
+        rows = [pc.cp[d, :layout.N_CP] for d in range(3)] + [pc.cg[:layout.N_CG]]
         real = np.float32 if hs.real_size == 4 else np.float64
         for block, row in enumerate(rows):
             self._send(L.Gains(block, tuple(float(v) for v in row)))
@@ -612,7 +612,7 @@ class SerialArm:
 
     def enabled(self) -> tuple[bool, bool, bool]:
         m = 0 if self._status is None else self._status.modes
-        return tuple(((m >> (2 * d)) & 3) == C.MODE_CLOSED for d in range(3))  # type: ignore[return-value]
+        return tuple(((m >> (2 * d)) & 3) == layout.MODE_CLOSED for d in range(3))  # type: ignore[return-value]
 
     def set_enabled(self, drive: int, enabled: bool) -> None:
         d = check_drive(drive) - 1

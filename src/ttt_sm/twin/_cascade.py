@@ -22,9 +22,17 @@ parameters ``cg[CG_*]``, per-drive state ``cs[d, CS_*]``, global state
 ``cgs[CGS_*]``, per-drive modes ``cm[d]`` (integers) and the outputs
 ``act[ACT_*]``; the input is ``counts[d]`` (integers).  All floats are
 float64.  The ``CP_``, ``CG_``, ``CS_``, ``CGS_`` and ``ACT_`` names are the
-only way code should index them.  The float blocks are rows of one
-buffer ``cf[CR_*]`` of :data:`WIDTH` columns (one array for the fused loop to
-take, cut into its blocks by slicing rows: see ``_kernel.py``).
+only way code should index them; ``twin/layout.py`` defines them (and
+generates the firmware's ``layout.h`` from the same tables).  The float
+blocks are rows of one buffer ``cf[CR_*]`` of ``layout.CONTROLLER_WIDTH``
+columns (one array for the fused loop to take, cut into its blocks by
+slicing rows: see ``_kernel.py``).
+
+The setpoint filter (:func:`setpoint_filter`) and the servo's duty
+(``params.servo_duty``) are written once and compiled here; the Safety
+stage's model of the controller (``app/_monitor.py``) calls the same filter.
+The firmware's ``cascade.c`` is this step's C port, held to it bit for bit
+by ``tests/hardware/test_cascade_c.py``.
 """
 
 from __future__ import annotations
@@ -32,70 +40,53 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-# ---- per-drive parameter row cp[d, CP_*] (SI units; joint side) -------------
-CP_RPC = 0  # joint angle of one encoder count (rad)
-CP_KP_POS = 1  # outer position PID: speed setpoint per rad (1/s), ...
-CP_KI_POS = 2  # ... per rad s (1/s^2)
-CP_KD_POS = 3  # ... per rad/s (dimensionless)
-CP_KFF = 4  # speed feedforward from the setpoint filter's derivative
-CP_WMAX = 5  # speed setpoint clamp (joint rad/s)
-CP_KP_SPD = 6  # inner speed PID: duty per rad/s (s/rad), ...
-CP_KI_SPD = 7  # ... per rad (1/rad)
-CP_KD_SPD = 8  # ... per rad/s^2 (s^2/rad)
-CP_ALPHA_W = 9  # speed filter: w += alpha * (w_raw - w)
-N_CP = 10
+from ..params import servo_duty
+from . import layout
+from .layout import (
+    ACT_BRIDGE,
+    ACT_DUTY,
+    ACT_SV_DUTY,
+    CG_DT,
+    CG_SF_NORMAL,
+    CG_SF_SLOW,
+    CG_SV_MAX,
+    CG_SV_MIN,
+    CG_SV_PERIOD,
+    CG_SV_PMAX,
+    CG_SV_PMIN,
+    CGS_FR_SW,
+    CGS_SV_DUTY,
+    CGS_SV_DUTY_OF,
+    CGS_SV_SET,
+    CP_ALPHA_W,
+    CP_KD_POS,
+    CP_KD_SPD,
+    CP_KFF,
+    CP_KI_POS,
+    CP_KI_SPD,
+    CP_KP_POS,
+    CP_KP_SPD,
+    CP_RPC,
+    CP_WMAX,
+    CS_DUTY_CMD,
+    CS_INT_POS,
+    CS_INT_SPD,
+    CS_OFFSET,
+    CS_OPEN_DUTY,
+    CS_Q_PREV,
+    CS_R_F,
+    CS_R_FD,
+    CS_R_RAW,
+    CS_W_MEAS,
+    CS_W_REF,
+    MODE_CLOSED,
+    MODE_OFF,
+    MODE_OPEN,
+)
 
-# ---- global parameters cg[CG_*] ----------------------------------------------
-CG_DT = 0  # control step (s)
-CG_SF_NORMAL = 1  # setpoint filter, normal: a11 a12 b1 a21 a22 b2 (6 values)
-CG_SF_SLOW = 7  # setpoint filter, slow (fr_sw on): same layout
-CG_SV_MIN = 13  # servo: angle range (rad) ...
-CG_SV_MAX = 14
-CG_SV_PMIN = 15  # ... the pulse widths at its ends and the PWM period (s)
-CG_SV_PMAX = 16
-CG_SV_PERIOD = 17
-N_CG = 18
-
-# ---- per-drive state cs[d, CS_*] ----------------------------------------------
-CS_R_RAW = 0  # position setpoint as given (encoder coordinates, rad)
-CS_R_F = 1  # filtered setpoint (rad)
-CS_R_FD = 2  # its derivative (rad/s)
-CS_Q_PREV = 3  # previous measured angle, for the speed estimate
-CS_W_MEAS = 4  # filtered speed estimate (rad/s)
-CS_INT_POS = 5  # outer integrator (rad/s)
-CS_INT_SPD = 6  # inner integrator (duty)
-CS_W_REF = 7  # speed setpoint (rad/s)
-CS_DUTY_CMD = 8  # duty computed this step (applied next step)
-CS_OFFSET = 9  # offset estimate of the encoder (rad)
-CS_OPEN_DUTY = 10  # duty in open-loop mode
-N_CS = 11
-
-# ---- global state cgs[CGS_*] --------------------------------------------------
-CGS_FR_SW = 0  # 1.0 while slow moves are selected (fr_sw)
-CGS_SV_SET = 1  # servo angle setpoint (rad)
-CGS_SV_DUTY = 2  # its PWM duty (0..1) ...
-CGS_SV_DUTY_OF = 3  # ... computed for this setpoint (NaN: not yet), so that it is computed once per setpoint
-N_CGS = 4
-
-# ---- outputs act[ACT_*]: what the plant (the H-bridges, the servo) receives ---
-ACT_DUTY = 0  # 3 values: PWM duty applied to each H-bridge now (-1..1)
-ACT_BRIDGE = 3  # 3 values: 1.0 while the bridge is on, 0.0 while off (the motor coasts)
-ACT_SV_DUTY = 6  # servo PWM duty (0..1)
-N_ACT = 7
-
-# ---- modes cm[d] ------------------------------------------------------------------
-MODE_OFF = 0  # controller and H-bridge off: the motor coasts (no current)
-MODE_CLOSED = 1  # cascade control
-MODE_OPEN = 2  # fixed duty (tests, experiments); duty 0 shorts the motor (brakes)
-
-# ---- one float buffer cf[CR_*, :WIDTH]: each block is a row or three ----------------
-CR_CP = 0  # 3 rows: cp
-CR_CS = 3  # 3 rows: cs
-CR_CG = 6  # cg
-CR_CGS = 7  # cgs
-CR_ACT = 8  # act
-N_CR = 9
-WIDTH = max(N_CP, N_CS, N_CG, N_CGS, N_ACT)
+# the offsets above, and the servo's formula from params.py, are frozen into the cached machine code:
+# recompile when either changes
+layout.forget_stale_compilations(__file__, servo_duty.__code__.co_filename)
 
 
 @njit(cache=True)
@@ -103,13 +94,29 @@ def _clip(x: float, lo: float, hi: float) -> float:
     return lo if x < lo else (hi if x > hi else x)
 
 
+#: ``params.servo_duty`` compiled: the servo's calibration, one definition for params.py and this step.
+servo_duty_compiled = njit(cache=True, inline="always")(servo_duty)
+
+
 @njit(cache=True)
 def servo_duty_for_angle(angle: float, cg: np.ndarray) -> float:
-    """PWM duty (0..1) that commands `angle` (clipped to the range): ``Servo.duty_for_angle`` of params.py."""
-    lo, hi = cg[CG_SV_MIN], cg[CG_SV_MAX]
-    a = _clip(angle, lo, hi)
-    frac = (a - lo) / (hi - lo)
-    return (cg[CG_SV_PMIN] + frac * (cg[CG_SV_PMAX] - cg[CG_SV_PMIN])) / cg[CG_SV_PERIOD]
+    """PWM duty (0..1) that commands `angle` (clipped to the range), with the servo's calibration in `cg`."""
+    return servo_duty_compiled(angle, cg[CG_SV_MIN], cg[CG_SV_MAX], cg[CG_SV_PMIN], cg[CG_SV_PMAX],
+                               cg[CG_SV_PERIOD])
+
+
+@njit(cache=True, inline="always")
+def setpoint_filter(row: np.ndarray, k: int, r: float, v: float, u: float) -> tuple[float, float]:
+    """One step of a second-order setpoint filter: the new angle and rate from ``(r, v)`` and the setpoint `u`.
+
+    ``row[k:k + 6]`` holds ``a11 a12 b1 a21 a22 b2`` of ``x <- A x + B u``
+    (``control.setpoint_filter_row``: the exact discretisation over one
+    control step; the Safety stage's model uses the same over a chart
+    step).  The controller step and ``app/_monitor.py`` call this one
+    definition; ``cascade.c`` is its C port.
+    """
+    return (row[k] * r + row[k + 1] * v + row[k + 2] * u,
+            row[k + 3] * r + row[k + 4] * v + row[k + 5] * u)
 
 
 @njit(cache=True, inline="always")  # inlined (numba IR): no call with arrays unpacked, see _kernel.py
@@ -124,12 +131,8 @@ def _control_drive(d: int, cp: np.ndarray, cg: np.ndarray, cs: np.ndarray, mode:
     w_meas = w_prev + cp[d, CP_ALPHA_W] * (w_raw - w_prev)
     cs[d, CS_W_MEAS] = w_meas
     # second-order setpoint filter, exact discretisation (state: angle, rate)
-    b = CG_SF_SLOW if slow else CG_SF_NORMAL
-    r = cs[d, CS_R_F]
-    v = cs[d, CS_R_FD]
-    u = cs[d, CS_R_RAW]
-    cs[d, CS_R_F] = cg[b] * r + cg[b + 1] * v + cg[b + 2] * u
-    cs[d, CS_R_FD] = cg[b + 3] * r + cg[b + 4] * v + cg[b + 5] * u
+    cs[d, CS_R_F], cs[d, CS_R_FD] = setpoint_filter(cg, CG_SF_SLOW if slow else CG_SF_NORMAL,
+                                                    cs[d, CS_R_F], cs[d, CS_R_FD], cs[d, CS_R_RAW])
 
     duty = 0.0
     if mode == MODE_CLOSED:
@@ -185,3 +188,39 @@ def cascade_step(cp: np.ndarray, cg: np.ndarray, cs: np.ndarray, cgs: np.ndarray
         cgs[CGS_SV_DUTY] = servo_duty_for_angle(sv_set, cg)
         cgs[CGS_SV_DUTY_OF] = sv_set
     act[ACT_SV_DUTY] = cgs[CGS_SV_DUTY]
+
+
+# ---- the commands between steps: plain Python, as cascade.c's ttt_cascade_* do them ------------------------
+# (CascadeController calls them with its numpy rows; nothing compiled calls them)
+
+def hold(cs: np.ndarray, d: int, q: float) -> None:
+    """Make drive d hold the encoder angle `q` (rad) with no bump: filters and integrators reset."""
+    cs[d, CS_R_RAW] = q
+    cs[d, CS_R_F] = q
+    cs[d, CS_R_FD] = 0.0
+    cs[d, CS_Q_PREV] = q
+    cs[d, CS_W_MEAS] = 0.0
+    cs[d, CS_INT_POS] = 0.0
+    cs[d, CS_INT_SPD] = 0.0
+
+
+def set_offset(cs: np.ndarray, d: int, offset: float) -> None:
+    """Set drive d's encoder offset (rad); its setpoints and speed-estimate state move with it (no jump)."""
+    shift = offset - cs[d, CS_OFFSET]
+    cs[d, CS_OFFSET] = offset
+    cs[d, CS_R_RAW] += shift
+    cs[d, CS_R_F] += shift
+    cs[d, CS_Q_PREV] += shift
+
+
+def set_mode(cs: np.ndarray, cm: np.ndarray, d: int, mode: int, hold_q: float) -> None:
+    """Switch drive d to `mode`; entering closed loop holds `hold_q` (its encoder angle now)."""
+    if mode == MODE_CLOSED and cm[d] != MODE_CLOSED:
+        hold(cs, d, hold_q)
+    cm[d] = mode
+
+
+def set_open_duty(cs: np.ndarray, cm: np.ndarray, d: int, duty: float) -> None:
+    """Drive d open loop at a fixed duty (the step clips it to -1..1)."""
+    cs[d, CS_OPEN_DUTY] = duty
+    cm[d] = MODE_OPEN

@@ -26,15 +26,16 @@ debugger.  docs/model.md derives the equations.
 
 from __future__ import annotations
 
-import hashlib
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numba import njit
 
-from . import _cascade, _plant
-from ._cascade import (
+from .. import params
+from . import _cascade, _plant, layout
+from ._cascade import cascade_step
+from ._plant import plant_step
+from .layout import (
     ACT_DUTY,
     ACT_SV_DUTY,
     CGS_SV_SET,
@@ -49,9 +50,6 @@ from ._cascade import (
     CS_R_RAW,
     CS_W_MEAS,
     CS_W_REF,
-    cascade_step,
-)
-from ._plant import (
     PGS_SV_CMD,
     PGS_SV_Q,
     PGS_T,
@@ -64,35 +62,29 @@ from ._plant import (
     PS_I,
     PS_Q,
     PS_TH,
-    plant_step,
+    REC_CURRENT,
+    REC_DUTY,
+    REC_Q_ENC,
+    REC_Q_MOTOR,
+    REC_Q_TRUE,
+    REC_R_F,
+    REC_R_RAW,
+    REC_T,
+    REC_W_MEAS,
+    REC_W_REF,
 )
-
-# ---- record buffer rec[k, REC_*], one row per control step (after it) -------
-REC_T = 0
-REC_R_RAW = 1  # 4 columns: drives 1-3, servo
-REC_R_F = 5  # 4 columns: filtered setpoints, angle the servo duty commands
-REC_Q_ENC = 9  # 3 columns
-REC_Q_TRUE = 12  # 4 columns
-REC_Q_MOTOR = 16  # 3 columns
-REC_CURRENT = 19  # 3 columns (true current)
-REC_DUTY = 22  # 4 columns: applied duty of drives 1-3, servo duty
-REC_W_REF = 26  # 3 columns
-REC_W_MEAS = 29  # 3 columns
-N_REC = 32
 
 
 def _sources_fingerprint() -> str:
-    """SHA-256 of the two steps' source files.
+    """SHA-256 of the source files the fused loop is compiled from: the two steps, their layout, the servo's formula.
 
     numba's disk cache checks only the file of the function it caches: after
-    an edit of ``_cascade.py`` or ``_plant.py`` alone it would load the fused
-    loop compiled from the old code.  Its cache key includes the contents of
-    the function's closure, so the loop closes over this fingerprint.
+    an edit of ``_cascade.py``, ``_plant.py``, ``layout.py`` or the servo's
+    calibration in ``params.py`` alone it would load the fused loop compiled
+    from the old code.  Its cache key includes the contents of the
+    function's closure, so the loop closes over this fingerprint.
     """
-    h = hashlib.sha256()
-    for module in (_cascade, _plant):
-        h.update(Path(str(module.__file__)).read_bytes())
-    return h.hexdigest()
+    return layout.fingerprint(*(str(m.__file__) for m in (_cascade, _plant, layout, params)))
 
 
 def _compile_run_steps(fingerprint: str) -> Any:
@@ -102,8 +94,8 @@ def _compile_run_steps(fingerprint: str) -> Any:
     def run_steps(n: int, cf: np.ndarray, cm: np.ndarray, pf: np.ndarray, pi: np.ndarray, rec: np.ndarray) -> None:
         """Run `n` control steps in place; fill `rec[:n]` if it has at least n rows.
 
-        `cf`: the controller's float buffer (rows ``_cascade.CR_*``), `cm`: its modes;
-        `pf`: the plant's float buffer (rows ``_plant.PR_*``), `pi`: its integer state.
+        `cf`: the controller's float buffer (rows ``layout.CR_*``), `cm`: its modes;
+        `pf`: the plant's float buffer (rows ``layout.PR_*``), `pi`: its integer state.
         """
         fingerprint  # noqa: B018  (a closure variable: part of numba's cache key)
         # the blocks are rows: slicing them costs nothing (a reshape would call into numba's runtime)

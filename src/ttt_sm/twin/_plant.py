@@ -2,7 +2,7 @@
 
 One call of :func:`plant_step` is one control step of the physical arm: it
 reads the actuator commands ``act`` (H-bridge duties and on/off flags, the
-servo's PWM duty: the layout of ``_cascade.ACT_*``) and integrates over
+servo's PWM duty: the layout ``ACT_*`` of ``layout.py``) and integrates over
 ``n_sub`` sub-steps, per DC drive: armature current (exact exponential over
 each sub-step), motor with implicit viscous and Coulomb friction (stick
 without chattering), gear clearance as a dead-zone spring with contact
@@ -18,109 +18,92 @@ Memory: per-drive parameter rows ``pp[d, PP_*]``, global parameters
 ``pgs[PGS_*]`` and per-drive integer state ``pi[d, PI_*]`` (the counters,
 index switch, hard-stop contact and the noise generator).  The ``PP_``,
 ``PG_``, ``PS_``, ``PGS_`` and ``PI_`` names are the only way code should
-index them.  The float blocks are rows of one buffer ``pf[PR_*]`` of
-:data:`WIDTH` columns.
+index them; ``twin/layout.py`` defines them.  The float blocks are rows of
+one buffer ``pf[PR_*]`` of ``layout.PLANT_WIDTH`` columns.
 docs/model.md derives the equations.
+
+Gravity on the pitch joints (:func:`gravity_torques`, :func:`gravity_slopes`)
+and the servo's calibration (``params.servo_angle``) are written once:
+the plant's Python side (``plant.py``) and the gear-play compensation
+(``app/compensation.py``) call the same functions as plain Python.
 """
 
 from __future__ import annotations
 
 import math
+from math import cos, sin
 
 import numpy as np
 from numba import njit
 
-from ._cascade import ACT_BRIDGE, ACT_DUTY, ACT_SV_DUTY
+from ..params import servo_angle
+from . import layout
+from .layout import (
+    ACT_BRIDGE,
+    ACT_DUTY,
+    ACT_SV_DUTY,
+    PG_DT,
+    PG_FB_ALPHA,
+    PG_FB_C0,
+    PG_FB_FULL,
+    PG_FB_K,
+    PG_FB_NOISE,
+    PG_GRAV2,
+    PG_GRAV23,
+    PG_H,
+    PG_I_NOISE,
+    PG_NSUB,
+    PG_SV_CLEAR,
+    PG_SV_INV_TAU,
+    PG_SV_MAX,
+    PG_SV_MIN,
+    PG_SV_PERIOD,
+    PG_SV_PMAX,
+    PG_SV_PMIN,
+    PG_SV_RATE,
+    PGS_FB_COUNTS,
+    PGS_FB_V,
+    PGS_SV_CMD,
+    PGS_SV_Q,
+    PGS_SV_TH,
+    PGS_T,
+    PI_AT_LIMIT,
+    PI_C0,
+    PI_COUNTS,
+    PI_FB_RNG,
+    PI_INDEX,
+    PI_INDEX_COUNT,
+    PI_INDEX_EDGES,
+    PI_RNG,
+    PP_CG,
+    PP_CLEAR,
+    PP_DTH_M,
+    PP_EL_AVG,
+    PP_EL_DECAY,
+    PP_FC_H,
+    PP_H_JL,
+    PP_H_JM,
+    PP_INV_N,
+    PP_INV_R,
+    PP_K,
+    PP_KT,
+    PP_QMAX,
+    PP_QMIN,
+    PP_SUPPLY,
+    PP_TH_IDX,
+    PP_VISC_L,
+    PP_VISC_M,
+    PS_I,
+    PS_I_MEAS,
+    PS_Q,
+    PS_TH,
+    PS_WM,
+    PS_WQ,
+)
 
-# ---- per-drive parameter row pp[d, PP_*] (SI units; joint = load side) ------
-PP_SUPPLY = 0  # supply voltage (V)
-PP_R = 1  # armature resistance (ohm)
-PP_KT = 2  # torque constant = back-EMF constant (N m / A = V s / rad)
-PP_JM = 3  # rotor inertia (kg m^2, motor shaft)
-PP_BM = 4  # motor viscous friction (N m s / rad)
-PP_TC = 5  # motor Coulomb (= static) friction (N m)
-PP_N = 6  # gear ratio (motor angle / joint angle)
-PP_JL = 7  # load inertia (kg m^2, joint)
-PP_BL = 8  # load viscous friction (N m s / rad)
-PP_CLEAR = 9  # total gear clearance at the joint (rad)
-PP_K = 10  # gear stiffness at the joint when engaged (N m / rad)
-PP_CG = 11  # gear contact damping at the joint (N m s / rad)
-PP_DTH_M = 12  # motor angle of one encoder count (rad)
-PP_QMIN = 13  # hard stops (joint, rad)
-PP_QMAX = 14
-PP_QIDX = 15  # index switch angle (motor-side joint angle, rad)
-PP_EL_DECAY = 16  # exp(-h R / L): current decay over one sub-step
-PP_EL_AVG = 17  # (1 - exp(-h R / L)) L / (R h): mean of that decay over the sub-step
-# derived per sub-step h, so the sub-step multiplies instead of dividing
-PP_INV_R = 18  # 1 / R
-PP_INV_N = 19  # 1 / N
-PP_H_JM = 20  # h / Jm
-PP_FC_H = 21  # h Tc / Jm: speed change Coulomb friction can stop within one sub-step
-PP_VISC_M = 22  # 1 / (1 + h Bm / Jm): implicit motor viscous friction
-PP_H_JL = 23  # h / Jl
-PP_VISC_L = 24  # 1 / (1 + h Bl / Jl)
-PP_TH_IDX = 25  # motor angle of the index switch, N * index angle
-N_PP = 26
-
-# ---- global parameters pg[PG_*] ----------------------------------------------
-PG_DT = 0  # control step (s)
-PG_NSUB = 1  # sub-steps per control step (stored as a float)
-PG_GRAV2 = 2  # g * (m2 c2 + (m3 + m_tool) L2): joint-2 gravity from sin(q2) (N m)
-PG_GRAV23 = 3  # g * (m3 c3 + m_tool L3): gravity from sin(q2 + q3) on joints 2 and 3 (N m)
-PG_SV_MIN = 4  # servo: range (rad), pulse widths and period (s), slew rate (rad/s),
-PG_SV_MAX = 5  #        lag time constant (s), gear clearance (rad)
-PG_SV_PMIN = 6
-PG_SV_PMAX = 7
-PG_SV_PERIOD = 8
-PG_SV_RATE = 9
-PG_SV_TAU = 10
-PG_SV_CLEAR = 11
-PG_I_NOISE = 12  # standard deviation of the current measurement noise (A)
-PG_SV_INV_TAU = 13  # 1 / PG_SV_TAU
-PG_H = 14  # the sub-step, PG_DT / PG_NSUB (s)
-PG_FB_K = 15  # servo feedback: ADC counts per rad of the output shaft (the calibration's slope)
-PG_FB_C0 = 16  #                 ADC counts at 0 rad
-PG_FB_NOISE = 17  #              rms noise of one reading (counts)
-PG_FB_ALPHA = 18  #              the RC filter's step over one sub-step, 1 - exp(-h / tau) (1: no filter)
-PG_FB_FULL = 19  #               the ADC's full scale, 2^bits - 1 (counts)
-N_PG = 20
-
-# ---- per-drive float state ps[d, PS_*] ----------------------------------------
-PS_I = 0  # armature current (A)
-PS_TH = 1  # motor shaft angle (rad, absolute: the encoder's edges sit at fixed angles)
-PS_WM = 2  # motor shaft speed (rad/s)
-PS_Q = 3  # load (joint) angle (rad)
-PS_WQ = 4  # load speed (rad/s)
-PS_I_MEAS = 5  # measured current (A)
-N_PS = 6
-
-# ---- global state pgs[PGS_*] ---------------------------------------------------
-PGS_T = 0  # simulated time (s)
-PGS_SV_CMD = 1  # angle the servo's PWM duty commands (rad)
-PGS_SV_TH = 2  # servo's internal (motor-side) angle (rad)
-PGS_SV_Q = 3  # servo output angle q4 after its gear clearance (rad)
-PGS_FB_V = 4  # the feedback wire after the RC filter, as the angle it stands for (rad)
-PGS_FB_COUNTS = 5  # the ADC's reading of it (integer counts, stored as a float)
-N_PGS = 6
-
-# ---- per-drive integer state pi[d, PI_*] -----------------------------------------
-PI_C0 = 0  # counter value of the motor angle at power-on (counts are relative to it)
-PI_COUNTS = 1  # encoder counts
-PI_INDEX = 2  # index switch level (1: motor-side joint angle above the switch)
-PI_INDEX_COUNT = 3  # counts latched at the last index edge
-PI_INDEX_EDGES = 4  # number of index edges seen
-PI_AT_LIMIT = 5  # -1 / +1 when the load rests on its lower / upper hard stop, else 0
-PI_RNG = 6  # state of the current-noise generator (31-bit LCG)
-PI_FB_RNG = 7  # row 0 only: state of the servo feedback's noise generator (31-bit LCG)
-N_PI = 8
-
-# ---- one float buffer pf[PR_*, :WIDTH]: each block is a row or three -----------------
-PR_PP = 0  # 3 rows: pp
-PR_PS = 3  # 3 rows: ps
-PR_PG = 6  # pg
-PR_PGS = 7  # pgs
-N_PR = 8
-WIDTH = max(N_PP, N_PS, N_PG, N_PGS)
+# the offsets above, and the servo's formula from params.py, are frozen into the cached machine code:
+# recompile when either changes
+layout.forget_stale_compilations(__file__, servo_angle.__code__.co_filename)
 
 LCG_MASK = 0x7FFFFFFF  # a 31-bit linear congruential generator (glibc's constants),
 _LCG_A = 1103515245  # exact in int64 both compiled and as plain Python; no division
@@ -240,12 +223,45 @@ def _integrate_drive(d: int, n_sub: int, h: float, tau0: float, dtau_dq: float, 
     pi[d, PI_AT_LIMIT] = lim
 
 
+#: ``params.servo_angle`` compiled: the servo's calibration, one definition for params.py and this step.
+servo_angle_compiled = njit(cache=True, inline="always")(servo_angle)
+
+
 @njit(cache=True)
 def servo_angle_for_duty(duty: float, pg: np.ndarray) -> float:
-    """Angle a PWM duty commands (the Servo.angle_for_duty of params.py)."""
-    frac = (duty * pg[PG_SV_PERIOD] - pg[PG_SV_PMIN]) / (pg[PG_SV_PMAX] - pg[PG_SV_PMIN])
-    frac = _clip(frac, 0.0, 1.0)
-    return pg[PG_SV_MIN] + frac * (pg[PG_SV_MAX] - pg[PG_SV_MIN])
+    """Angle a PWM duty commands, with the servo's calibration in `pg`."""
+    return servo_angle_compiled(duty, pg[PG_SV_MIN], pg[PG_SV_MAX], pg[PG_SV_PMIN], pg[PG_SV_PMAX],
+                                pg[PG_SV_PERIOD])
+
+
+@njit(cache=True, inline="always")
+def gravity_torques(g2: float, g23: float, q2: float, q3: float) -> tuple[float, float]:
+    """Gravity torques on joints 2 and 3 (N m) at load angles `q2`, `q3` (q = 0 hangs down).
+
+    ``g2`` and ``g23`` (N m) are ``plant.gravity_coefficients``: joint 2
+    carries link 2, link 3 and the tool, joint 3 link 3 and the tool (at
+    the end of L3).  Joint 1 turns about the vertical: none.  The plant's
+    step, ``plant.gravity_torques`` and the gear-play compensation
+    (``app/compensation.py``) all use this function.
+    """
+    t2 = g2 * sin(q2)
+    t23 = g23 * sin(q2 + q3)
+    return -t2 - t23, -t23
+
+
+@njit(cache=True, inline="always")
+def gravity_slopes(g2: float, g23: float, q2: float, q3: float) -> tuple[float, float]:
+    """``(g2 cos q2, g23 cos(q2 + q3))``: :func:`gravity_torques`' derivatives, less their signs.
+
+    d tau2 / d q2 = -(both), d tau2 / d q3 = d tau3 / d q2 = d tau3 / d q3 = -(the second).
+    """
+    return g2 * cos(q2), g23 * cos(q2 + q3)
+
+
+#: :func:`gravity_torques` as plain Python (the same source), for plain-Python callers that run every
+#: chart step (a numba call costs more in dispatch than this arithmetic); with ``NUMBA_DISABLE_JIT=1``
+#: it is :func:`gravity_torques` itself.
+gravity_torques_py = getattr(gravity_torques, "py_func", gravity_torques)
 
 
 @njit(cache=True)
@@ -284,17 +300,17 @@ def plant_step(pp: np.ndarray, pg: np.ndarray, ps: np.ndarray, pgs: np.ndarray, 
     pgs[PGS_SV_CMD] = sv_cmd
     # gravity on the pitch joints from the true load angles (q = 0 hangs
     # down), linearised about the start of the control step
-    q2, q23 = ps[1, PS_Q], ps[1, PS_Q] + ps[2, PS_Q]
+    g2, g23, q2, q3 = pg[PG_GRAV2], pg[PG_GRAV23], ps[1, PS_Q], ps[2, PS_Q]
     w2, w3 = ps[1, PS_WQ], ps[2, PS_WQ]
-    s2, c2 = pg[PG_GRAV2] * math.sin(q2), pg[PG_GRAV2] * math.cos(q2)
-    s23, c23 = pg[PG_GRAV23] * math.sin(q23), pg[PG_GRAV23] * math.cos(q23)
+    tau2, tau3 = gravity_torques(g2, g23, q2, q3)
+    c2, c23 = gravity_slopes(g2, g23, q2, q3)
     for d in range(3):  # one call site: the inlined drive is compiled once
         if d == 0:
             tau0, dtau_dq, dtau_dt = 0.0, 0.0, 0.0  # joint 1 turns about the vertical
         elif d == 1:
-            tau0, dtau_dq, dtau_dt = -s2 - s23, -c2 - c23, -c23 * w3
+            tau0, dtau_dq, dtau_dt = tau2, -c2 - c23, -c23 * w3
         else:
-            tau0, dtau_dq, dtau_dt = -s23, -c23, -c23 * w2
+            tau0, dtau_dq, dtau_dt = tau3, -c23, -c23 * w2
         _integrate_drive(d, n_sub, h, tau0, dtau_dq, dtau_dt, pp, ps, pi, act[ACT_DUTY + d],
                          act[ACT_BRIDGE + d] == 0.0)
     _integrate_servo(sv_cmd, n_sub, h, pg, pgs)

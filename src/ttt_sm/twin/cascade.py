@@ -5,7 +5,7 @@
 ``fr_sw``, a speed estimate from the encoder, an outer position PID and an
 inner speed PID with PWM saturation; and the servo's PWM.  It holds the
 controller's parameters (from the parameter file and the gains), its state
-and its outputs in the layout of ``_cascade.py`` (docs/model.md, "The
+and its outputs in the layout of ``layout.py`` (docs/model.md, "The
 controller step"), takes setpoints, offsets and modes, and runs
 ``_cascade.cascade_step``: encoder counts in, actuator commands out.  It
 never sees the plant: the simulated arm (:class:`ttt_sm.twin.sim.ArmSim`)
@@ -25,12 +25,13 @@ import numpy as np
 
 from ..params import ArmParams
 from . import _cascade as C
+from . import layout
 from ._buffers import flat_view
 from .control import Gains, check_drive, setpoint_filter_row, speed_filter_alpha
 from .errors import SimError
 
 # slots of the controllers' shared state that every chart step writes
-_FR_SW, _SV_SET = C.CGS_FR_SW, C.CGS_SV_SET
+_FR_SW, _SV_SET = layout.CGS_FR_SW, layout.CGS_SV_SET
 
 
 class CascadeController:
@@ -47,52 +48,48 @@ class CascadeController:
 
     Attributes
     ----------
-    buffer : ndarray, shape (``_cascade.N_CR``, ``_cascade.WIDTH``)
+    buffer : ndarray, shape (``layout.N_CR``, ``layout.CONTROLLER_WIDTH``)
         The controller's float memory; ``cp``, ``cs`` (3 rows each), ``cg``,
-        ``cgs`` and ``act`` are views of its rows (``_cascade.CR_*``).
+        ``cgs`` and ``act`` are views of its rows (``layout.CR_*``).
     modes : ndarray of int64, shape (3,)
         ``MODE_OFF``, ``MODE_CLOSED`` or ``MODE_OPEN`` per drive; all drives
         start closed, holding where they power on.
     """
 
     def __init__(self, params: ArmParams, gains: Gains, servo_angle: float) -> None:
-        self.buffer = np.zeros((C.N_CR, C.WIDTH))
-        self.cp, self.cs = self.buffer[C.CR_CP:C.CR_CP + 3], self.buffer[C.CR_CS:C.CR_CS + 3]
-        self.cg, self.cgs, self.act = self.buffer[C.CR_CG], self.buffer[C.CR_CGS], self.buffer[C.CR_ACT]
-        self.modes = np.full(3, C.MODE_CLOSED, dtype=np.int64)
+        self.buffer = np.zeros((layout.N_CR, layout.CONTROLLER_WIDTH))
+        self.cp, self.cs = self.buffer[layout.CR_CP:layout.CR_CP + 3], self.buffer[layout.CR_CS:layout.CR_CS + 3]
+        self.cg, self.cgs, self.act = self.buffer[layout.CR_CG], self.buffer[layout.CR_CGS], self.buffer[layout.CR_ACT]
+        self.modes = np.full(3, layout.MODE_CLOSED, dtype=np.int64)
         alpha = speed_filter_alpha(params.control)
         for d, (p, g) in enumerate(zip(params.drives, gains.drives, strict=True)):
             row = self.cp[d]
-            row[C.CP_RPC] = p.rad_per_count
-            row[C.CP_KP_POS] = g.kp_pos
-            row[C.CP_KI_POS] = g.ki_pos
-            row[C.CP_KD_POS] = g.kd_pos
-            row[C.CP_KFF] = g.kff_speed
-            row[C.CP_WMAX] = g.max_speed_rad_s
-            row[C.CP_KP_SPD] = g.kp_speed
-            row[C.CP_KI_SPD] = g.ki_speed
-            row[C.CP_KD_SPD] = g.kd_speed
-            row[C.CP_ALPHA_W] = alpha
+            row[layout.CP_RPC] = p.rad_per_count
+            row[layout.CP_KP_POS] = g.kp_pos
+            row[layout.CP_KI_POS] = g.ki_pos
+            row[layout.CP_KD_POS] = g.kd_pos
+            row[layout.CP_KFF] = g.kff_speed
+            row[layout.CP_WMAX] = g.max_speed_rad_s
+            row[layout.CP_KP_SPD] = g.kp_speed
+            row[layout.CP_KI_SPD] = g.ki_speed
+            row[layout.CP_KD_SPD] = g.kd_speed
+            row[layout.CP_ALPHA_W] = alpha
         c, s, cg = params.control, params.servo, self.cg
-        cg[C.CG_DT] = c.dt
-        cg[C.CG_SF_NORMAL:C.CG_SF_NORMAL + 6] = setpoint_filter_row(c.setpoint_cutoff_hz, c.dt)
-        cg[C.CG_SF_SLOW:C.CG_SF_SLOW + 6] = setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt)
-        cg[C.CG_SV_MIN] = s.min_rad
-        cg[C.CG_SV_MAX] = s.max_rad
-        cg[C.CG_SV_PMIN] = s.pulse_min_s
-        cg[C.CG_SV_PMAX] = s.pulse_max_s
-        cg[C.CG_SV_PERIOD] = s.period_s
-        self.cgs[C.CGS_SV_SET] = servo_angle
-        self.cgs[C.CGS_SV_DUTY_OF] = math.nan  # the first step computes the servo's duty
+        cg[layout.CG_DT] = c.dt
+        cg[layout.CG_SF_NORMAL:layout.CG_SF_NORMAL + 6] = setpoint_filter_row(c.setpoint_cutoff_hz, c.dt)
+        cg[layout.CG_SF_SLOW:layout.CG_SF_SLOW + 6] = setpoint_filter_row(c.setpoint_cutoff_slow_hz, c.dt)
+        cg[layout.CG_SV_MIN:layout.CG_SV_MIN + layout.SERVO_CALIBRATION_SIZE] = s.calibration
+        self.cgs[layout.CGS_SV_SET] = servo_angle
+        self.cgs[layout.CGS_SV_DUTY_OF] = math.nan  # the first step computes the servo's duty
         # Flat views for the per-chart-step commands: a memoryview reads and
         # writes plain Python numbers at a third of the cost of numpy indexing.
         self._csv = flat_view(self.cs)
         self._cgsv = flat_view(self.cgs)
         self._modev = flat_view(self.modes)
         # ... at flat indices worked out once (not from the layout's names on every call)
-        n = C.WIDTH
-        self._i_raw = (C.CS_R_RAW, n + C.CS_R_RAW, 2 * n + C.CS_R_RAW)
-        self._i_offset = (C.CS_OFFSET, n + C.CS_OFFSET, 2 * n + C.CS_OFFSET)
+        n = layout.CONTROLLER_WIDTH
+        self._i_raw = (layout.CS_R_RAW, n + layout.CS_R_RAW, 2 * n + layout.CS_R_RAW)
+        self._i_offset = (layout.CS_OFFSET, n + layout.CS_OFFSET, 2 * n + layout.CS_OFFSET)
 
     # ---- the step -------------------------------------------------------------
 
@@ -131,7 +128,7 @@ class CascadeController:
     @property
     def servo_setpoint(self) -> float:
         """The servo angle last commanded (rad)."""
-        return self._cgsv[C.CGS_SV_SET]
+        return self._cgsv[layout.CGS_SV_SET]
 
     def offset_estimates(self) -> tuple[float, float, float]:
         """The encoder offsets (rad), 0 until a drive is initialised."""
@@ -143,16 +140,11 @@ class CascadeController:
 
         The physical target stays where it was, so the arm does not jump.
         """
-        d = check_drive(drive) - 1
-        cs = self.cs
-        shift = float(offset_rad) - cs[d, C.CS_OFFSET]
-        cs[d, C.CS_OFFSET] = float(offset_rad)
-        for k in (C.CS_R_RAW, C.CS_R_F, C.CS_Q_PREV):
-            cs[d, k] += shift
+        C.set_offset(self.cs, check_drive(drive) - 1, float(offset_rad))
 
     def enabled(self) -> tuple[bool, bool, bool]:
         """True per drive while its cascade runs."""
-        m, on = self._modev, C.MODE_CLOSED
+        m, on = self._modev, layout.MODE_CLOSED
         return m[0] == on, m[1] == on, m[2] == on
 
     def mode(self, drive: int) -> int:
@@ -162,45 +154,33 @@ class CascadeController:
     def set_mode(self, drive: int, mode: int, hold_rad: float | None = None) -> None:
         """Switch drive `drive` to `mode`; entering closed loop holds `hold_rad` (its encoder angle), bumplessly."""
         d = check_drive(drive) - 1
-        if mode == C.MODE_CLOSED and self.modes[d] != C.MODE_CLOSED:
-            if hold_rad is None:
-                raise SimError(f"drive {drive}: closing the loop needs the angle to hold")
-            self.hold(drive, hold_rad)
-        self.modes[d] = mode
+        if mode == layout.MODE_CLOSED and self.modes[d] != layout.MODE_CLOSED and hold_rad is None:
+            raise SimError(f"drive {drive}: closing the loop needs the angle to hold")
+        C.set_mode(self.cs, self.modes, d, mode, math.nan if hold_rad is None else hold_rad)
 
     def set_open_duty(self, drive: int, duty: float) -> None:
         """Drive open loop with a fixed PWM duty (clipped to -1..1 by the step)."""
-        d = check_drive(drive) - 1
-        self.cs[d, C.CS_OPEN_DUTY] = float(duty)
-        self.modes[d] = C.MODE_OPEN
+        C.set_open_duty(self.cs, self.modes, check_drive(drive) - 1, float(duty))
 
     def hold(self, drive: int, q_rad: float) -> None:
         """Make drive `drive`'s cascade hold the encoder angle `q_rad`, with no bump: filters and integrators reset."""
-        d = check_drive(drive) - 1
-        cs = self.cs
-        cs[d, C.CS_R_RAW] = q_rad
-        cs[d, C.CS_R_F] = q_rad
-        cs[d, C.CS_R_FD] = 0.0
-        cs[d, C.CS_Q_PREV] = q_rad
-        cs[d, C.CS_W_MEAS] = 0.0
-        cs[d, C.CS_INT_POS] = 0.0
-        cs[d, C.CS_INT_SPD] = 0.0
+        C.hold(self.cs, check_drive(drive) - 1, q_rad)
 
     # ---- outputs ------------------------------------------------------------------
 
     @property
     def duty(self) -> np.ndarray:
         """PWM duties applied to the three H-bridges now (-1..1), a copy."""
-        return self.act[C.ACT_DUTY:C.ACT_DUTY + 3].copy()
+        return self.act[layout.ACT_DUTY:layout.ACT_DUTY + 3].copy()
 
     @property
     def servo_duty(self) -> float:
         """The servo's PWM duty now (0..1)."""
-        return float(self.act[C.ACT_SV_DUTY])
+        return float(self.act[layout.ACT_SV_DUTY])
 
     def max_speed(self) -> np.ndarray:
         """Speed setpoint clamps of drives 1..3 (rad/s)."""
-        return self.cp[:, C.CP_WMAX].copy()
+        return self.cp[:, layout.CP_WMAX].copy()
 
 
 __all__ = ["CascadeController"]

@@ -30,9 +30,8 @@ import numpy as np
 
 from ..arm.protocol import Sensors
 from ..params import ArmParams
-from . import _cascade as C
 from . import _kernel as K
-from . import _plant as P
+from . import layout
 from .cascade import CascadeController
 from .control import Gains
 from .errors import SimError
@@ -129,13 +128,13 @@ class ArmSim:
         self.truth = ArmTruth(params, self.plant, self.controller.act)
         self._cf, self._cm = self.controller.buffer, self.controller.modes
         self._pf, self._pi = self.plant.buffer, self.plant.ints
-        self._no_rec = np.zeros((0, K.N_REC))
+        self._no_rec = np.zeros((0, layout.N_REC))
         # plain-number views for the per-chart-step accessors
         self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
         self._intsv, self._pgsv = self.plant.intsv, self.plant.pgsv
         self._csv = self.controller._csv
-        ni = P.N_PI  # the encoder counts' flat indices, drives 1-3 (the offsets': the controller's)
-        self._i_counts = (P.PI_COUNTS, ni + P.PI_COUNTS, 2 * ni + P.PI_COUNTS)
+        ni = layout.N_PI  # the encoder counts' flat indices, drives 1-3 (the offsets': the controller's)
+        self._i_counts = (layout.PI_COUNTS, ni + layout.PI_COUNTS, 2 * ni + layout.PI_COUNTS)
         self._i_offset = self.controller._i_offset
         # set_setpoints runs every chart step: the controller's own method, bound here, spares
         # the call a delegating method would add (the method below documents it)
@@ -151,7 +150,7 @@ class ArmSim:
     @property
     def t(self) -> float:
         """Simulated time since power-on, s."""
-        return self._pgsv[P.PGS_T]
+        return self._pgsv[layout.PGS_T]
 
     def set_setpoints(self, q_des: Angles, fr_sw: bool = False) -> None:
         """Set the joint setpoints: drives 1-3 in encoder coordinates (rad), q4 the servo angle.
@@ -168,15 +167,18 @@ class ArmSim:
 
     def run(self, n: int, record: bool = True) -> Trace:
         """Advance `n` control steps and return their time series (empty if not `record`)."""
-        rec = np.zeros((n if record else 0, K.N_REC))
+        rec = np.zeros((n if record else 0, layout.N_REC))
         K.run_steps(n, self._cf, self._cm, self._pf, self._pi, rec)
         return Trace(
-            t=rec[:, K.REC_T], setpoint_raw=rec[:, K.REC_R_RAW:K.REC_R_RAW + 4],
-            setpoint_filtered=rec[:, K.REC_R_F:K.REC_R_F + 4],
-            q_encoder=rec[:, K.REC_Q_ENC:K.REC_Q_ENC + 3], q_true=rec[:, K.REC_Q_TRUE:K.REC_Q_TRUE + 4],
-            q_motor=rec[:, K.REC_Q_MOTOR:K.REC_Q_MOTOR + 3],
-            current_a=rec[:, K.REC_CURRENT:K.REC_CURRENT + 3], duty=rec[:, K.REC_DUTY:K.REC_DUTY + 4],
-            speed_ref=rec[:, K.REC_W_REF:K.REC_W_REF + 3], speed_meas=rec[:, K.REC_W_MEAS:K.REC_W_MEAS + 3],
+            t=rec[:, layout.REC_T], setpoint_raw=rec[:, layout.REC_R_RAW:layout.REC_R_RAW + 4],
+            setpoint_filtered=rec[:, layout.REC_R_F:layout.REC_R_F + 4],
+            q_encoder=rec[:, layout.REC_Q_ENC:layout.REC_Q_ENC + 3],
+            q_true=rec[:, layout.REC_Q_TRUE:layout.REC_Q_TRUE + 4],
+            q_motor=rec[:, layout.REC_Q_MOTOR:layout.REC_Q_MOTOR + 3],
+            current_a=rec[:, layout.REC_CURRENT:layout.REC_CURRENT + 3],
+            duty=rec[:, layout.REC_DUTY:layout.REC_DUTY + 4],
+            speed_ref=rec[:, layout.REC_W_REF:layout.REC_W_REF + 3],
+            speed_meas=rec[:, layout.REC_W_MEAS:layout.REC_W_MEAS + 3],
         )
 
     def run_for(self, seconds: float, record: bool = True) -> Trace:
@@ -205,15 +207,15 @@ class ArmSim:
         (the protocol's methods are what it offers).
         """
         pf, pi, cf = self._pf.reshape(-1), self._pi.reshape(-1), self._cf.reshape(-1)
-        pw, cw = P.WIDTH, C.WIDTH
+        pw, cw = layout.PLANT_WIDTH, layout.CONTROLLER_WIDTH
         a0, c0, inv_k = self.plant._fb
         return ReadingsInPlace(
             pf, pi, cf,
-            counts=tuple(d * P.N_PI + P.PI_COUNTS for d in range(3)),
-            currents=tuple((P.PR_PS + d) * pw + P.PS_I_MEAS for d in range(3)),
-            servo_counts=P.PR_PGS * pw + P.PGS_FB_COUNTS,
-            offsets=tuple((C.CR_CS + d) * cw + C.CS_OFFSET for d in range(3)),
-            servo_setpoint=C.CR_CGS * cw + C.CGS_SV_SET,
+            counts=tuple(d * layout.N_PI + layout.PI_COUNTS for d in range(3)),
+            currents=tuple((layout.PR_PS + d) * pw + layout.PS_I_MEAS for d in range(3)),
+            servo_counts=layout.PR_PGS * pw + layout.PGS_FB_COUNTS,
+            offsets=tuple((layout.CR_CS + d) * cw + layout.CS_OFFSET for d in range(3)),
+            servo_setpoint=layout.CR_CGS * cw + layout.CGS_SV_SET,
             servo_calibration=(a0, c0, inv_k))
 
     def encoder_angles(self) -> tuple[float, float, float]:
@@ -275,7 +277,7 @@ class ArmSim:
 
     def set_enabled(self, drive: int, enabled: bool) -> None:
         """Switch a drive's controller on (holding where the drive is) or off (bridge off)."""
-        mode = C.MODE_CLOSED if enabled else C.MODE_OFF
+        mode = layout.MODE_CLOSED if enabled else layout.MODE_OFF
         self.controller.set_mode(drive, mode, hold_rad=self.encoder_angles()[drive - 1] if enabled else None)
 
     def set_duty(self, drive: int, duty: float) -> None:
@@ -288,10 +290,10 @@ class ArmSim:
         Drives that were under control hold where they came to rest.
         """
         modes = self._cm.copy()
-        self._cm[:] = C.MODE_OFF
+        self._cm[:] = layout.MODE_OFF
         self.step(int(round(seconds / self.dt)))
         for d in range(3):
-            if modes[d] == C.MODE_CLOSED:
+            if modes[d] == layout.MODE_CLOSED:
                 self.controller.hold(d + 1, self.encoder_angles()[d])
             self._cm[d] = modes[d]
 

@@ -16,13 +16,12 @@ from typing import Protocol
 import numpy as np
 
 from ..params import ArmParams
-from . import _cascade as C
-from . import _plant as P
+from . import layout
 from .kinematics import fk
 from .plant import Plant
 
 # the servo's true angle in the plant's shared state (read every chart step)
-_SV_Q = P.PGS_SV_Q
+_SV_Q = layout.PGS_SV_Q
 
 
 class GroundTruth(Protocol):
@@ -60,7 +59,7 @@ class ArmTruth:
     plant : Plant
         The simulated plant.
     act : ndarray
-        The actuator commands the plant receives (``_cascade.ACT_*``), for :attr:`stalled`.
+        The actuator commands the plant receives (``layout.ACT_*``), for :attr:`stalled`.
     """
 
     def __init__(self, params: ArmParams, plant: Plant, act: np.ndarray) -> None:
@@ -69,15 +68,15 @@ class ArmTruth:
         self._act = act
         self._rpc = np.array([d.rad_per_count for d in params.drives])
         self._psv, self._pgsv = plant.psv, plant.pgsv
-        n = P.WIDTH  # the true angles' flat indices, drives 1-3
-        self._i_q = (P.PS_Q, n + P.PS_Q, 2 * n + P.PS_Q)
+        n = layout.PLANT_WIDTH  # the true angles' flat indices, drives 1-3
+        self._i_q = (layout.PS_Q, n + layout.PS_Q, 2 * n + layout.PS_Q)
 
     @property
     def q(self) -> np.ndarray:
         """True joint angles q1..q4 (rad), a copy."""
         # built from a list: np.append costs several microseconds, and this runs every chart step
         p = self._plant
-        return np.array([*p.ps[:, P.PS_Q].tolist(), float(p.pgs[P.PGS_SV_Q])])
+        return np.array([*p.ps[:, layout.PS_Q].tolist(), float(p.pgs[layout.PGS_SV_Q])])
 
     def angles(self) -> tuple[float, float, float, float]:
         """:attr:`q` as plain floats, for code that runs every chart step (the whiteboard)."""
@@ -91,39 +90,39 @@ class ArmTruth:
     @property
     def offsets(self) -> np.ndarray:
         """The encoder offsets that make an encoder angle the motor-side joint angle within half a count (rad)."""
-        return (self._plant.ints[:, P.PI_C0] + 0.5) * self._rpc
+        return (self._plant.ints[:, layout.PI_C0] + 0.5) * self._rpc
 
     @property
     def q_motor(self) -> np.ndarray:
         """True motor angles divided by the gear ratios (rad): what an ideal encoder would see."""
         p = self._plant
-        return p.ps[:, P.PS_TH] / p.pp[:, P.PP_N]
+        return p.ps[:, layout.PS_TH] / p.pp[:, layout.PP_N]
 
     @property
     def current_a(self) -> np.ndarray:
         """True armature currents (A), without the measurement noise."""
-        return self._plant.ps[:, P.PS_I].copy()
+        return self._plant.ps[:, layout.PS_I].copy()
 
     @property
     def speed_motor(self) -> np.ndarray:
         """True motor shaft speeds (rad/s)."""
-        return self._plant.ps[:, P.PS_WM].copy()
+        return self._plant.ps[:, layout.PS_WM].copy()
 
     @property
     def speed_load(self) -> np.ndarray:
         """True load (joint) speeds of drives 1..3 (rad/s)."""
-        return self._plant.ps[:, P.PS_WQ].copy()
+        return self._plant.ps[:, layout.PS_WQ].copy()
 
     @property
     def at_limit(self) -> np.ndarray:
         """True per drive while its load rests on a hard stop."""
-        return self._plant.ints[:, P.PI_AT_LIMIT] != 0
+        return self._plant.ints[:, layout.PI_AT_LIMIT] != 0
 
     @property
     def stalled(self) -> np.ndarray:
         """True per drive while the bridge drives it (|duty| > 0.1) but the motor stands still."""
-        duty = self._act[C.ACT_DUTY:C.ACT_DUTY + 3]
-        return (np.abs(duty) > 0.1) & (self._plant.ps[:, P.PS_WM] == 0.0)
+        duty = self._act[layout.ACT_DUTY:layout.ACT_DUTY + 3]
+        return (np.abs(duty) > 0.1) & (self._plant.ps[:, layout.PS_WM] == 0.0)
 
     def mechanical_energy(self) -> float:
         """Kinetic energy of rotors and loads + gravity and gear-spring potential of drives 1..3, J.
@@ -132,13 +131,14 @@ class ArmTruth:
         off, friction can only take energy out: a check of the integrator.
         """
         ps, pp, pg = self._plant.ps, self._plant.pp, self._plant.pg
-        kinetic = 0.5 * float(np.sum(pp[:, P.PP_JM] * ps[:, P.PS_WM] ** 2 + pp[:, P.PP_JL] * ps[:, P.PS_WQ] ** 2))
-        g2, g23 = float(pg[P.PG_GRAV2]), float(pg[P.PG_GRAV23])
-        q2, q3 = float(ps[1, P.PS_Q]), float(ps[2, P.PS_Q])
+        kinetic = 0.5 * float(np.sum(pp[:, layout.PP_JM] * ps[:, layout.PS_WM] ** 2
+                                     + pp[:, layout.PP_JL] * ps[:, layout.PS_WQ] ** 2))
+        g2, g23 = float(pg[layout.PG_GRAV2]), float(pg[layout.PG_GRAV23])
+        q2, q3 = float(ps[1, layout.PS_Q]), float(ps[2, layout.PS_Q])
         gravity = g2 * (1.0 - math.cos(q2)) + g23 * (1.0 - math.cos(q2 + q3))
-        delta = ps[:, P.PS_TH] / pp[:, P.PP_N] - ps[:, P.PS_Q]
-        squeeze = np.maximum(np.abs(delta) - 0.5 * pp[:, P.PP_CLEAR], 0.0)
-        spring = 0.5 * float(np.sum(pp[:, P.PP_K] * squeeze**2))
+        delta = ps[:, layout.PS_TH] / pp[:, layout.PP_N] - ps[:, layout.PS_Q]
+        squeeze = np.maximum(np.abs(delta) - 0.5 * pp[:, layout.PP_CLEAR], 0.0)
+        spring = 0.5 * float(np.sum(pp[:, layout.PP_K] * squeeze**2))
         return kinetic + gravity + spring
 
 

@@ -6,7 +6,7 @@ TTT := .venv/bin/ttt-sm
 JOBS ?= auto
 PYTEST := $(PY) -m pytest -q -n $(JOBS) --maxprocesses 4 --dist worksteal
 
-.PHONY: setup play test gui screenshots soak fuzz lint bench tune firmware clean
+.PHONY: setup play test gui screenshots soak fuzz lint bench tune firmware docs clean
 
 setup:
 	@sh scripts/setup.sh
@@ -32,8 +32,13 @@ fuzz: setup
 	TTT_SM_FUZZ_RANDOM=1 $(PYTEST) -m soak -k fuzz
 
 lint: setup
-	.venv/bin/ruff check src tests
+	.venv/bin/ruff check src tests tools
 	.venv/bin/mypy
+
+# Every generated file of the repository: charts/, docs/architecture.md, the firmware's layout.h
+# (tools/docs.py, a development tool: not in the installed package).  `make docs CHECK=1` only checks.
+docs: setup
+	$(PY) -m tools.docs $(if $(CHECK),check,export)
 
 bench: setup
 	$(TTT) bench

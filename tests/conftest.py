@@ -11,6 +11,14 @@ with SIGINT, and a process that ignores it would never stop.
 """
 
 import signal
+import sys
+from pathlib import Path
+
+# The repository's development tools (tools/: the layering checker, docs/architecture.md's generator)
+# are not installed with the package: the tests import them from the checkout.
+_ROOT = str(Path(__file__).resolve().parents[1])
+if _ROOT not in sys.path:
+    sys.path.insert(0, _ROOT)
 
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)

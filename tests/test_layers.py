@@ -1,4 +1,4 @@
-"""The layers hold: who may import whom (ttt_sm.architecture.layers.CONTRACT), and no import circles.
+"""The layers hold: who may import whom (tools.architecture.layers.CONTRACT), and no import circles.
 
 The checker reads the source with ``ast``; the second half of this file
 points it at a copy of the package with one wrong import put in, to show
@@ -11,8 +11,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-
-from ttt_sm.architecture.layers import CONTRACT, SOURCE_ROOT, allowed, check, component_of, scan
+from tools.architecture.layers import CONTRACT, SOURCE_ROOT, allowed, check, component_of, scan
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""docs/architecture.md is generated from the code (`ttt-sm docs export`): a test fails when it is stale."""
+"""docs/architecture.md is generated from the code (`make docs`): a test fails when it is stale."""
 
 from __future__ import annotations
 
@@ -6,20 +6,21 @@ import json
 import re
 from pathlib import Path
 
-from ttt_sm.architecture import document
-from ttt_sm.architecture.layers import CONTRACT
-from ttt_sm.cli import main
+from tools.architecture import document
+from tools.architecture.layers import CONTRACT
+from tools.docs import main as docs_main
+
 from ttt_sm.runtime.export import svg_dot_sha256
 
 REPO = Path(__file__).resolve().parents[2]
 
 
 def test_the_architecture_page_is_up_to_date():
-    assert document.stale(REPO) == [], "regenerate with `ttt-sm docs export` (from the repository's root)"
+    assert document.stale(REPO) == [], "regenerate with `make docs` (from the repository's root)"
 
 
 def test_docs_check_covers_charts_and_the_page(capsys):
-    assert main(["docs", "check", "--root", str(REPO), "--json"]) == 0
+    assert docs_main(["check", "--root", str(REPO), "--json"]) == 0
     assert json.loads(capsys.readouterr().out) == {"root": str(REPO), "stale": [], "ok": True}
 
 
@@ -55,6 +56,6 @@ def test_a_section_added_to_the_list_appears_on_the_page(monkeypatch):
 
 
 def test_docs_check_outside_the_repository_is_one_line(tmp_path, capsys):
-    assert main(["docs", "check", "--root", str(tmp_path)]) == 2
+    assert docs_main(["check", "--root", str(tmp_path)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("ttt-sm docs: error: ") and "no src/ttt_sm there" in err and err.count("\n") == 1
+    assert err.startswith("tools.docs: error: ") and "no src/ttt_sm there" in err and err.count("\n") == 1

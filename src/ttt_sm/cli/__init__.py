@@ -17,8 +17,11 @@ strict JSON output); each other module adds its subcommands with a
 ``ttt-sm --help`` shows them:
 
 - :mod:`.commands`: play, demo, draw, tune, bench, ik, init, charts, params;
-- :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.arm`, :mod:`.vision`, :mod:`.ai`,
-  :mod:`.docs`: the command of that name.
+- :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.arm`, :mod:`.vision`, :mod:`.ai`:
+  the command of that name.
+
+(Regenerating the repository's generated files is a development tool, ``make docs``
+(``python -m tools.docs``), not a command of the installed package.)
 
 The subcommand modules import only :mod:`.common` from this package, never
 this module, and nothing below the CLI imports the CLI.
@@ -35,11 +38,11 @@ from collections.abc import Sequence
 
 from ..params import shown_path
 from ..runtime.recordfile import interruption
-from . import ai, arm, camera, commands, debug, docs, gui, scenario, vision
+from . import ai, arm, camera, commands, debug, gui, scenario, vision
 from .common import join_negative_values, terminate_interrupts
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
-SUBCOMMANDS = (commands, scenario, debug, gui, camera, arm, vision, ai, docs)
+SUBCOMMANDS = (commands, scenario, debug, gui, camera, arm, vision, ai)
 
 
 def build_parser() -> argparse.ArgumentParser:

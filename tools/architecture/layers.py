@@ -11,7 +11,7 @@ every ``import`` statement in the source counts, wherever it stands.
 tree with :mod:`ast` (nothing is imported or run); :func:`check` returns
 every import that breaks the contract and every circle, each named by file
 and line.  ``tests/test_layers.py`` runs it on the package, and
-``docs/architecture.md`` (``ttt-sm docs export``) draws it.
+``docs/architecture.md`` (``make docs``) draws it.
 
 Why a checker of our own rather than import-linter: the contract needs
 three things at once, tiers, per-component ``only`` lists and module-level
@@ -28,8 +28,10 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import ttt_sm
+
 ROOT_PACKAGE = "ttt_sm"
-SOURCE_ROOT = Path(__file__).resolve().parents[1]
+SOURCE_ROOT = Path(ttt_sm.__file__).resolve().parent
 """The ``ttt_sm`` package folder this module was loaded from."""
 
 
@@ -87,8 +89,7 @@ CONTRACT: tuple[Component, ...] = (
     Component("bench", 6, ("ttt_sm.bench",), "the speed and quality targets",
               only=("package", "runtime", "params", "arm", "charts", "twin", "game", "seriallink", "vision", "sched",
                     "hardware",
-                    "vision staging", "app", "debug", "scenario", "architecture", "web")),
-    Component("architecture", 4, ("ttt_sm.architecture",), "this contract, its checker, docs/architecture.md"),
+                    "vision staging", "app", "debug", "scenario", "web")),
     Component("cli common", 4, ("ttt_sm.cli.common",), "the CLI's one-line error, options and strict JSON output",
               only=("runtime",)),
     Component("cli", 7, ("ttt_sm.cli",), "ttt-sm: parse, call, print; one module per command group"),

@@ -3,5 +3,7 @@
 - :mod:`.layers`: the contract (components in tiers, who may import whom,
   no import circles) and its checker, an :mod:`ast` scan of the source;
 - :mod:`.document`: ``docs/architecture.md``, generated from the code
-  (``ttt-sm docs export``; a test fails when it is stale).
+  (``make docs``; a test fails when it is stale).
+
+A development tool of the repository: not in the installed package.
 """

@@ -84,6 +84,8 @@ def annotate(svg: str, chart_name: str, structure: ChartStructure) -> str:
     """
     document = minidom.parseString(svg)
     root = document.documentElement
+    if root is None or root.tagName != "svg":
+        raise ValueError("Graphviz drew no <svg> element")
     marker = Marker(chart_name, structure)
     for group in root.getElementsByTagName("g"):
         kind, ident = group.getAttribute("class"), group.getAttribute("id")
@@ -92,8 +94,9 @@ def annotate(svg: str, chart_name: str, structure: ChartStructure) -> str:
                 group.setAttribute(name, value)
     for link in root.getElementsByTagName("a"):
         parent = link.parentNode
-        while link.firstChild is not None:
-            parent.insertBefore(link.firstChild, link)
+        assert isinstance(parent, minidom.Element)  # an <a> below the <svg> element
+        while (child := link.firstChild) is not None:
+            parent.insertBefore(child, link)
         parent.removeChild(link)
     text = root.toxml()
     document.unlink()

@@ -30,3 +30,17 @@ export function cell(text, cls) {
   if (cls) td.className = cls;
   return td;
 }
+
+// Whether `el` shows something other than `value` (compared as JSON with its data-key), noting `value` as
+// what it shows: a list is drawn again only when what it lists has changed.
+export function showsOther(el, value) {
+  const key = JSON.stringify(value);
+  if (el.dataset.key === key) return false;
+  el.dataset.key = key;
+  return true;
+}
+
+// Replace the options of a <select> by `options`, [value, text] pairs.
+export function fillSelect(select, options) {
+  select.replaceChildren(...options.map(([value, text]) => new Option(text, value)));
+}

@@ -2,7 +2,7 @@
 // one: a condition, an event, or a spec as `ttt-sm debug` writes it.  A click on the diagram adds
 // one too (diagram.js).
 
-import { $, button, role } from "../dom.js";
+import { $, button, fillSelect, role, showsOther } from "../dom.js";
 
 export class Breakpoints {
   constructor(link) {
@@ -30,11 +30,8 @@ export class Breakpoints {
 
   // The events a breakpoint may wait for: every chart's tick and events (the session's charts).
   describe(charts) {
-    const opts = [];
-    for (const c of charts) {
-      for (const e of ["tick", ...c.events]) opts.push(`${c.name}.${e}`);
-    }
-    $('select[name="event"]', role("event-break-form")).replaceChildren(...opts.map((v) => new Option(v, v)));
+    const events = charts.flatMap((c) => ["tick", ...c.events].map((e) => `${c.name}.${e}`));
+    fillSelect($('select[name="event"]', role("event-break-form")), events.map((v) => [v, v]));
   }
 
   take(f) {
@@ -44,9 +41,7 @@ export class Breakpoints {
 
   draw() {
     const list = role("breakpoints");
-    const key = JSON.stringify(this.list);
-    if (list.dataset.key === key) return;
-    list.dataset.key = key;
+    if (!showsOther(list, this.list)) return;
     list.replaceChildren();
     for (const bp of this.list) {
       const li = document.createElement("li");

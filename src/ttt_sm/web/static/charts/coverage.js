@@ -1,7 +1,7 @@
 // Coverage on the diagram: the states entered and the transitions taken by scenario runs (green),
 // and what they never reached (red), from scenario files run by the session or a report loaded.
 
-import { $$, role } from "../dom.js";
+import { $$, fillSelect, role } from "../dom.js";
 
 export class CoverageView {
   constructor(link, say) {
@@ -37,7 +37,7 @@ export class CoverageView {
 
   // The scenario files the session may run (its "session" message).
   describe(scenarios) {
-    role("coverage-form").files.replaceChildren(...scenarios.map((f) => new Option(f, f)));
+    fillSelect(role("coverage-form").files, scenarios.map((f) => [f, f]));
   }
 
   show(chart) {

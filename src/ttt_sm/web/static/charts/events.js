@@ -1,7 +1,7 @@
 // Events posted to a chart from the page, and the list of the user's actions (inputs set, events
 // posted; the session keeps them all, a replay applies them again).
 
-import { $, role } from "../dom.js";
+import { $, fillSelect, role, showsOther } from "../dom.js";
 
 export class Events {
   constructor(link) {
@@ -22,11 +22,8 @@ export class Events {
 
   // The events a page may post: every chart's (the session's charts).
   describe(charts) {
-    const opts = [];
-    for (const c of charts) {
-      for (const e of c.events) opts.push([`${c.name}.${e}`, `${c.name} ${e}`]);
-    }
-    $('select[name="event"]', role("post-form")).replaceChildren(...opts.map(([v, t]) => new Option(t, v)));
+    const events = charts.flatMap((c) => c.events.map((e) => [`${c.name}.${e}`, `${c.name} ${e}`]));
+    fillSelect($('select[name="event"]', role("post-form")), events);
   }
 
   take(f) {
@@ -36,9 +33,7 @@ export class Events {
 
   draw() {
     const list = role("actions");
-    const key = JSON.stringify(this.actions);
-    if (list.dataset.key === key) return;
-    list.dataset.key = key;
+    if (!showsOther(list, this.actions)) return;
     list.replaceChildren(...this.actions.slice(-8).map((a) => {
       const li = document.createElement("li");
       li.textContent = a;

@@ -9,7 +9,8 @@ from ttt_sm.debug.shell import DebugShell
 from ttt_sm.params import load_params
 from ttt_sm.runtime.listeners import Trace
 from ttt_sm.runtime.recordfile import read_lines
-from ttt_sm.web.session import ACTIONS_SHOWN, Session
+from ttt_sm.web.frames import ACTIONS_SHOWN
+from ttt_sm.web.session import Session
 
 P = load_params()
 
@@ -46,6 +47,6 @@ def test_a_frame_lists_the_newest_actions_only() -> None:
     session = Session(Debugger.build(P, seed=0), speed=None, running=False)
     for k in range(ACTIONS_SHOWN + 10):
         session.debugger.set_input("DriveInit1", "stop", "1" if k % 2 else "0")
-    frame = session._frame(full=True)
+    frame = session.frames.state(stop=None)  # what a frame carries
     assert len(session.debugger.actions) == ACTIONS_SHOWN + 10  # all kept: a replay re-applies them
     assert frame["actions"] == [a.describe() for a in session.debugger.actions[-ACTIONS_SHOWN:]]

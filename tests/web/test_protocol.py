@@ -8,9 +8,11 @@ do what ``ttt-sm debug`` does.
 
 from __future__ import annotations
 
+import inspect
 import json
 import random
 import time
+import types
 from collections.abc import Iterator
 from typing import Any
 
@@ -20,6 +22,9 @@ from starlette.websockets import WebSocketDisconnect
 
 from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params
+from ttt_sm.web.commands import SPECS
+from ttt_sm.web.commands.spec import collect, command
+from ttt_sm.web.fields import integer
 from ttt_sm.web.protocol import COMMANDS, ProtocolError, parse_command
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
@@ -126,6 +131,25 @@ def test_every_command_with_its_defaults_is_accepted() -> None:
 def test_a_message_too_long_is_refused_before_it_is_read() -> None:
     with pytest.raises(ProtocolError, match="at most"):
         parse_command('{"type": "break", "spec": "' + "x" * 600_000 + '"}')
+
+
+def test_each_command_is_declared_once_beside_its_handler() -> None:
+    """The protocol's fields are the handlers' declarations; a handler takes exactly the fields declared."""
+    assert {kind: dict(fields) for kind, fields in COMMANDS.items()} == \
+        {kind: dict(spec.fields) for kind, spec in SPECS.items()}
+    for kind, spec in SPECS.items():
+        assert spec.type == kind and (spec.handler.__doc__ or "").strip(), kind
+        assert list(inspect.signature(spec.handler).parameters)[2:] == list(spec.fields), kind
+    assert [k for k, s in SPECS.items() if not s.queued] == ["ack"]  # noted in the server's thread, not queued
+
+
+def test_a_handler_that_does_not_take_its_declared_fields_is_refused_when_declared() -> None:
+    def step(session: Any, cid: int, count: int) -> None:
+        """Steps."""
+    with pytest.raises(TypeError, match="command 'step': .*step takes count after .*declared fields are n"):
+        command("step", n=integer(1, 5))(step)
+    with pytest.raises(TypeError, match="declared twice"):
+        collect([types.SimpleNamespace(a=SPECS["run"]), types.SimpleNamespace(b=SPECS["run"])])  # type: ignore[list-item]
 
 
 # -- the session through the WebSocket --------------------------------------------------------------
@@ -349,9 +373,9 @@ class _TimedSession(Session):
 
     published: list[float]
 
-    def _publish(self) -> None:
+    def publish(self) -> None:
         self.published.append(time.perf_counter())
-        super()._publish()
+        super().publish()
 
 
 def test_frames_are_throttled_and_carry_every_transition_since_the_last() -> None:

@@ -8,11 +8,17 @@ names charts by class, states by id and transitions by their stable label
 chart names, state ids and transition indices, the numbers its diagram edges
 carry, and refuses a report that names a state or transition the charts do not
 have (a report of other charts, or of an older version of them).
+
+:class:`CoverageRuns` runs the scenarios a page asks for on a worker thread of
+its own, one run at a time, beside the simulation (a run takes seconds), and
+keeps the colouring the pages show.
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +29,8 @@ from ..scenario.loader import load_scenario, load_scenario_text
 from ..scenario.model import Scenario
 from ..scenario.runner import ScenarioResult
 from ..scenario.suite import coverage_dict, run_scenarios
+
+log = logging.getLogger(__name__)
 
 
 class CoverageError(ValueError):
@@ -128,3 +136,68 @@ def scenario_dir_files(folder: Path | None) -> dict[str, Path]:
     if folder is None or not folder.is_dir():
         return {}
     return {p.name: p for p in sorted(folder.glob("*.yaml"))}
+
+
+class CoverageRuns:
+    """A session's coverage: scenario runs on a worker thread, one at a time, and the colouring its pages show.
+
+    Parameters
+    ----------
+    params, charts
+        The session's parameters and chart classes (the scenarios run on robots of their own).
+    scenarios : mapping of name to Path
+        Scenario files the pages may run.
+    send_to, broadcast
+        ``send_to(cid, message)``: to one page; ``broadcast(message)``: to every page that joined.
+    """
+
+    def __init__(self, params: ArmParams, charts: Mapping[str, type[TickChart]], scenarios: Mapping[str, Path],
+                 send_to: Callable[[int, dict[str, Any]], None],
+                 broadcast: Callable[[dict[str, Any]], None]) -> None:
+        self.params = params
+        self.charts = charts
+        self.scenarios = dict(scenarios)
+        #: The colouring shown (a ``coverage`` message's fields), or None.
+        self.shown: dict[str, Any] | None = None
+        self._send_to = send_to
+        self._broadcast = broadcast
+        self._busy = False
+        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ttt-sm-coverage")
+
+    def start(self, cid: int, cmd: str, job: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+        """Run ``job`` (scenarios, for their colouring) on the worker; its end is sent to every page, or its
+        error to page ``cid``.  The reply to command ``cmd`` now."""
+        if self._busy:
+            raise CoverageError("scenarios are running already; wait for their coverage")
+        self._busy = True
+
+        def work() -> None:
+            try:
+                result = job()
+            except (CoverageError, ValueError) as exc:
+                self._send_to(cid, {"type": "error", "id": None, "command": cmd, "error": f"{cmd}: {exc}"})
+            except Exception as exc:  # a scenario run that broke: say so, keep the session
+                log.exception("coverage run failed")
+                self._send_to(cid, {"type": "error", "id": None, "command": cmd,
+                                    "error": f"{cmd}: {type(exc).__name__}: {exc}"})
+            else:
+                self.show(result)
+            finally:
+                self._busy = False
+
+        self._worker.submit(work)
+        return {"text": "running the scenarios; the diagrams are coloured when they are done"}
+
+    def show(self, colouring: dict[str, Any]) -> None:
+        """Colour every page's diagrams (and those of a page that joins later)."""
+        self.shown = colouring
+        self._broadcast({"type": "coverage", **colouring})
+
+    def clear(self) -> None:
+        """Colour no coverage."""
+        self.shown = None
+        self._broadcast({"type": "coverage", "charts": {}, "ignored": [], "cleared": True})
+
+    def close(self) -> None:
+        """Stop the worker; a run under way is left to end on its own, one waiting is dropped."""
+        self._worker.shutdown(wait=False, cancel_futures=True)

@@ -16,17 +16,17 @@ and get what a page, a test and a screen reader need:
   the picture that draws it;
 * all of them ``role="button"``, ``tabindex="0"`` and an ``aria-label``.
 
-Graphviz writes a ``-`` in an id as ``&#45;``; the links Graphviz draws for
-closed sub-charts and stubs (to the ``charts/`` files) are dropped: in the
-cockpit a click opens the picture in place.
+The ids are read with an XML parser (Graphviz writes a ``-`` in an id as
+``&#45;``); the links Graphviz draws for closed sub-charts and stubs (to the
+``charts/`` files) are dropped, their contents kept: in the cockpit a click
+opens the picture in place.
 """
 
 from __future__ import annotations
 
-import html
-import re
 import threading
 from collections import OrderedDict
+from xml.dom import minidom
 
 from ..runtime import TickChart
 from ..runtime.dot import WHOLE, View, overview_with, subcharts, to_dot
@@ -34,8 +34,8 @@ from ..runtime.export import svg_from_dot
 from ..runtime.structure import ChartStructure
 from .catalogue import qualified_names, transition_name
 
-_GROUP = re.compile(r'<g id="([^"]+)" class="(node|cluster|edge)">')
-_LINK_OPEN = re.compile(r'<a xlink:href="[^"]*"(?: xlink:title="[^"]*")?>')
+#: The Graphviz classes of the groups that draw a state or a transition.
+_KINDS = ("node", "cluster", "edge")
 #: Pictures kept per session (a few hundred kB each at most).
 CACHE_SIZE = 64
 
@@ -75,41 +75,66 @@ def _picture_key(structure: ChartStructure, state_id: str) -> str:
 
 
 def annotate(svg: str, chart_name: str, structure: ChartStructure) -> str:
-    """Add the cockpit's data attributes to the SVG Graphviz drew (see the module's docstring)."""
-    qnames = qualified_names(chart_name, structure)
-    compound = {s.id for s in structure.states if s.is_compound}
-    names = {t.index: transition_name(chart_name, t.source, t.target) for t in structure.transitions}
+    """Add the cockpit's data attributes to the SVG Graphviz drew (see the module's docstring).
 
-    def tag(match: re.Match[str]) -> str:
-        raw, kind = match.group(1), match.group(2)
-        ident = html.unescape(raw)
-        attrs: list[tuple[str, str]] = []
+    The SVG is read and written as an XML document (:mod:`xml.dom.minidom`:
+    its namespaces, comments and every element kept, but the ``<a>`` links,
+    whose children take their place); what comes back is the ``<svg>`` element
+    alone, without the XML declaration and the doctype, as a page puts it inline.
+    """
+    document = minidom.parseString(svg)
+    root = document.documentElement
+    if root is None or root.tagName != "svg":
+        raise ValueError("Graphviz drew no <svg> element")
+    marker = Marker(chart_name, structure)
+    for group in root.getElementsByTagName("g"):
+        kind, ident = group.getAttribute("class"), group.getAttribute("id")
+        if kind in _KINDS and ident:
+            for name, value in marker.attributes(kind, ident).items():
+                group.setAttribute(name, value)
+    for link in root.getElementsByTagName("a"):
+        parent = link.parentNode
+        assert isinstance(parent, minidom.Element)  # an <a> below the <svg> element
+        while (child := link.firstChild) is not None:
+            parent.insertBefore(child, link)
+        parent.removeChild(link)
+    text = root.toxml()
+    document.unlink()
+    return text
+
+
+class Marker:
+    """The data attributes of one chart's picture, element by element, from its stable ids."""
+
+    def __init__(self, chart_name: str, structure: ChartStructure) -> None:
+        self.structure = structure
+        self.qnames = qualified_names(chart_name, structure)
+        self.compound = {s.id for s in structure.states if s.is_compound}
+        self.names = {t.index: transition_name(chart_name, t.source, t.target) for t in structure.transitions}
+
+    def attributes(self, kind: str, ident: str) -> dict[str, str]:
+        """What an element Graphviz drew as ``kind`` (node, cluster, edge) with id ``ident`` gets, if anything."""
+        qnames = self.qnames
         if ident.startswith("state-") and ident[6:] in qnames:
             sid = ident[6:]
-            attrs = [("data-state", qnames[sid]), ("data-state-id", sid), ("data-active", "false")]
-            if kind == "node" and sid in compound:
-                attrs.append(("data-subchart", sid))
-            attrs += [("role", "button"), ("tabindex", "0"), ("aria-label", f"state {qnames[sid]}")]
-        elif ident.startswith("stub-") and ident[5:] in qnames:
+            attrs = {"data-state": qnames[sid], "data-state-id": sid, "data-active": "false"}
+            if kind == "node" and sid in self.compound:
+                attrs["data-subchart"] = sid
+            return {**attrs, "role": "button", "tabindex": "0", "aria-label": f"state {qnames[sid]}"}
+        if ident.startswith("stub-") and ident[5:] in qnames:
             sid = ident[5:]
-            attrs = [("data-stub", qnames[sid]), ("data-view", _picture_key(structure, sid)),
-                     ("role", "button"), ("tabindex", "0"),
-                     ("aria-label", f"state {qnames[sid]}, drawn in another picture: open it")]
-        elif ident.startswith("tr-"):
+            return {"data-stub": qnames[sid], "data-view": _picture_key(self.structure, sid),
+                    "role": "button", "tabindex": "0",
+                    "aria-label": f"state {qnames[sid]}, drawn in another picture: open it"}
+        if ident.startswith("tr-"):
             indices = [int(p) for p in ident[3:].split("-") if p.isdigit()]
-            transitions = [n for n in (names.get(i) for i in indices) if n]
+            transitions = [n for n in (self.names.get(i) for i in indices) if n]
             if transitions:
-                attrs = [("data-transition", " ".join(dict.fromkeys(transitions))),
-                         ("data-index", " ".join(str(i) for i in indices)), ("data-taken-count", "0"),
-                         ("role", "button"), ("tabindex", "0"),
-                         ("aria-label", "transition " + ", ".join(dict.fromkeys(transitions)))]
-        extra = "".join(f' {k}="{html.escape(v, quote=True)}"' for k, v in attrs)
-        return f'<g id="{raw}" class="{kind}"{extra}>'
-
-    svg = _GROUP.sub(tag, svg)
-    svg = _LINK_OPEN.sub("", svg).replace("</a>", "")
-    # The <svg> element sizes itself from its viewBox in the page.
-    return svg[svg.find("<svg"):] if "<svg" in svg else svg
+                return {"data-transition": " ".join(dict.fromkeys(transitions)),
+                        "data-index": " ".join(str(i) for i in indices), "data-taken-count": "0",
+                        "role": "button", "tabindex": "0",
+                        "aria-label": "transition " + ", ".join(dict.fromkeys(transitions))}
+        return {}
 
 
 class Diagrams:

@@ -1,10 +1,11 @@
 """The Tic-tac-toe page (``/game``, thesis section 3.7, fig. 3.35) over the session's game.
 
 The page is a view of the same :class:`~.session.Session` as the chart cockpit:
-its buttons are commands of :mod:`.protocol` (``game_symbol``, ``game_cell``,
-``game_play``, ``game_stop``; Run is the session's ``run``), handled here in
-the simulation thread between two control steps, and what it draws comes in
-each frame's ``game`` part (:func:`game_view`), sent when it changed.
+its buttons are commands (``game_symbol``, ``game_cell``, ``game_play``,
+``game_stop``, ``game_engine``, ``game_new``; Run is the session's ``run``),
+declared and handled in :mod:`.commands.game`, in the simulation thread between
+two control steps, and what it draws comes in each frame's ``game`` part
+(:func:`game_view`), sent when it changed.
 
 A click on a cell is the person's move: the simulated hand draws the person's
 symbol on the simulated whiteboard (:meth:`GameSession.person_draws`); Play
@@ -19,8 +20,6 @@ page asks for the picture again when that number changes.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import replace
 from typing import Any
 
 import cv2
@@ -36,7 +35,6 @@ from ..charts.game import (
     RESULT_MESSAGES,
 )
 from ..debug.debugger import Debugger
-from ..debug.replay import GameRecipe
 
 #: Person messages a frame carries at most (the newest).
 MESSAGES_SHOWN = 8
@@ -109,79 +107,3 @@ def photo_png(debugger: Debugger) -> bytes | None:
     if not ok:
         raise RuntimeError("OpenCV could not encode the camera's photo as PNG")
     return bytes(data)
-
-
-def _game(debugger: Debugger, command: str) -> GameSession:
-    game = game_of_debugger(debugger)
-    if game is None:
-        raise ValueError(f"{command}: this session plays no game (start it with `ttt-sm gui --game`)")
-    if not game.remote:
-        raise ValueError(f"{command}: a simulated person plays this game; start `ttt-sm gui --game`"
-                         " with --person page to play it in the page")
-    return game
-
-
-def cmd_game_symbol(debugger: Debugger, symbol: str) -> dict[str, Any]:
-    """Symbol: the manipulator plays ``symbol`` (before the first move only)."""
-    game = _game(debugger, "game_symbol")
-    debugger.game_input("symbol", symbol=symbol)
-    return {"text": f"the manipulator plays {game.robot_symbol}, you play {game.person_symbol}"}
-
-
-def cmd_game_engine(debugger: Debugger, engine: str) -> dict[str, Any]:
-    """The engine: the manipulator's game algorithm, strong or the thesis' (before the first move only)."""
-    _game(debugger, "game_engine")
-    debugger.game_input("engine", engine=engine)
-    return {"text": f"the manipulator plays with the {ENGINES[engine]}"}
-
-
-def cmd_game_cell(debugger: Debugger, row: int, column: int) -> dict[str, Any]:
-    """A click on a cell: the simulated hand draws the person's symbol there."""
-    game = _game(debugger, "game_cell")
-    debugger.game_input("cell", row=row, column=column)
-    return {"text": f"you drew {game.person_symbol} in row {row}, column {column}; click Play when you are done"}
-
-
-def cmd_game_play(debugger: Debugger) -> dict[str, Any]:
-    """Play: the manipulator's move (the AlgorithmActivator's trigger, pulled by the game's flow)."""
-    game = _game(debugger, "game_play")
-    debugger.game_input("play")
-    return {"text": "Play: the camera looks at the board" if game.awaiting == "draw" else "Play: the manipulator moves"}
-
-
-def cmd_game_stop(debugger: Debugger) -> dict[str, Any]:
-    """Stop (the thesis' Stop_sim): the Game chart turns the arm off; it returns to its start pose."""
-    game = _game(debugger, "game_stop")
-    if game.game.ended:
-        raise ValueError("game_stop: the game is over and the arm off already")
-    debugger.post(game.game.chart_name, "stop")
-    return {"text": "Stop: the manipulator returns to its start pose avoiding the board, then stops"}
-
-
-def start_new_game(debugger: Debugger) -> dict[str, Any]:
-    """A new game: a new robot from power-on (the thesis' Run_sim again), with the symbol and engine chosen.
-
-    Only once this game is over (its result and the arm turned off, or Stop)
-    or cannot go on; the new game's record goes beside the last one
-    (``game-<n+1>``).  The caller (the session) starts its views over.
-    """
-    game = _game(debugger, "game_new")
-    recipe = debugger.recipe
-    if not isinstance(recipe, GameRecipe):
-        raise ValueError("game_new: this session's robot was not built for a game")
-    driver = game.driver
-    if not (game.game.ended or (driver is not None and driver.error is not None)):
-        raise ValueError("game_new: this game is still on: click Stop first (or play it to its end)")
-    debugger.start_over(replace(recipe, robot_symbol=game.robot_symbol, engine=game.engine_name,
-                                number=recipe.number + 1))
-    return {"text": f"a new game (game {recipe.number + 1}): the robot is powered on; click Run"}
-
-
-#: The page's commands (beside the session's ``run`` and ``game_new``), by protocol type.
-GAME_COMMANDS: dict[str, Callable[..., dict[str, Any]]] = {
-    "game_symbol": cmd_game_symbol,
-    "game_engine": cmd_game_engine,
-    "game_cell": cmd_game_cell,
-    "game_play": cmd_game_play,
-    "game_stop": cmd_game_stop,
-}

@@ -1,16 +1,15 @@
 // The Tic-tac-toe page (/game): the thesis' fig. 3.35 over the session's game.
 //
 // A view, as every page: the buttons send commands (run, game_symbol, game_cell,
-// game_play, game_stop; checked by ttt_sm.web.protocol, handled by ttt_sm.web.game)
+// game_play, game_stop; declared and handled by ttt_sm.web.commands.game)
 // and each frame's "game" part (sent when it changed) is drawn.  A click on a cell
 // asks the simulated hand to draw there; the board shows what the game has read
 // through the camera, never what the page guessed.
 
-import { ArmViews } from "/static/arm.js";
-import { drawCommon, pageHeader, SessionLink } from "/static/session.js";
-
-const $ = (sel) => document.querySelector(sel);
-const role = (name) => $(`[data-role="${name}"]`);
+import { ArmViews } from "./arm.js";
+import { $, role } from "./dom.js";
+import { drawCommon, pageHeader, sayReply as say } from "./page.js";
+import { SessionLink } from "./session.js";
 
 const state = { game: null, photos: -1, arm: null };
 
@@ -88,12 +87,6 @@ function drawCamera(c) {
     img.hidden = false;
   }
   if (!c.has_image) img.hidden = true;
-}
-
-function say(text, error) {
-  const box = role("reply");
-  box.textContent = text;
-  box.dataset.error = error ? "true" : "false";
 }
 
 function drawGame(g) {

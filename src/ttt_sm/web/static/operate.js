@@ -1,16 +1,15 @@
 // The Operational page (/operate): the thesis' fig. 3.36 over the session's robot.
 //
 // A view, as every page: Run_simulation, Trigger and Stop_simulation send commands
-// (run, operate_trigger, operate_stop; checked by ttt_sm.web.protocol, handled by
-// ttt_sm.web.operate), and each frame's "operate" part (the status message, whether
+// (run, operate_trigger, operate_stop; declared and handled by ttt_sm.web.commands.operate
+// over ttt_sm.web.operate), and each frame's "operate" part (the status message, whether
 // Trigger is taken and why not, the last drawing's precision) and "plot" part (the
 // graphs' samples, taken in simulated time by the session) are drawn.  The graphs
 // are plain canvases drawn here; their data live in a ring buffer of fixed size.
 
-import { drawCommon, pageHeader, SessionLink } from "/static/session.js";
-
-const $ = (sel) => document.querySelector(sel);
-const role = (name) => $(`[data-role="${name}"]`);
+import { $, role } from "./dom.js";
+import { drawCommon, pageHeader, sayReply as say } from "./page.js";
+import { SessionLink } from "./session.js";
 
 //: Samples kept per column (2 minutes at 25 a simulated second); the oldest are overwritten.
 const CAPACITY = 3000;
@@ -229,12 +228,6 @@ function download(g) {
 }
 
 // -- the controls ---------------------------------------------------------------------------
-
-function say(text, error) {
-  const box = role("reply");
-  box.textContent = text;
-  box.dataset.error = error ? "true" : "false";
-}
 
 // A slider and its number box: the box takes a typed value only inside the slider's range;
 // outside it the value is refused, said, and left in the box as typed (never clamped).

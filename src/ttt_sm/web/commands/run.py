@@ -1,0 +1,62 @@
+"""Run control, on every page: run, pause, step by control steps, chart ticks or transitions, the speed."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from ...debug.records import StopReason
+from ..fields import MAX_COUNT, integer, number, optional, speed
+from .spec import Cockpit, Reply, command
+
+
+@command("run")
+def run(session: Cockpit, cid: int) -> Reply:
+    """Run until a breakpoint or a pause."""
+    session.mode = "running"
+    session.last_stop = None
+    session.clock.restart()
+    return {"text": "running"}
+
+
+@command("pause")
+def pause(session: Cockpit, cid: int) -> Reply:
+    """Pause between two control steps."""
+    robot = session.debugger.robot
+    if session.mode == "running":
+        session.mode = "paused"
+        session.last_stop = {"kind": "paused", "text": f"paused at t = {robot.t:.4f} s, step {robot.steps},"
+                             f" chart tick {robot.chart_ticks}", "tick": robot.chart_ticks, "hits": []}
+    return {"text": "paused"}
+
+
+def _stepping(session: Cockpit, go: Callable[[], StopReason]) -> Reply:
+    session.mode = "paused"
+    reason = go()
+    session.note_stop(reason)
+    return {"text": reason.describe()}
+
+
+@command("step", n=optional(integer(1, MAX_COUNT), 1))
+def step(session: Cockpit, cid: int, n: int) -> Reply:
+    """``n`` control steps (1 ms each)."""
+    return _stepping(session, lambda: session.debugger.step(n))
+
+
+@command("tick", n=optional(integer(1, MAX_COUNT), 1))
+def tick(session: Cockpit, cid: int, n: int) -> Reply:
+    """To just after the ``n``-th chart tick from now."""
+    return _stepping(session, lambda: session.debugger.tick(n))
+
+
+@command("next", timeout_s=optional(number(0.001, 3600.0), 10.0))
+def next_transition(session: Cockpit, cid: int, timeout_s: float) -> Reply:
+    """Run to the next chart tick that takes a transition (at most ``timeout_s`` simulated seconds)."""
+    return _stepping(session, lambda: session.debugger.next(timeout_s))
+
+
+@command("speed", value=speed)
+def set_speed(session: Cockpit, cid: int, value: float | None) -> Reply:
+    """Pace the run: 0.1 .. 10 times real time, or ``"max"``: as fast as it goes."""
+    session.clock.set_speed(value)
+    session.speed = value
+    return {"text": "as fast as it goes" if value is None else f"x{value:g}"}

@@ -1,0 +1,198 @@
+// The diagram of the chart shown: the server's Graphviz SVG, one picture per view, live.
+//
+// A picture (overview, a sub-chart on its own, the whole chart; sub-charts opened in
+// place) is loaded once; a frame only toggles attributes on it (data-active,
+// data-taken-count, a "flash" class on each transition taken, removed when its
+// animation ends), it never redraws it.  A click on a state or a transition opens a
+// menu: breakpoints on it, or its sub-chart.
+
+import { $$, button, role } from "../dom.js";
+import { openMenu } from "./menu.js";
+
+export class DiagramView {
+  // link: the SessionLink; say(text, isError): the page's status line;
+  // onLoaded(): called when a picture is in place (the coverage colours it).
+  constructor(link, say, onLoaded) {
+    this.link = link;
+    this.say = say;
+    this.onLoaded = onLoaded;
+    this.charts = {};     // name -> chart description (states, transitions, subcharts)
+    this.chart = null;    // the chart shown
+    this.view = "overview";
+    this.opened = [];     // sub-charts open in place in the overview
+    this.active = {};     // chart -> Set of active state ids
+    this.taken = {};      // chart -> {index: count}
+    this.loads = 0;       // pictures asked for: only the last one asked is shown
+    this.box = role("diagram");
+  }
+
+  // The session's charts (its "session" message).
+  setCharts(charts) {
+    this.charts = Object.fromEntries(charts.map((c) => [c.name, c]));
+  }
+
+  // Show chart `name`: its overview (or its one picture) when it was not shown already.
+  show(name) {
+    const chart = this.charts[name];
+    if (this.chart !== name) {
+      this.chart = name;
+      this.view = chart.subcharts.length ? "overview" : "whole";
+      this.opened = [];
+    }
+    this.drawViewBar();
+    this.load();
+  }
+
+  setView(view, opened = []) {
+    this.view = view;
+    this.opened = opened;
+    this.drawViewBar();
+    this.load();
+  }
+
+  // A frame: the active states and the transitions taken (counted; those of this frame flash).
+  take(f) {
+    if (f.full) this.taken = {};
+    this.active = Object.fromEntries(Object.entries(f.active).map(([k, v]) => [k, new Set(v)]));
+    for (const [chart, counts] of Object.entries(f.taken || {})) {
+      this.taken[chart] = { ...(this.taken[chart] || {}), ...counts };
+    }
+    this.draw(f.transitions || [], f.full);
+  }
+
+  drawViewBar() {
+    const chart = this.charts[this.chart];
+    const bar = role("view-bar");
+    bar.replaceChildren();
+    if (!chart.subcharts.length) { bar.append(this.fitButton()); return; }
+    const overview = button("Overview", () => this.setView("overview", []));
+    overview.title = "all sub-charts closed";
+    overview.setAttribute("aria-pressed", String(this.view === "overview" && !this.opened.length));
+    bar.append(overview);
+    for (const sub of chart.subcharts) {
+      const isOpen = this.view === "overview" && this.opened.includes(sub);
+      const inPlace = button(`${isOpen ? "▾" : "▸"} ${sub}`, () => {
+        const opened = isOpen ? this.opened.filter((x) => x !== sub) : [...this.opened, sub];
+        this.setView("overview", opened);
+      }, `${isOpen ? "close" : "open"} sub-chart ${sub} in place`);
+      inPlace.setAttribute("aria-pressed", String(isOpen));
+      const alone = button("⤢", () => this.setView(sub, []), `open sub-chart ${sub} on its own`);
+      alone.setAttribute("aria-pressed", String(this.view === sub));
+      alone.classList.add("alone");
+      const group = document.createElement("span");
+      group.className = "sub";
+      group.append(inPlace, alone);
+      bar.append(group);
+    }
+    const whole = button("Whole chart", () => this.setView("whole", []));
+    whole.title = "every sub-chart open, nested";
+    whole.setAttribute("aria-pressed", String(this.view === "whole"));
+    bar.append(whole);
+    bar.append(this.fitButton());
+  }
+
+  fitButton() {
+    const box = this.box;
+    const fit = button(box.dataset.fit === "true" ? "Actual size" : "Fit to width", () => {
+      box.dataset.fit = box.dataset.fit === "true" ? "false" : "true";
+      this.drawViewBar();
+    }, "zoom the diagram: fit it to the page's width, or draw it at its actual size");
+    fit.classList.add("fit");
+    return fit;
+  }
+
+  async load() {
+    const seq = ++this.loads;
+    const params = new URLSearchParams({ view: this.view });
+    if (this.opened.length) params.set("open", this.opened.join(","));
+    const box = this.box;
+    box.dataset.loading = "true";
+    let text;
+    try {
+      const res = await fetch(`/api/diagram/${encodeURIComponent(this.chart)}?${params}`);
+      text = await res.text();
+      if (!res.ok) throw new Error(text);
+    } catch (err) {
+      if (seq === this.loads) this.say(`diagram: ${err.message}`, true);
+      return;
+    }
+    if (seq !== this.loads) return;  // another picture was asked for meanwhile
+    box.innerHTML = text;
+    box.dataset.chart = this.chart;
+    box.dataset.view = this.view + (this.opened.length ? "+" + this.opened.join("+") : "");
+    const onClick = (e) => this.onClick(e);
+    for (const el of $$("[data-state], [data-transition], [data-stub]", box)) {
+      el.addEventListener("click", onClick);
+      el.addEventListener("contextmenu", onClick);
+      el.addEventListener("keydown", (e) => { if (e.key === "Enter" || e.key === " ") onClick(e); });
+    }
+    for (const el of $$("[data-transition]", box)) {  // a flash is cleared when its animation has run
+      el.addEventListener("animationend", () => el.classList.remove("flash"));
+    }
+    for (const el of $$("[data-subchart]", box)) {
+      el.addEventListener("dblclick", (e) => {
+        e.preventDefault();
+        this.setView("overview", [...new Set([...this.opened, el.dataset.subchart])]);
+      });
+    }
+    this.draw([], true);
+    this.onLoaded();
+    delete box.dataset.loading;
+  }
+
+  // Mark the active states and the transitions' counts; flash `transitions` (all: recount every edge).
+  draw(transitions, all) {
+    const box = this.box;
+    if (box.dataset.chart !== this.chart) return;
+    const active = this.active[this.chart] || new Set();
+    for (const el of $$("[data-state-id]", box)) {
+      const on = active.has(el.dataset.stateId) ? "true" : "false";
+      if (el.dataset.active !== on) el.dataset.active = on;
+    }
+    const taken = this.taken[this.chart] || {};
+    const flashed = new Set(transitions.filter((t) => t.chart === this.chart && t.index !== null).map((t) => t.index));
+    for (const el of $$("[data-index]", box)) {
+      const indices = el.dataset.index.split(" ").map(Number);
+      if (all || indices.some((i) => String(i) in taken || flashed.has(i))) {
+        const count = indices.reduce((sum, i) => sum + (taken[i] || 0), 0);
+        el.dataset.takenCount = String(count);
+      }
+      if (indices.some((i) => flashed.has(i))) {
+        el.classList.remove("flash");
+        void el.getBoundingClientRect();  // restart the animation
+        el.classList.add("flash");
+      }
+    }
+  }
+
+  // A click on a state, a transition or a stub: its menu (breakpoints, sub-charts).
+  onClick(event) {
+    event.preventDefault();
+    event.stopPropagation();
+    const el = event.currentTarget;
+    const chart = this.chart;
+    const addBreak = (spec) => this.link.send({ type: "break", spec });
+    const items = [];
+    if (el.dataset.stub) {
+      const [, ...path] = el.dataset.stub.split(".");
+      items.push([`Open the picture of ${el.dataset.stub}`, () => this.setView(el.dataset.view, [])]);
+      const id = path[path.length - 1];
+      items.push([`Break on entering ${el.dataset.stub}`, () => addBreak(`enter ${chart}.${id}`)]);
+    } else if (el.dataset.stateId) {
+      const id = el.dataset.stateId;
+      const q = el.dataset.state;
+      if (el.dataset.subchart) {
+        items.push([`Open ${id} in place`, () => this.setView("overview", [...new Set([...this.opened, id])])]);
+        items.push([`Open ${id} on its own`, () => this.setView(id, [])]);
+      }
+      items.push([`Break on entering ${q}`, () => addBreak(`enter ${chart}.${id}`)]);
+      items.push([`Break on leaving ${q}`, () => addBreak(`exit ${chart}.${id}`)]);
+    } else if (el.dataset.transition) {
+      for (const name of el.dataset.transition.split(" ")) {
+        const arrow = name.slice(chart.length + 1);
+        items.push([`Break when ${name} is taken`, () => addBreak(`transition ${chart} ${arrow}`)]);
+      }
+    }
+    openMenu(items, event);
+  }
+}

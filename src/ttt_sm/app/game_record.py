@@ -23,7 +23,6 @@ survive").
 from __future__ import annotations
 
 import hashlib
-import json
 from dataclasses import asdict
 from pathlib import Path
 from typing import IO, Any
@@ -31,6 +30,7 @@ from typing import IO, Any
 from ..params import ArmParams
 from ..runtime.jsonable import dumps
 from ..runtime.listeners import Trace
+from ..runtime.recordfile import read_lines
 
 #: The events that end a record.
 ENDINGS = ("finished", "interrupted", "error")
@@ -117,13 +117,5 @@ class GameRecord:
         self._traced = max(self._traced, upto)
 
 
-def read_record(path: Path) -> list[dict[str, Any]]:
-    """Every line of a record, parsed (a line that does not parse raises ValueError naming it)."""
-    lines = []
-    with path.open(encoding="utf-8") as f:
-        for n, line in enumerate(f, 1):
-            try:
-                lines.append(json.loads(line))
-            except json.JSONDecodeError as exc:
-                raise ValueError(f"{path}:{n}: not a JSON line ({exc.msg})") from None
-    return lines
+#: Every line of a game's record, parsed (the runtime's reader of every record file).
+read_record = read_lines

@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import ClassVar
 
+from ..ptylink import crc16
+
 PROTOCOL_VERSION = 2
 HEADER = 3
 CRC_BYTES = 2
@@ -75,17 +77,7 @@ class Reason(IntEnum):
 
 N_REASONS = len(Reason)
 
-# ---- CRC and COBS ---------------------------------------------------------------
-
-
-def crc16(data: bytes) -> int:
-    """CRC-16/CCITT-FALSE: polynomial 0x1021, init 0xFFFF, no reflection, no final xor."""
-    crc = 0xFFFF
-    for byte in data:
-        crc ^= byte << 8
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
-    return crc
+# ---- COBS (the CRC is ttt_sm.ptylink.crc16, the camera link's too) ----------------
 
 
 def cobs_encode(data: bytes) -> bytes:

@@ -19,13 +19,13 @@ content, and raises :class:`FrameError` naming the first thing wrong.
 
 from __future__ import annotations
 
-import binascii
 import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 
+from ..ptylink import crc16
 from .errors import EncodeError, FrameError, Reason
 
 CELLS = 25
@@ -83,15 +83,6 @@ class Status:
     text: str
 
 
-def crc16(data: bytes) -> int:
-    """CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection, no final XOR) of ``data``.
-
-    Check value: ``crc16(b"123456789") == 0x29B1``.  Chosen over NMEA's XOR
-    because XOR cannot see a dropped pair of equal bytes (``100.0`` losing
-    ``00`` reads as a valid ``1.0``); a CRC-16 catches every error burst up to
-    16 bits and all but 1 in 65536 of the rest.
-    """
-    return binascii.crc_hqx(data, 0xFFFF)
 
 
 def _wrap(body: bytes) -> bytes:

@@ -325,7 +325,7 @@ class Execution:
             return True
         return node.id not in d["_active"]
 
-    def _condition_action(self, node: Node, seg: Seg) -> None:
+    def _condition_action(self, node: Node | None, seg: Seg) -> None:
         key = seg.transition.before.key
         run = self._runner(key)
         if run is _no_action:
@@ -337,8 +337,10 @@ class Execution:
         finally:
             frames.pop()
 
-    def _follow(self, node: Node, path: list[Seg]) -> list[Seg] | object | None:
+    def _follow(self, node: Node | None, path: list[Seg]) -> list[Seg] | object | None:
         """A path whose last segment's condition held: run its condition action, follow junctions.
+
+        `node` is the state the path leaves (None: the chart's default transition).
 
         Returns the whole path to a state, :data:`TERMINAL` for a path that ended at a
         terminal junction (its transition actions run: the path is complete, as
@@ -347,7 +349,7 @@ class Execution:
         """
         seg = path[-1]
         self._condition_action(node, seg)
-        if node.id not in self.__dict__["_active"]:
+        if node is not None and node.id not in self.__dict__["_active"]:
             raise EarlyReturn  # a condition action's broadcast left the source
         target = seg.target
         assert target is not None
@@ -491,8 +493,8 @@ class Execution:
         # a default transition through junctions: conditions decide, actions run, as for any path
         for seg in default.out:
             if self._matches(seg) and self._guard(seg):
-                found = self._follow_default(node, [seg])
-                if found is not None:
+                found = self._follow(node, [seg])
+                if isinstance(found, list):
                     end = found[-1].target
                     assert end is not None
                     self._transition_actions(found)
@@ -505,22 +507,6 @@ class Execution:
         raise ChartExecutionError(
             f"{self.chart_name}: no default transition of {where} is valid (from junction {default.id!r}):"
             " a state must enter one of its sub-states; add a segment without a condition")
-
-    def _follow_default(self, node: Node | None, path: list[Seg]) -> list[Seg] | None:
-        seg = path[-1]
-        run = self._runner(seg.transition.before.key)
-        if run is not _no_action:
-            run((seg.transition, seg.source.state, None))
-        target = seg.target
-        assert target is not None
-        if target.kind != "junction":
-            return path
-        for nxt in target.out:
-            if self._matches(nxt) and self._guard(nxt):
-                found = self._follow_default(node, [*path, nxt])
-                if found is not None:
-                    return found
-        return None
 
     def _exit(self, node: Node, path: Sequence[Seg] | None = None) -> None:
         """Exit an active state: its active children first (a parallel state's in reverse order)."""
@@ -594,6 +580,8 @@ class Execution:
         """Stateflow's early-return rule for the action that just broadcast."""
         kind, node, path = frame
         active = self.__dict__["_active"]
+        if node is None:
+            return False  # the chart's own default transition: the chart stays active
         if kind in ("entry", "during", "exit", "condition"):
             return node.id not in active
         # a transition action: the path's parent must be active and have no active child

@@ -26,7 +26,7 @@ import math
 import reprlib
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, cast
 
 from ..runtime import TickChart
 from ..runtime.conditions import KEYWORDS, ExprError, Expression, parse
@@ -416,23 +416,28 @@ class _Checker:
         for_s = self.number(value, "for_s", "expect") if "for_s" in value else None
         return ExpectStep(where, cond, within_s=within, for_s=for_s)
 
-    def step_expect_states(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+    def sequence_step(self, kind: str, value: Any, line: int, what: str,
+                      empty_ok: bool) -> tuple[str, Literal["subsequence", "exact"], MarkedList]:
+        """The chart, match and sequence of an ``expect_states`` / ``expect_events`` step, checked."""
         if not isinstance(value, MarkedDict):
-            raise self.error(line, "expect_states: expected {chart: ..., sequence: [...]}, got "
-                                   f"{_type_name(value)}")
-        self.keys(value, ("chart", "sequence", "match"), "expect_states")
+            raise self.error(line, f"{kind}: expected {{chart: ..., sequence: [...]}}, got {_type_name(value)}")
+        self.keys(value, ("chart", "sequence", "match"), kind)
         for key in ("chart", "sequence"):
             if key not in value:
-                raise self.error(value.line, f"expect_states: missing {key}:")
-        chart = self.chart_name(value["chart"], value.line_of("chart"), "expect_states")
+                raise self.error(value.line, f"{kind}: missing {key}:")
+        chart = self.chart_name(value["chart"], value.line_of("chart"), kind)
         match = value.get("match", "subsequence")
         if match not in MATCH_MODES:
-            raise self.error(value.line_of("match"), f"expect_states: match expected one of"
+            raise self.error(value.line_of("match"), f"{kind}: match expected one of"
                                                      f" {', '.join(MATCH_MODES)}, got {_type_name(match)}")
         seq = value["sequence"]
-        if not isinstance(seq, MarkedList) or not seq:
-            raise self.error(value.line_of("sequence"), "expect_states: sequence expected a list of state"
+        if not isinstance(seq, MarkedList) or not (seq or empty_ok):
+            raise self.error(value.line_of("sequence"), f"{kind}: sequence expected a list of {what}"
                                                         f" names, got {_type_name(seq)}")
+        return chart, cast(Literal["subsequence", "exact"], match), seq
+
+    def step_expect_states(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
+        chart, match, seq = self.sequence_step("expect_states", value, line, "state", empty_ok=False)
         states = chart_states(self.charts[chart])
         for name, n_line in zip(seq, seq.item_lines, strict=True):
             with self.going_on():  # each name on its own
@@ -444,22 +449,7 @@ class _Checker:
         return ExpectStatesStep(where, chart, tuple(seq), match)
 
     def step_expect_events(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:
-        if not isinstance(value, MarkedDict):
-            raise self.error(line, "expect_events: expected {chart: ..., sequence: [...]}, got "
-                                   f"{_type_name(value)}")
-        self.keys(value, ("chart", "sequence", "match"), "expect_events")
-        for key in ("chart", "sequence"):
-            if key not in value:
-                raise self.error(value.line, f"expect_events: missing {key}:")
-        chart = self.chart_name(value["chart"], value.line_of("chart"), "expect_events")
-        match = value.get("match", "subsequence")
-        if match not in MATCH_MODES:
-            raise self.error(value.line_of("match"), f"expect_events: match expected one of"
-                                                     f" {', '.join(MATCH_MODES)}, got {_type_name(match)}")
-        seq = value["sequence"]
-        if not isinstance(seq, MarkedList):
-            raise self.error(value.line_of("sequence"), "expect_events: sequence expected a list of event"
-                                                        f" names, got {_type_name(seq)}")
+        chart, match, seq = self.sequence_step("expect_events", value, line, "event", empty_ok=True)
         events = self.charts[chart].structure().user_events
         for name, n_line in zip(seq, seq.item_lines, strict=True):
             if name not in events:

@@ -482,52 +482,45 @@ class _Run:
 
     def do_expect_states(self, step: ExpectStatesStep) -> None:
         """Fail at the first state that is not as expected: which one, what was expected, what came."""
-        chart, since = step.chart, self.mark_label
-        entries = self.log.entries.get(chart, [])[self.mark.get(chart, 0):]
+        entries = self.log.entries.get(step.chart, [])[self.mark.get(step.chart, 0):]
         actual = [e.state for e in entries]
-        expected = list(step.sequence)
         if step.match == "exact":
-            kinds = chart_states(type(self.robot.chart(chart)))
+            kinds = chart_states(type(self.robot.chart(step.chart)))
             actual = [s for s in actual if kinds.get(s) == "leaf"]
-            k = _first_difference(expected, actual)
-            if k is None:
-                return
-            want = expected[k] if k < len(expected) else "none"
-            got = actual[k] if k < len(actual) else "none"
-            problem = (f"{chart}'s {_ordinal(k + 1)} leaf state since {since}: expected {want}, got {got}"
-                       f" (expected {_around(expected, k)}; entered {_around(actual, k)})")
-        else:
-            gap = _subsequence_gap(expected, actual)
-            if gap is None:
-                return
-            k, start = gap
-            after = f" after {expected[k - 1]}" if k else ""
-            problem = (f"{chart} since {since}: expected {expected[k]} ({_ordinal(k + 1)} of the"
-                       f" sequence){after}, got {_listed(actual[start:])}")
-        self.fail(step, f"expect_states: {problem}; {self.where_is(chart)}")
+        self.check_sequence(step, list(step.sequence), actual, ("leaf state", "", "entered"))
 
     def do_expect_events(self, step: ExpectEventsStep) -> None:
         """Fail at the first local event that is not as expected."""
+        events = self.log.events.get(step.chart, [])[self.event_mark.get(step.chart, 0):]
+        self.check_sequence(step, list(step.sequence), [e.state for e in events],
+                            ("local event", "local event ", "sent"))
+
+    def check_sequence(self, step: ExpectStatesStep | ExpectEventsStep, expected: list[str], actual: list[str],
+                       words: tuple[str, str, str]) -> None:
+        """Compare what a chart did with `expected` (exactly, or as a subsequence); fail at the first miss.
+
+        `words`: what one item is (``leaf state``), how a missing one is named
+        (``local event ``), and what the chart did with them (``entered``).
+        """
+        item, named, did = words
         chart, since = step.chart, self.mark_label
-        actual = [e.state for e in self.log.events.get(chart, [])[self.event_mark.get(chart, 0):]]
-        expected = list(step.sequence)
         if step.match == "exact":
             k = _first_difference(expected, actual)
             if k is None:
                 return
             want = expected[k] if k < len(expected) else "none"
             got = actual[k] if k < len(actual) else "none"
-            problem = (f"{chart}'s {_ordinal(k + 1)} local event since {since}: expected {want}, got {got}"
-                       f" (expected {_around(expected, k)}; sent {_around(actual, k)})")
+            problem = (f"{chart}'s {_ordinal(k + 1)} {item} since {since}: expected {want}, got {got}"
+                       f" (expected {_around(expected, k)}; {did} {_around(actual, k)})")
         else:
             gap = _subsequence_gap(expected, actual)
             if gap is None:
                 return
             k, start = gap
             after = f" after {expected[k - 1]}" if k else ""
-            problem = (f"{chart} since {since}: expected local event {expected[k]} ({_ordinal(k + 1)} of the"
+            problem = (f"{chart} since {since}: expected {named}{expected[k]} ({_ordinal(k + 1)} of the"
                        f" sequence){after}, got {_listed(actual[start:])}")
-        self.fail(step, f"expect_events: {problem}; {self.where_is(chart)}")
+        self.fail(step, f"{step.kind}: {problem}; {self.where_is(chart)}")
 
     def do_mark(self, step: MarkStep) -> None:
         self.event_mark = {name: len(self.log.events.get(name, [])) for name in self.robot.charts}

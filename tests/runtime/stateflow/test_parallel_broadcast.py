@@ -35,7 +35,27 @@ from ._log import act
 URL = "https://mathworks.com/help/stateflow/ug/parallel-and-state-examples.html"
 
 
-class BroadcastInStateAction(TickChart):
+class _Logged:
+    """The three charts' actions: each logs its name; send_E_two broadcasts E_two."""
+
+    during_A = act("durA")
+    during_A1 = act("durA1")
+    during_A2 = act("durA2")
+    during_A1a = act("durA1a")
+    on_exit_A1a = act("exitA1a")
+    on_enter_A1b = act("entA1b")
+    during_A1b = act("durA1b")
+    during_A2a = act("durA2a")
+    on_exit_A2a = act("exitA2a")
+    on_enter_A2b = act("entA2b")
+    during_A2b = act("durA2b")
+
+    def send_E_two(self):
+        """The undirected broadcast send(E_two) (E_two is a local event of the chart)."""
+        self.send("E_two")
+
+
+class BroadcastInStateAction(_Logged, TickChart):
     """A1's label has ``on E_one: send(E_two)`` after its during action.  <URL above>"""
 
     local = (Data("log", "list", [], "actions in the order they ran"),)
@@ -52,24 +72,8 @@ class BroadcastInStateAction(TickChart):
 
     E_one = action_on(A.A1, "send_E_two") | A.A1.A1a.to(A.A1.A1b)
 
-    during_A = act("durA")
-    during_A1 = act("durA1")
-    during_A2 = act("durA2")
-    during_A1a = act("durA1a")
-    on_exit_A1a = act("exitA1a")
-    on_enter_A1b = act("entA1b")
-    during_A1b = act("durA1b")
-    during_A2a = act("durA2a")
-    on_exit_A2a = act("exitA2a")
-    on_enter_A2b = act("entA2b")
-    during_A2b = act("durA2b")
 
-    def send_E_two(self):
-        """The undirected broadcast send(E_two) (E_two is a local event of the chart)."""
-        self.send("E_two")
-
-
-class BroadcastInTransitionAction(TickChart):
+class BroadcastInTransitionAction(_Logged, TickChart):
     """A1a -> A1b is labelled ``E_one/send(E_two)``.  <URL above>"""
 
     local = (Data("log", "list", [], "actions in the order they ran"),)
@@ -85,24 +89,8 @@ class BroadcastInTransitionAction(TickChart):
             A2b = State()
             E_two = A2a.to(A2b)
 
-    during_A = act("durA")
-    during_A1 = act("durA1")
-    during_A2 = act("durA2")
-    during_A1a = act("durA1a")
-    on_exit_A1a = act("exitA1a")
-    on_enter_A1b = act("entA1b")
-    during_A1b = act("durA1b")
-    during_A2a = act("durA2a")
-    on_exit_A2a = act("exitA2a")
-    on_enter_A2b = act("entA2b")
-    during_A2b = act("durA2b")
 
-    def send_E_two(self):
-        """The undirected broadcast send(E_two) (E_two is a local event of the chart)."""
-        self.send("E_two")
-
-
-class BroadcastInConditionAction(TickChart):
+class BroadcastInConditionAction(_Logged, TickChart):
     """A1a -> A1b is labelled ``E_one{send(E_two)}``.  <URL above>"""
 
     local = (Data("log", "list", [], "actions in the order they ran"),)
@@ -117,22 +105,6 @@ class BroadcastInConditionAction(TickChart):
             A2a = State(initial=True)
             A2b = State()
             E_two = A2a.to(A2b)
-
-    during_A = act("durA")
-    during_A1 = act("durA1")
-    during_A2 = act("durA2")
-    during_A1a = act("durA1a")
-    on_exit_A1a = act("exitA1a")
-    on_enter_A1b = act("entA1b")
-    during_A1b = act("durA1b")
-    during_A2a = act("durA2a")
-    on_exit_A2a = act("exitA2a")
-    on_enter_A2b = act("entA2b")
-    during_A2b = act("durA2b")
-
-    def send_E_two(self):
-        """The undirected broadcast send(E_two) (E_two is a local event of the chart)."""
-        self.send("E_two")
 
 
 def test_a_broadcast_from_an_on_event_action_is_processed_at_once_from_the_root():

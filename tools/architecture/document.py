@@ -332,8 +332,74 @@ def wiring_section(pictures: Pictures) -> str:
     return section("../charts/")
 
 
+#: Thesis figure or section -> where it lives: the parts a reader looks for first (docs/thesis_map.md has
+#: every figure and equation).  Each module named here is checked to exist when the page is drawn.
+THESIS_MODULES: tuple[tuple[str, str, str], ...] = (
+    ("§3.1.2, figs. 3.2-3.4", "the drive-initialisation charts", "ttt_sm.charts.drive_init"),
+    ("§3.6.1, figs. 3.23-3.27", "the Control chart: field, X, four-arc O, erase, finish", "ttt_sm.charts.control"),
+    ("eqs. 3.36-3.51", "the geometry of the field, the X and the O", "ttt_sm.charts.geometry"),
+    ("§3.6.2, fig. 3.30", "the algorithm activator and the game flow", "ttt_sm.charts.game"),
+    ("(Stateflow)", "how every chart runs: one wake-up, junctions, local events, temporal logic",
+     "ttt_sm.runtime.engine"),
+    ("eqs. 3.17-3.21, 3.25", "forward kinematics", "ttt_sm.twin.kinematics.chain"),
+    ("§3.4", "inverse kinematics (damped least squares)", "ttt_sm.twin.kinematics.dls"),
+    ("§3.2, figs. 3.5-3.6", "the cascade per drive: position PID, speed PID, filtered encoder derivative",
+     "ttt_sm.twin._cascade"),
+    ("§3.2 (gains)", "the gains, designed with python-control, and their margins", "ttt_sm.twin.tuning"),
+    ("figs. 3.7-3.9", "step responses of drives 1-3", "ttt_sm.twin.step_response"),
+    ("fig. 3.25 (fr_sw)", "the setpoint filters and their cut-off switch", "ttt_sm.twin.control"),
+    ("§3.3", "the pen servo's duty and angle", "ttt_sm.params"),
+    ("(the loop's memory)", "the layouts of the controller's and the plant's flat arrays", "ttt_sm.twin.layout"),
+    ("§3.1.2 note (1 kHz, charts at half rate)", "controller and plant fused in one compiled loop",
+     "ttt_sm.twin._kernel"),
+    ("(beyond the thesis)", "the firmware's C step loaded on the PC; the firmware on the twin's plant",
+     "ttt_sm.hardware.emulator"),
+    ("§3.5, figs. 3.14-3.19", "drawing precision", "ttt_sm.app.drawing"),
+    ("§3.7, figs. 3.35-3.36", "the Tic-tac-toe GUI and the Operational GUI", "ttt_sm.web"),
+)
+
+
+def thesis_section(pictures: Pictures) -> str:
+    """From the thesis to the modules, and the files generated from a single definition."""
+    import importlib
+
+    del pictures
+    rows = ["| thesis | what | module |", "|---|---|---|"]
+    for where, what, module in THESIS_MODULES:
+        importlib.import_module(module)  # a renamed module fails here, not on the page
+        rows.append(f"| {where} | {what} | `{module}` |")
+    from ttt_sm.hardware import generate
+
+    files = [Path(*path.parts[len(path.parts) - 1 - path.parts[::-1].index("firmware"):])
+             for path in generate.generated(Path("firmware"))]  # as the repository names them
+    generated = "\n".join(f"- `{path.as_posix()}` from `ttt_sm.twin.layout` (`ttt_sm.hardware.generate`)"
+                          for path in files)
+    return f"""## From the thesis to the modules
+
+Where the thesis' parts live (docs/thesis_map.md maps every figure and
+equation). The cascade loop spans several modules on purpose: one
+definition of each formula (`ttt_sm.twin._cascade` for the controller step and
+the setpoint filter, `ttt_sm.twin._plant` for gravity, `ttt_sm.params` for the
+servo), one table of each memory layout (`ttt_sm.twin.layout`), the design of
+the gains apart from the step that uses them (`ttt_sm.twin.tuning`,
+`ttt_sm.twin.control`), and the loop that fuses controller and plant
+(`ttt_sm.twin._kernel`).
+
+{chr(10).join(rows)}
+
+### Generated files
+
+Written from one definition, and checked by `make docs CHECK=1` (and a test)
+so that a stale copy fails rather than drifts:
+
+- `charts/`: every chart's diagrams and page, from the chart classes (`ttt_sm.runtime.export`)
+- `docs/architecture.md` and its pictures: this page, from the code (`tools.architecture.document`)
+{generated}
+"""
+
+
 #: The sections of docs/architecture.md, in order.  Add yours here.
-SECTIONS: list[Section] = [layers_section, control_step_section, wiring_section, conventions_section]
+SECTIONS: list[Section] = [layers_section, control_step_section, wiring_section, thesis_section, conventions_section]
 
 
 def render() -> tuple[str, dict[str, str]]:

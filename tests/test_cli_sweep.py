@@ -157,9 +157,6 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     cases.append((["ai", "move", "--board", "XXXXX", "--symbol", "X"], "--board"))
     cases.append((["ai", "move", "--board", "." * 25, "--symbol", "Q"], "--symbol"))
     cases.append((["ai", "move", "--board", "." * 25, "--engine", "nope"], "--engine"))
-    for action in ("export", "check"):
-        for key in ("missing", "garbage", "folder"):
-            cases.append((["docs", action, "--root", p[key]], p[key]))
     cases.append((["no-such-command"], "no-such-command"))
     return cases
 

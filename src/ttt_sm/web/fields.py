@@ -20,6 +20,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from ..runtime.jsonable import dumps
+
 #: The longest breakpoint spec, condition, name or short text.
 MAX_TEXT = 500
 #: The longest scenario text sent from a page.
@@ -170,7 +172,7 @@ def report(cmd: str, name: str, value: Any) -> dict[str, Any]:
 
 def one_of(*choices: str) -> Check:
     """One of a few texts (``"X"`` or ``"O"``)."""
-    quoted = [json.dumps(c) for c in choices]
+    quoted = [dumps(c) for c in choices]
     said = quoted[0] if len(quoted) == 1 else f"{', '.join(quoted[:-1])} or {quoted[-1]}"
 
     def check(cmd: str, name: str, value: Any) -> str:

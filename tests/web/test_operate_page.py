@@ -2,7 +2,10 @@
 
 One session for the module, paused at power-on, as fast as it goes once
 Run_simulation is clicked; the tests run in order on it (the arm waits at its
-waiting pose after the first).  What the drawing tests assert on is the
+waiting pose after the O's test).  Test workers may split the module
+(pytest-xdist's worksteal), so no test relies on another having run: the two
+that need the arm at power-on get a session of their own when the module's has
+already been run, and the others click Run_simulation when it is still on.  What the drawing tests assert on is the
 simulated whiteboard's ink, read in the simulation thread, beside what the
 page shows.
 
@@ -45,6 +48,17 @@ def operate_cockpit(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cockpi
         yield cockpit
 
 
+@pytest.fixture
+def powered_on(operate_cockpit: Cockpit) -> Iterator[Cockpit]:
+    """The module's session while it is still at power-on (never run); otherwise one of its own, at power-on."""
+    if operate_cockpit.session.call(lambda d: d.robot.t) == 0.0:
+        yield operate_cockpit
+        return
+    session = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
+    with served(session) as cockpit:
+        yield cockpit
+
+
 def wait_status(page: Any, text: str, timeout: int = LONG) -> None:
     page.wait_for_function("(text) => document.querySelector('[data-role=status]').textContent.trim() === text",
                            arg=text, timeout=timeout)
@@ -58,6 +72,14 @@ def trigger(page: Any) -> Any:
     return page.get_by_role("button", name="Trigger", exact=True)
 
 
+def run_until_waiting(page: Any) -> None:
+    """Click Run_simulation if the session has not been run yet; wait until Trigger is on (the arm waits)."""
+    run = page.get_by_role("button", name="Run_simulation", exact=True)
+    if run.is_enabled():
+        run.click()
+    page.wait_for_function("!document.querySelector('[data-cmd=trigger]').disabled", timeout=LONG)
+
+
 def fit_circle(points: np.ndarray) -> tuple[float, float, float]:
     """The least-squares circle through ``points`` (x, y rows): centre and diameter, m."""
     x, y = points[:, 0], points[:, 1]
@@ -68,10 +90,10 @@ def fit_circle(points: np.ndarray) -> tuple[float, float, float]:
 
 
 def test_trigger_is_off_before_the_arm_waits_and_a_typed_value_out_of_range_is_refused(
-        browser: Any, operate_cockpit: Cockpit) -> None:
+        browser: Any, powered_on: Cockpit) -> None:
     page = browser.new_page()
     try:
-        open_operate(page, operate_cockpit)
+        open_operate(page, powered_on)
         assert page.get_by_role("status", name="manipulator status").text_content() == MSG_INITIALISING
         assert trigger(page).is_disabled()
         assert text_of(page, "why").startswith("Trigger is off: the manipulator is not at its waiting pose yet")
@@ -98,12 +120,12 @@ def test_trigger_is_off_before_the_arm_waits_and_a_typed_value_out_of_range_is_r
 
 
 def test_an_o_of_6_cm_at_speed_3_is_a_circle_of_60_mm_on_the_whiteboard(
-        browser: Any, operate_cockpit: Cockpit, tmp_path: Path) -> None:
-    session = operate_cockpit.session
+        browser: Any, powered_on: Cockpit, tmp_path: Path) -> None:
+    session = powered_on.session
     page = browser.new_page(viewport={"width": 1500, "height": 1000})
     charts = browser.new_page(viewport={"width": 1200, "height": 900})
     try:
-        open_operate(page, operate_cockpit)
+        open_operate(page, powered_on)
         page.get_by_role("button", name="Run_simulation", exact=True).click()
         wait_status(page, MSG_DRAWING)  # the field first: the Control chart's own order
         assert trigger(page).is_disabled()
@@ -123,7 +145,7 @@ def test_an_o_of_6_cm_at_speed_3_is_a_circle_of_60_mm_on_the_whiteboard(
         box.fill("6")
         page.get_by_role("spinbutton", name="Speed (0 to 5)", exact=True).fill("3")
         assert text_of(page, "speed-mm-s") == "20.0 mm/s"
-        open_page(charts, operate_cockpit, "/charts")
+        open_page(charts, powered_on, "/charts")
         strokes_before, t0 = session.call(lambda d: (len(d.robot.board.strokes), d.robot.t))
         trigger(page).click()
         # the same session in the chart cockpit: Trigger's inputs and event, within a frame
@@ -189,10 +211,7 @@ def test_an_o_of_6_cm_at_speed_3_is_a_circle_of_60_mm_on_the_whiteboard(
 def draw_from_page(page: Any, session: Session, symbol: str, magnitude_cm: str, speed: str) -> list[np.ndarray]:
     """Choose ``symbol`` (the list's value), type the magnitude and speed, Trigger, wait until the arm waits
     again; the robot's ink strokes of that drawing (x, y rows, m), read on the twin's whiteboard."""
-    run = page.get_by_role("button", name="Run_simulation", exact=True)
-    if run.is_enabled():  # run alone (-k), before the O's test has started the session
-        run.click()
-    page.wait_for_function("!document.querySelector('[data-cmd=trigger]').disabled", timeout=LONG)
+    run_until_waiting(page)  # on a session the O's test has not run
     page.get_by_label("Symbol", exact=True).select_option(symbol)
     page.get_by_role("spinbutton", name="Magnitude (cm)", exact=True).fill(magnitude_cm)
     page.get_by_role("spinbutton", name="Speed (0 to 5)", exact=True).fill(speed)
@@ -271,10 +290,11 @@ def test_stop_simulation_turns_the_manipulator_off_and_trigger_says_why(
     page = browser.new_page()
     try:
         open_operate(page, operate_cockpit)
-        wait_status(page, MSG_READY, timeout=30_000)
+        run_until_waiting(page)
+        wait_status(page, MSG_READY)
         page.get_by_role("button", name="Stop_simulation", exact=True).click()
-        wait_status(page, MSG_TURNING_OFF, timeout=30_000)
-        page.wait_for_function("document.querySelector('[data-cmd=trigger]').disabled", timeout=30_000)
+        wait_status(page, MSG_TURNING_OFF)
+        page.wait_for_function("document.querySelector('[data-cmd=trigger]').disabled", timeout=LONG)
         assert text_of(page, "why") == "Trigger is off: the manipulator is being turned off"
         operate_cockpit.session.call(lambda d: d.robot.run_until(lambda: d.robot.control.at_start, 60.0))
         assert operate_cockpit.session.call(lambda d: bool(d.robot.control.at_start))

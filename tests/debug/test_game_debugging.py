@@ -1,7 +1,9 @@
 """The debugger over a whole game: Game and AlgorithmActivator charts, the simulated person, the camera.
 
 One game (seed 0) is stepped by the debugger to the robot's first turn;
-the tests go on from there in file order (continue, replay back).
+each test starts there: a test that runs the game on leaves it elsewhere, and
+the next replays it back (test workers may run the module's tests in any
+order).
 """
 
 from __future__ import annotations
@@ -27,8 +29,17 @@ def first_turn(params):
     return dbg, stop, dbg.fingerprint(), [dict(m) for m in dbg.game.moves]
 
 
-def test_a_breakpoint_on_the_game_chart_stops_at_the_robots_turn(first_turn):
-    dbg, stop, _, moves = first_turn
+@pytest.fixture
+def at_first_turn(first_turn):
+    """The module's game, replayed back to the robot's first turn if a test ran it on."""
+    dbg, stop = first_turn[:2]
+    if dbg.robot.chart_ticks != stop.chart_ticks:
+        assert dbg.replay(stop.chart_ticks).identical
+    return first_turn
+
+
+def test_a_breakpoint_on_the_game_chart_stops_at_the_robots_turn(at_first_turn):
+    dbg, stop, _, moves = at_first_turn
     assert stop.kind == "breakpoint" and stop.breakpoint is not None
     assert stop.breakpoint.spec == "enter Game.drawing" and stop.breakpoint.chart == "Game"
     where = dbg.where()
@@ -42,8 +53,8 @@ def test_a_breakpoint_on_the_game_chart_stops_at_the_robots_turn(first_turn):
     assert dbg.game.pending_move is not None and dbg.game.camera.mode == "direct"
 
 
-def test_the_shell_shows_the_game_and_the_game_charts_timeline(first_turn, capsys):
-    dbg = first_turn[0]
+def test_the_shell_shows_the_game_and_the_game_charts_timeline(at_first_turn, capsys):
+    dbg = at_first_turn[0]
     shell = DebugShell(dbg)
     shell.run_script(["where", "show game", "show timeline Game", "show data Game --diff"])
     out = capsys.readouterr().out
@@ -55,8 +66,8 @@ def test_the_shell_shows_the_game_and_the_game_charts_timeline(first_turn, capsy
     assert re.search(r"input +busy +False -> True", out)
 
 
-def test_continue_plays_on_to_the_robots_next_turn(first_turn):
-    dbg, stop, _, _ = first_turn
+def test_continue_plays_on_to_the_robots_next_turn(at_first_turn):
+    dbg, stop, _, _ = at_first_turn
     again = dbg.run(60.0)
     assert again.kind == "breakpoint" and again.chart_ticks > stop.chart_ticks
     game = dbg.game
@@ -81,10 +92,10 @@ def test_replay_to_a_tick_in_the_game_reproduces_the_same_data(first_turn):
     assert now["game"]["moves"] == moves and now["charts"]["Game"]["active"] == ["drawing", "playing"]
 
 
-def test_the_debugged_game_is_the_game_play_plays(first_turn, params):
+def test_the_debugged_game_is_the_game_play_plays(at_first_turn, params):
     """GameSession.play runs the same flow with Robot.run_until: move for move, at the same times."""
-    dbg = first_turn[0]
-    dbg.run(60.0)  # on to the robot's second turn, as in the test before the replay
+    dbg = at_first_turn[0]
+    dbg.run(60.0)  # on to the robot's second turn
     driven = dbg.game
     played = GameSession(params, seed=0, camera="direct", record_trace=False)
     played.record_start(25)  # the record's first line, as play() and drive() write it

@@ -23,7 +23,6 @@ survive").
 from __future__ import annotations
 
 import hashlib
-import json
 from dataclasses import asdict
 from pathlib import Path
 from typing import IO, Any
@@ -31,9 +30,8 @@ from typing import IO, Any
 from ..params import ArmParams
 from ..runtime.jsonable import dumps
 from ..runtime.listeners import Trace
-
-#: The events that end a record.
-ENDINGS = ("finished", "interrupted", "error")
+from ..runtime.recordfile import ENDINGS
+from ..runtime.recordfile import read_lines as read_record
 
 
 def params_digest(params: ArmParams) -> str:
@@ -117,13 +115,4 @@ class GameRecord:
         self._traced = max(self._traced, upto)
 
 
-def read_record(path: Path) -> list[dict[str, Any]]:
-    """Every line of a record, parsed (a line that does not parse raises ValueError naming it)."""
-    lines = []
-    with path.open(encoding="utf-8") as f:
-        for n, line in enumerate(f, 1):
-            try:
-                lines.append(json.loads(line))
-            except json.JSONDecodeError as exc:
-                raise ValueError(f"{path}:{n}: not a JSON line ({exc.msg})") from None
-    return lines
+__all__ = ["ENDINGS", "GameRecord", "params_digest", "read_record"]

@@ -62,7 +62,8 @@ CONTRACT: tuple[Component, ...] = (
     Component("params", 0, ("ttt_sm.params", "ttt_sm.data"), "the arm's assumed physical values (arm.toml)"),
     Component("arm", 0, ("ttt_sm.arm",), "the Arm protocol the scheduler drives: the twin or a real arm"),
     Component("ptylink", 0, ("ttt_sm.ptylink",),
-              "a raw pseudo-terminal behind a stable symlink: the port of every emulated serial device", only=()),
+              "what every serial device shares: a raw pseudo-terminal behind a stable symlink (an emulator's port),"
+              " an emulator's thread, the CRC-16", only=()),
     Component("charts", 1, ("ttt_sm.charts",), "the thesis' Stateflow charts", only=("runtime",)),
     Component("twin", 1, ("ttt_sm.twin",),
               "the digital twin: kinematics, plant, control, tuning, whiteboard", only=("params", "arm")),

@@ -30,10 +30,8 @@ from typing import IO, Any
 from ..params import ArmParams
 from ..runtime.jsonable import dumps
 from ..runtime.listeners import Trace
-from ..runtime.recordfile import read_lines
-
-#: The events that end a record.
-ENDINGS = ("finished", "interrupted", "error")
+from ..runtime.recordfile import ENDINGS
+from ..runtime.recordfile import read_lines as read_record
 
 
 def params_digest(params: ArmParams) -> str:
@@ -117,5 +115,4 @@ class GameRecord:
         self._traced = max(self._traced, upto)
 
 
-#: Every line of a game's record, parsed (the runtime's reader of every record file).
-read_record = read_lines
+__all__ = ["ENDINGS", "GameRecord", "params_digest", "read_record"]

@@ -44,7 +44,7 @@ from typing import Literal, Protocol
 import numpy as np
 
 from ..params import ArmParams
-from ..ptylink import PtyLink, PtyLinkError, realtime_priority
+from ..ptylink import DeviceThread, PtyLink, PtyLinkError, realtime_priority
 from ..twin import layout
 from ..twin.plant import REST_POSE, Plant, check_pose
 from . import link as L
@@ -187,8 +187,7 @@ class ArmEmulator:
             raise ArmEmulatorError(str(exc)) from None
         self._log = logger or _LOG
         self._lock = threading.RLock()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._loop = DeviceThread(self._run, f"arm-emulator {self._pty.link}")
         self._out = bytearray()
         self.bytes_in = 0
         self.bytes_out = 0
@@ -219,31 +218,23 @@ class ArmEmulator:
 
     def start(self) -> ArmEmulator:
         """Make the pty and its link, and run the firmware in a background thread."""
-        if self._thread is not None:
+        if self._loop.started:
             return self
         device = self._pty.open()
-        self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name=f"arm-emulator {self._pty.link}", daemon=True)
-        self._thread.start()
+        self._loop.start()
         self._log.info("arm emulator (%s, %s firmware): %s -> %s", self.pace, self._lib.precision, self._pty.link,
                        device)
         return self
 
     def stop(self, timeout_s: float = 5.0) -> None:
         """Stop the thread, close the pty, remove the link (and its folder if the emulator made it)."""
-        self._stop.set()
-        thread, self._thread = self._thread, None
-        if thread is not None:
-            thread.join(timeout_s)
+        self._loop.stop(timeout_s)
         with self._lock:
             self._pty.remove()
 
     def hang(self, timeout_s: float = 5.0) -> None:
         """Stop the firmware but leave the port open, as a board that hangs: bytes go in, nothing comes out."""
-        self._stop.set()
-        thread, self._thread = self._thread, None
-        if thread is not None:
-            thread.join(timeout_s)
+        self._loop.stop(timeout_s)
 
     def inject_fault(self, make: Callable[[Plant], ArmFault]) -> ArmFault:
         """Switch a fault of the arm on now: `make` builds it on the plant, between two control steps.
@@ -278,7 +269,8 @@ class ArmEmulator:
             self.priority_note = realtime_priority()
         t0 = time.monotonic()
         fw = self.firmware
-        while not self._stop.is_set():
+        stopping = self._loop.stopping
+        while not stopping.is_set():
             fd = self._pty.master
             if fd is None:
                 return
@@ -292,7 +284,7 @@ class ArmEmulator:
                 if due - fw.steps > self.max_behind_steps:
                     self.max_behind_steps = due - fw.steps
                 with self._lock:  # (a fault goes in between two steps)
-                    while fw.steps < due and not self._stop.is_set():
+                    while fw.steps < due and not stopping.is_set():
                         self.bench.step()
                         self._note_state()
                         self._send(fd)

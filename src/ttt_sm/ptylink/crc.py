@@ -1,8 +1,9 @@
-"""CRC-16/CCITT-FALSE, the check of every frame on the two serial links (camera and arm).
+"""CRC-16/CCITT-FALSE: the checksum of both serial links (the camera's lines, the arm's frames).
 
-One definition for both links and the firmware's C (``ttt_crc16`` in
-firmware/src/link.c computes the same; tests/hardware/test_link.py compares
-them).
+The camera's sentences carry it as four hex digits (docs/seriallink.md), the
+arm's frames as two bytes, MSB first (docs/hardware.md); the firmware
+computes the same CRC bit by bit in C (``ttt_crc16``, ``firmware/src/link.c``),
+and tests/hardware/test_link.py holds the two to each other on random bytes.
 """
 
 from __future__ import annotations
@@ -11,11 +12,13 @@ import binascii
 
 
 def crc16(data: bytes) -> int:
-    """CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection, no final XOR) of ``data``.
+    """CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection, no final XOR) of `data`.
 
-    Check value: ``crc16(b"123456789") == 0x29B1``.  Chosen over NMEA's XOR
-    because XOR cannot see a dropped pair of equal bytes (``100.0`` losing
-    ``00`` reads as a valid ``1.0``); a CRC-16 catches every error burst up to
-    16 bits and all but 1 in 65536 of the rest.
+    ``binascii.crc_hqx`` is this polynomial, unreflected and without a
+    final XOR (CRC-16/XMODEM when started at 0); started at 0xFFFF it is
+    CCITT-FALSE.  Check value: ``crc16(b"123456789") == 0x29B1``.
     """
     return binascii.crc_hqx(data, 0xFFFF)
+
+
+__all__ = ["crc16"]

@@ -30,9 +30,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 
-from ..ptylink import PtyLink, PtyLinkError
+from ..ptylink import DeviceThread, PtyLink, PtyLinkError
 from .errors import EncodeError, SerialLinkError
-from .protocol import CELLS, MAX_STATUS_TEXT, SEQ_MODULUS, Level, crc16, encode_frame, encode_status
+from .protocol import CELLS, MAX_STATUS_TEXT, SEQ_MODULUS, Level, encode_frame, encode_status, wrap_sentence
 
 FrameSource = Callable[[], Sequence[float]]
 """Returns the 25 percentages of the field as the camera sees it now (row-major, image order, percent)."""
@@ -148,9 +148,9 @@ def apply_fault(line: bytes, fault: Fault | None) -> bytes:
             raise ValueError(f"fault cell must be 1..{CELLS}, got {fault.cell}")
         fields = _body(line).split(b",")
         fields[1 + fault.cell] = fault.value.encode("ascii")
-        return _rewrap(b",".join(fields))
+        return wrap_sentence(b",".join(fields))
     if kind is FaultKind.FIELD_COUNT:
-        return _rewrap(_body(line).rsplit(b",", 1)[0])
+        return wrap_sentence(_body(line).rsplit(b",", 1)[0])
     if kind is FaultKind.GARBAGE:
         return fault.data + line
     if kind is FaultKind.OVERLONG:
@@ -166,10 +166,6 @@ def _status_text(text: str) -> str:
 
 def _body(line: bytes) -> bytes:
     return line[1:line.rindex(b"*")]
-
-
-def _rewrap(body: bytes) -> bytes:
-    return b"$" + body + b"*" + f"{crc16(body):04X}".encode("ascii") + b"\r\n"
 
 
 @dataclass(frozen=True)
@@ -227,8 +223,7 @@ class CameraEmulator:
         self._lock = threading.RLock()
         self._faults: deque[Fault] = deque()
         self._replug_at: float | None = None
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._loop = DeviceThread(self._run, f"camera-emulator {self._pty.link}")
         self._n = {k: 0 for k in EmulatorStats.__dataclass_fields__}
 
     # -- the port -----------------------------------------------------------
@@ -274,23 +269,17 @@ class CameraEmulator:
         """Plug (if needed) and send frames from ``frame_source`` at ``rate_hz`` in a background thread."""
         if self._source is None:
             raise EmulatorError("start() needs a frame_source: the callable that returns the 25 percentages")
-        if self._thread is not None:
+        if self._loop.started:
             return self
         self.plug()
-        self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name=f"camera-emulator {self._pty.link}", daemon=True)
-        self._thread.start()
+        self._loop.start()
         return self
 
     def stop(self, timeout_s: float = 5.0) -> None:
         """Stop the thread (waiting at most ``timeout_s``), unplug, and remove the link's folder if it made it."""
-        self._stop.set()
-        thread, self._thread = self._thread, None
-        if thread is not None:
-            thread.join(timeout_s)
-            if thread.is_alive():
-                self._log.error("camera emulator: thread still busy after %g s (a frame_source that hangs?);"
-                                " leaving it as a daemon", timeout_s)
+        if not self._loop.stop(timeout_s):
+            self._log.error("camera emulator: thread still busy after %g s (a frame_source that hangs?);"
+                            " leaving it as a daemon", timeout_s)
         with self._lock:
             self.unplug()
             self._pty.remove()
@@ -307,7 +296,7 @@ class CameraEmulator:
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        return self._loop.running
 
     def inject(self, *faults: Fault) -> None:
         """Queue faults; the thread applies one per frame, in order."""
@@ -322,7 +311,8 @@ class CameraEmulator:
     def _run(self) -> None:
         period = 1.0 / self.rate_hz
         next_t = time.monotonic()
-        while not self._stop.is_set():
+        stopping = self._loop.stopping
+        while not stopping.is_set():
             try:
                 self._tick()
             except Exception:  # keep the camera alive; the reader will see the gap
@@ -331,7 +321,7 @@ class CameraEmulator:
             now = time.monotonic()
             if next_t < now - period:  # fell behind (a loaded machine): skip, do not burst
                 next_t = now
-            self._stop.wait(max(0.0, next_t - now))
+            stopping.wait(max(0.0, next_t - now))
 
     def _tick(self) -> None:
         with self._lock:
@@ -341,7 +331,7 @@ class CameraEmulator:
             self.plug()
         if fault is not None and fault.kind is FaultKind.PAUSE:
             self._n["faults_applied"] += 1
-            self._stop.wait(fault.seconds)  # the camera is busy: no frames, no sequence numbers used
+            self._loop.stopping.wait(fault.seconds)  # the camera is busy: no frames, no sequence numbers used
             return
         if fault is not None and fault.kind is FaultKind.DISCONNECT:
             self._n["faults_applied"] += 1

@@ -10,8 +10,12 @@ terminal shows it readably::
     $TTS,<level>,<text>*<CRC>\\r\\n           a status line (INFO, WARN, ERROR)
 
 ``seq`` is 0..65535 (wrapping), each ``p`` is 0.0..100.0 with exactly one
-decimal, ``CRC`` is CRC-16/CCITT-FALSE of the bytes between ``$`` and ``*``
-as 4 upper-case hex digits.  The full grammar is in docs/seriallink.md.
+decimal, ``CRC`` is CRC-16/CCITT-FALSE (:func:`ttt_sm.ptylink.crc16`, the arm's
+link's too) of the bytes between ``$`` and ``*`` as 4 upper-case hex digits.
+The full grammar is in docs/seriallink.md.  A CRC rather than NMEA's XOR,
+because XOR cannot see a dropped pair of equal bytes (``100.0`` losing ``00``
+reads as a valid ``1.0``); a CRC-16 catches every error burst up to 16 bits
+and all but 1 in 65536 of the rest.
 
 :func:`decode_line` is strict: it checks framing, then the checksum, then the
 content, and raises :class:`FrameError` naming the first thing wrong.
@@ -25,7 +29,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 
-from ..ptylink import crc16
+from ..ptylink.crc import crc16
 from .errors import EncodeError, FrameError, Reason
 
 CELLS = 25
@@ -83,9 +87,8 @@ class Status:
     text: str
 
 
-
-
-def _wrap(body: bytes) -> bytes:
+def wrap_sentence(body: bytes) -> bytes:
+    """The wire line of a sentence's ``body`` (the bytes between ``$`` and ``*``): ``$<body>*<CRC>\\r\\n``."""
     return b"$" + body + b"*" + f"{crc16(body):04X}".encode("ascii") + b"\r\n"
 
 
@@ -118,7 +121,7 @@ def encode_frame(seq: int, percentages: Sequence[float]) -> bytes:
             fields.append(format_percentage(p))
         except (EncodeError, TypeError, ValueError) as exc:
             raise EncodeError(f"cell {i + 1}: {exc}") from None
-    return _wrap(b"TTT," + str(seq).encode("ascii") + b"," + ",".join(fields).encode("ascii"))
+    return wrap_sentence(b"TTT," + str(seq).encode("ascii") + b"," + ",".join(fields).encode("ascii"))
 
 
 def encode_status(level: Level | str, text: str) -> bytes:
@@ -134,7 +137,7 @@ def encode_status(level: Level | str, text: str) -> bytes:
     if len(raw) > MAX_STATUS_TEXT or not set(raw) <= _TEXT_BYTES or not text.isascii():
         raise EncodeError(f"status text must be <= {MAX_STATUS_TEXT} printable ASCII characters"
                           f" without '$' or '*', got {text!r}")
-    return _wrap(b"TTS," + lvl.value.encode("ascii") + b"," + raw)
+    return wrap_sentence(b"TTS," + lvl.value.encode("ascii") + b"," + raw)
 
 
 def decode_line(line: bytes) -> Frame | Status:

@@ -26,9 +26,10 @@ import cv2
 import numpy as np
 import pytest
 
-from ttt_sm.app.game import GameSession, SimulatedPerson, TerminalPerson
+from ttt_sm.app.game import GameSession
 from ttt_sm.app.game_record import ENDINGS, read_record
 from ttt_sm.app.game_replay import replay_record
+from ttt_sm.app.person import SimulatedPerson, TerminalPerson
 from ttt_sm.charts.game import RESULT_MESSAGES
 from ttt_sm.params import load_params
 from ttt_sm.twin.board_picture import save_board_picture
@@ -68,7 +69,7 @@ def _dark_pixels(png: str) -> int:
 
 def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_has_its_own_name(
         tmp_path, monkeypatch):
-    import ttt_sm.app.game as game_module
+    import ttt_sm.app.game_report as game_report
 
     titles: list[str] = []
 
@@ -76,7 +77,7 @@ def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_ha
         titles.append(title)
         return save_board_picture(board, path, title, subtitle)
 
-    monkeypatch.setattr(game_module, "save_board_picture", save_and_note_the_title)
+    monkeypatch.setattr(game_report, "save_board_picture", save_and_note_the_title)
     said: list[str] = []
     session = GameSession(P, seed=4, camera="direct", out_dir=tmp_path, progress=said.append)
     try:
@@ -117,7 +118,7 @@ def test_a_perfect_person_is_not_beaten_quickly(tmp_path):
 
 
 def test_every_game_is_bounded_in_simulated_time():
-    from ttt_sm.app.game import GameError
+    from ttt_sm.app.game_errors import GameError
 
     session = GameSession(P, seed=0, camera="direct", record_trace=False, time_limit_s=20.0)
     try:

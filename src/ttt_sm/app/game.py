@@ -16,6 +16,11 @@ step's end when asked to (:meth:`GameSession.interrupt`, from a signal
 handler; at once while it waits for the person), and its record then ends
 with the ``interrupted`` event; every game is bounded in simulated time
 (``time_limit_s``).
+
+The session holds the game's state and runs it; its parts live beside it:
+who plays against the robot (:mod:`.person`), the engine chosen by name
+(:mod:`.engines`), the turns (:mod:`.game_flow`), the stages the game adds to
+the scheduler (:mod:`.game_stages`) and what a game reports (:mod:`.game_report`).
 """
 
 from __future__ import annotations
@@ -23,39 +28,31 @@ from __future__ import annotations
 import gc
 import hashlib
 import math
-import sys
 import time
-from collections import deque
-from collections.abc import Callable, Generator, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
 from ..arm import Arm
 from ..charts.game import AlgorithmActivator, Game
-from ..game.bitboard import FULL, bits, cell_index, cell_of, win_cells
-from ..game.rules import is_full, parse_board, winner
+from ..game.bitboard import cell_index
 from ..params import ArmParams
 from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
 from ..runtime.recordfile import interruption
-from ..sched.scheduler import Signals
-from ..twin.board_picture import save_board_picture
 from ..twin.truth import GroundTruth
-from ..vision import MoveError, percent_process
+from . import game_flow
 from .camera_link import CameraLink, CameraLost
+from .engines import engine_for
+from .game_errors import GameError, GameInterrupted
 from .game_record import GameRecord, params_digest
+from .game_report import game_report, result_of, save_board
+from .game_stages import Flow, GameDriver, GameStage, PenPathStage, Wait
+from .person import Cell, Person, RemotePerson, SimulatedPerson
 from .robot import Robot
 from .wires import GAME_WIRES
-from .wiring import Wiring, not_wired
-
-Cell = tuple[int, int]
-
-#: How long the game waits for a person at a GUI to draw and click Play, simulated s.
-PERSON_WAIT_S = 24 * 3600.0
-
 
 #: Longest a game may run, in simulated seconds, unless told otherwise: a whole game of 25 moves
 #: takes about 450 s (a usual one about 190 s), so only a game that is stuck reaches it.
@@ -63,330 +60,6 @@ DEFAULT_TIME_LIMIT_S = 1200.0
 #: Longest the game waits, once the camera is lost, for the Safety chart to lift the pen and hold, s of simulated
 #: time (its lift gives up after 2 s).
 CAMERA_LIFT_S = 3.0
-
-#: The strengths of the simulated person (``ttt-sm play --person``).
-PERSON_STRENGTHS = ("random", "greedy", "thesis", "perfect")
-
-
-class GameError(RuntimeError):
-    """The game cannot go on (a chart did not finish its job in time, the camera went silent)."""
-
-
-class GameInterrupted(Exception):
-    """The game was stopped from outside (:meth:`GameSession.interrupt`: Ctrl-C, SIGTERM); ``why`` says how."""
-
-    def __init__(self, why: str) -> None:
-        super().__init__(f"interrupted ({why})")
-        self.why = why
-
-
-class Person(Protocol):
-    """Who plays against the robot."""
-
-    def choose(self, board: str, symbol: str) -> Cell | None:
-        """A free cell to draw `symbol` in (1-based), or None to give up."""
-
-    def tell(self, message: str) -> None:
-        """Show the person a message (the Tic-tac-toe GUI's text box)."""
-
-
-def _masks(board: str) -> tuple[int, int]:
-    b = parse_board(board)
-    return b.marks("X"), b.marks("O")
-
-
-def result_of(board: str) -> str | None:
-    """'X' or 'O' for a win, 'draw' for a full board, None while the game is on."""
-    b = parse_board(board)
-    won = winner(b)
-    if won is not None:
-        return won
-    return "draw" if is_full(b) else None
-
-
-def outcome_in_words(outcome: str | None, robot_symbol: str, person_symbol: str) -> str:
-    """How a game ended, for a person to read: who won, or why there is no winner."""
-    return {robot_symbol: f"the robot ({robot_symbol}) won", person_symbol: f"the person ({person_symbol}) won",
-            "draw": "a draw: the board is full", "given_up": "the person gave up",
-            "halted": "stopped before a result", "abandoned": "ended without a result"}.get(outcome or "abandoned",
-                                                                                           str(outcome))
-
-
-class SimulatedPerson:
-    """A simulated person at the board, at one of :data:`PERSON_STRENGTHS`:
-
-    - ``random``: any free cell;
-    - ``greedy`` (the default): wins when one move wins, blocks when one move loses, else random;
-    - ``thesis``: the thesis' three-ply minimax (:class:`~ttt_sm.game.thesis_engine.ThesisEngine`);
-    - ``perfect``: never a move that lets the robot force a win, else random
-      (:class:`~ttt_sm.game.opponents.PerfectEngine`): against the strong engine, a draw.
-    """
-
-    def __init__(self, seed: int = 0, say: Callable[[str], None] | None = None, strength: str = "greedy") -> None:
-        if strength not in PERSON_STRENGTHS:
-            raise ValueError(f"unknown person strength {strength!r}; choose from {', '.join(PERSON_STRENGTHS)}")
-        self.rng = np.random.default_rng(seed)
-        self.say = say
-        self.strength = strength
-        self.name = f"simulated {strength}"
-        self._engine: Any = None
-        if strength != "greedy":
-            from ..game.opponents import PerfectEngine, RandomEngine
-            from ..game.thesis_engine import ThesisEngine
-
-            self._engine = {"random": lambda: RandomEngine(seed), "thesis": ThesisEngine,
-                            "perfect": lambda: PerfectEngine(seed)}[strength]()
-
-    def choose(self, board: str, symbol: str) -> Cell | None:
-        if self._engine is not None:
-            from ..game.engine import GameOver
-
-            answer = self._engine.move(board, symbol)
-            return None if isinstance(answer, GameOver) else (answer.row, answer.column)
-        x, o = _masks(board)
-        mine, theirs = (x, o) if symbol == "X" else (o, x)
-        empty = FULL & ~(x | o)
-        for mask in (win_cells(mine, theirs), win_cells(theirs, mine)):
-            if mask & empty:
-                return cell_of(bits(mask & empty)[0])
-        free = bits(empty)
-        return cell_of(int(self.rng.choice(free))) if free else None
-
-    def tell(self, message: str) -> None:
-        if self.say:
-            self.say(f"  [person] {message}")
-
-
-class TerminalPerson:
-    """The person at the terminal: types a cell ("2 3" = row 2, column 3); q gives up."""
-
-    name = "terminal"
-
-    def __init__(self, stdin: Any = None, stdout: Any = None) -> None:
-        self.stdin = stdin or sys.stdin
-        self.stdout = stdout or sys.stdout
-
-    def choose(self, board: str, symbol: str) -> Cell | None:
-        self.stdout.write(_board_picture(board) + "\n")
-        while True:
-            self.stdout.write(f"Your move ({symbol}): row column, e.g. 2 3 (q to give up): ")
-            self.stdout.flush()
-            line = self.stdin.readline()
-            if not line or line.strip().lower() in ("q", "quit"):
-                return None
-            parts = line.replace(",", " ").split()
-            if len(parts) == 2 and all(p.isdigit() for p in parts):
-                r, c = int(parts[0]), int(parts[1])
-                if 1 <= r <= 5 and 1 <= c <= 5 and board[cell_index(r, c)] == ".":
-                    return r, c
-                self.stdout.write(f"cell ({r}, {c}) is not a free cell of the 5x5 field\n")
-            else:
-                self.stdout.write(f"not a cell: {line.strip()!r}\n")
-
-    def tell(self, message: str) -> None:
-        self.stdout.write(message + "\n")
-        self.stdout.flush()
-
-
-class RemotePerson:
-    """The person at a GUI (the browser's ``/game`` page): draws by clicking cells, then clicks Play.
-
-    Nothing here decides: the page's clicks reach the :class:`GameSession`
-    (:meth:`GameSession.person_draws`, :meth:`GameSession.press_play`), whose
-    flow waits for them; the simulated hand draws each clicked cell on the
-    whiteboard and the camera reads the board when Play is clicked, as in
-    ``ttt-sm play``.  What the game tells the person is kept for the page.
-    """
-
-    def __init__(self, keep: int = 50) -> None:
-        self.messages: deque[str] = deque(maxlen=keep)
-        #: Messages told so far (the page shows the newest ones).
-        self.told = 0
-
-    def choose(self, board: str, symbol: str) -> Cell | None:
-        raise GameError("the person at the page plays by clicking cells; the flow does not ask them")
-
-    def tell(self, message: str) -> None:
-        self.messages.append(message)
-        self.told += 1
-
-
-def _board_picture(board: str) -> str:
-    rows = ["    1 2 3 4 5"]
-    for r in range(5):
-        rows.append(f"  {r + 1} " + " ".join(board[5 * r:5 * r + 5]))
-    return "\n".join(rows)
-
-
-@dataclass(frozen=True)
-class Wait:
-    """What the game flow waits for between two of its moves.
-
-    Chart steps run until ``until()`` holds (checked after each step), at most
-    ``timeout_s`` of simulated time; ``what`` names it in the error a timeout
-    raises.  ``tell``: the Game chart's new messages are shown to the person
-    meanwhile.
-    """
-
-    until: Callable[[], bool]
-    timeout_s: float
-    what: str
-    tell: bool = True
-
-
-#: The game flow (:meth:`GameSession.flow`): yields what it waits for, returns at the end of the game.
-Flow = Generator[Wait, None, None]
-
-
-class GameDriver:
-    """Plays the game flow from inside the chart steps: whoever steps the robot plays the game.
-
-    :meth:`GameSession.play` runs the flow itself (``Robot.run_until`` for each
-    :class:`Wait`).  A debugger or a GUI steps the robot one control step at a
-    time instead; with a driver (:meth:`GameSession.drive`) the Game stage
-    checks the flow's wait at the start of each chart step, that is right after
-    the previous chart step, where ``run_until`` checks it: the same game,
-    move for move.  A wait that times out, or a camera view the game refuses,
-    ends the flow with :attr:`error` (the charts run on); nothing is raised
-    out of a chart step.
-    """
-
-    def __init__(self, session: GameSession, max_moves: int) -> None:
-        self.session = session
-        self._flow: Flow | None = session.flow(max_moves)
-        self.wait: Wait | None = None
-        #: Chart steps run since the flow began its current wait.
-        self.waited = 0
-        #: Why the flow stopped before the end of the game (a wait that timed out, a refused view).
-        self.error: GameError | None = None
-        #: The flow ran to its end: the game is over and the arm turned off.
-        self.done = False
-
-    @property
-    def running(self) -> bool:
-        """The flow has not ended (neither finished nor stopped by an error)."""
-        return self._flow is not None
-
-    def before_chart_step(self) -> None:
-        """Called at the start of every chart step: check the wait, go on with the flow when it holds."""
-        flow = self._flow
-        if flow is None:
-            return
-        wait = self.wait
-        if self.session.robot.tripped:
-            self._stop(GameError(f"safety stop: {self.session.robot.safety.reason}"))
-            return
-        if wait is not None:
-            self.waited += 1
-            if not self.session.watch(wait):
-                limit = self.session.robot.sched.ticks_for(wait.timeout_s)
-                if self.waited >= limit:
-                    self._stop(self.session.wait_failed(wait))
-                return
-        try:
-            self.wait = next(flow)
-        except StopIteration:
-            self._flow, self.wait, self.done = None, None, True
-            self.session._end("finished", outcome=self.session.outcome, boundary=True)
-            return
-        except GameError as exc:
-            self._stop(exc)
-            return
-        self.waited = 0
-
-    def _stop(self, error: GameError) -> None:
-        assert self._flow is not None
-        self._flow.close()
-        self._flow, self.error = None, error
-        self.session._end("error", message=str(error), boundary=True)
-
-
-class GameStage:
-    """Task stage before the Control chart: the Game and AlgorithmActivator charts and the engine.
-
-    What feeds the two charts and where their outputs go is the wiring
-    table's (:data:`~ttt_sm.app.wires.GAME_WIRES`); this stage runs them and
-    the session's part: the erase flag set once per game, the erasing seen
-    through, the engine asked when the activator enables it.
-    """
-
-    def __init__(self, session: GameSession) -> None:
-        self.s = session
-        self._feed_game: Callable[[], None] = not_wired
-        self._after_game: Callable[[], tuple[bool, bool, bool]] = not_wired
-        self._feed_activator: Callable[[], None] = not_wired
-        self._enable: Callable[[], bool] = not_wired
-
-    def blocks(self) -> dict[str, object]:
-        """The session holds the Session block's outputs."""
-        return {"Session": self.s}
-
-    def wire(self, wiring: Wiring) -> None:
-        """Compile this stage's part of the wiring table."""
-        s = self.s
-        self._feed_game = wiring.feed([s.game.chart_name])
-        self._after_game = wiring.collect("EraseFlag.request", "Session.erasing", "Session.field_drawn")
-        self._feed_activator = wiring.feed([s.activator.chart_name])
-        self._enable = wiring.collect("Session.enable")
-
-    def tick(self, signals: Signals) -> None:
-        s = self.s
-        if s.driver is not None:
-            s.driver.before_chart_step()
-        self._feed_game()
-        s.game.tick()
-        request, erasing, field_drawn = self._after_game()
-        flag = s.robot.control_stage
-        if request and not flag.erase_requested and not s.erase_started:
-            flag.erase_requested = True
-            s.erase_started = True
-        if s.erase_started and not s.erased_seen and not erasing and not field_drawn:
-            s.erased_seen = True
-        self._feed_activator()
-        s.activator.tick()
-        if self._enable():
-            s.robot_turn_now()
-
-
-class PenPathStage:
-    """Joint stage: where the Control chart sends the pen each chart step while it draws (not erasing).
-
-    For the game's drawing precision (:meth:`GameSession.report`): the
-    robot's ink against these desired pen-down paths, as ``ttt-sm draw``
-    measures one drawing (thesis section 3.5).  Simulation only: the ink is
-    the true pen's.
-    """
-
-    #: At most this many pen-down samples are kept (a game draws ~60 s of them: 30 000).
-    MAX_SAMPLES = 250_000
-
-    def __init__(self, robot: Robot) -> None:
-        self.control = robot.control
-        self.surface_z = robot.params.board.surface_z
-        #: Desired pen positions while it is down, one row per chart step; a row at z = inf where it lifts.
-        self.xyz: list[tuple[float, float, float]] = []
-        self._down = False
-        self.board = robot.board
-        #: The robot's ink as it was when the sponge set off (the points of each stroke), kept for the report.
-        self.ink: list[np.ndarray] | None = None
-
-    def robot_ink(self) -> list[np.ndarray]:
-        """The robot's ink strokes: as they were before erasing when the board was erased, else as they are."""
-        if self.ink is not None:
-            return self.ink
-        return [s.points for s in self.board.strokes if s.author == "robot"]
-
-    def tick(self, signals: Signals) -> None:
-        c = self.control
-        if c.erasing and self.ink is None:
-            self.ink = [np.array(s.points) for s in self.board.strokes if s.author == "robot"]
-        if c.busy and not c.erasing and c.Z_out <= self.surface_z:
-            if len(self.xyz) < self.MAX_SAMPLES:
-                self.xyz.append((c.X_out, c.Y_out, c.Z_out))
-            self._down = True
-        elif self._down:
-            self.xyz.append((c.X_out, c.Y_out, math.inf))
-            self._down = False
 
 
 class GameSession:
@@ -462,7 +135,6 @@ class GameSession:
         #: Plays the flow from inside the chart steps (:meth:`drive`), else None.
         self.driver: GameDriver | None = None
         self._last_message = ""
-        self._given_up = False
         #: A person at a GUI (:class:`RemotePerson`): the game waits for their clicks.
         self.remote = isinstance(self.person, RemotePerson)
         #: The cells the person drew in the current turn (a GUI's person), last one last.
@@ -481,7 +153,7 @@ class GameSession:
         self.robot.add_charts((self.activator, self.game), GAME_WIRES, GameStage(self))
         self.robot.game = self
         # the Safety chart's trips and resets go into the record as they happen, with their reasons
-        self.robot.safety_stage.listeners.append(lambda kind, data: self._event(kind, **data))
+        self.robot.safety_stage.listeners.append(lambda kind, data: self.add_event(kind, **data))
         #: Building the twin (controller design, compiled kernels loaded), the charts and the camera.
         self.setup_wall_s = time.perf_counter() - setup0
 
@@ -498,7 +170,7 @@ class GameSession:
         c.row, c.column, c.symbol = row, column, 1 if self.robot_symbol == "X" else 0
         self.robot.post("Control", "button")
         self.pending_move = (row, column)
-        self._event("robot_move", row=row, column=column, think_ms=round(ms, 2))
+        self.add_event("robot_move", row=row, column=column, think_ms=round(ms, 2))
 
     # -- running -----------------------------------------------------------------------
 
@@ -509,7 +181,7 @@ class GameSession:
             if msg != self._last_message:
                 self._last_message = msg
                 self.person.tell(msg)
-                self._event("message", text=msg)
+                self.add_event("message", text=msg)
         return wait.until()
 
     def wait_failed(self, wait: Wait) -> GameError:
@@ -518,7 +190,8 @@ class GameSession:
         return GameError(f"{wait.what} did not happen within {wait.timeout_s:.0f} s of simulated time "
                          f"(Control: {control}, Game: {game})")
 
-    def _event(self, kind: str, **data: Any) -> dict[str, Any]:
+    def add_event(self, kind: str, **data: Any) -> dict[str, Any]:
+        """Add an event of the game to its record, at the simulated time and chart tick of now."""
         return self.record.add(self.robot.t, kind, tick=self.robot.chart_ticks, **data)
 
     def interrupt(self, why: str) -> None:
@@ -534,6 +207,16 @@ class GameSession:
             self._stop_request = why
             raise GameInterrupted(why)
         self._stop_request = why
+
+    def ask_person(self) -> Cell | None:
+        """The cell the person chooses (None: they give up); an interrupt meanwhile stops the game at once."""
+        self._waiting_for_person = True
+        try:
+            if self._stop_request is not None:
+                raise GameInterrupted(self._stop_request)
+            return self.person.choose(self.truth, self.person_symbol)
+        finally:
+            self._waiting_for_person = False
 
     def _check_stop(self) -> None:
         if self._stop_request is not None:
@@ -577,24 +260,28 @@ class GameSession:
     def _waiting(self) -> bool:
         return bool(self.robot.control.ready)
 
-    def _stopped(self) -> bool:
+    def stopped(self) -> bool:
         """Stop was clicked (the Game chart's `stop`): the Game chart asks the Control chart to finish."""
         return bool(self.game.finish)
 
-    def _waiting_or_stopped(self) -> bool:
-        return self._waiting() or self._stopped()
+    def waiting_or_stopped(self) -> bool:
+        """The Control chart waits for its next job, or Stop was clicked."""
+        return self._waiting() or self.stopped()
 
-    def _place(self, cell: Cell, symbol: str, which: str) -> None:
+    def place(self, cell: Cell, symbol: str, which: str) -> None:
+        """``symbol`` is really drawn in ``cell`` (the truth; ``which="board"``: the robot believes it too)."""
         i = cell_index(*cell)
         self.truth = self.truth[:i] + symbol + self.truth[i + 1:]
         if which == "board":
             self.board = self.board[:i] + symbol + self.board[i + 1:]
 
-    def _set_board(self, cell: Cell, symbol: str) -> None:
+    def set_board(self, cell: Cell, symbol: str) -> None:
+        """The robot believes ``symbol`` is in ``cell`` (its move, or the person's move it detected)."""
         i = cell_index(*cell)
         self.board = self.board[:i] + symbol + self.board[i + 1:]
 
-    def _look(self) -> tuple[tuple[float, ...], str | None]:
+    def look(self) -> tuple[tuple[float, ...], str | None]:
+        """The camera's photo of the board: the 25 percentages and the symbols read (a lost camera: GameError)."""
         try:
             view = self.camera.read()
         except CameraLost as exc:
@@ -615,7 +302,7 @@ class GameSession:
         """
         robot = self.robot
         robot.camera_status.ok = False
-        self._event("camera_lost", message=str(exc))
+        self.add_event("camera_lost", message=str(exc))
         if self.driver is None:
             # held or stopped: tripped, and no lift under way (the chart's outputs, not its state names)
             robot.run_until(lambda: robot.tripped and math.isnan(robot.safety.lift_z), CAMERA_LIFT_S)
@@ -636,7 +323,7 @@ class GameSession:
             raise GameError(f"the manipulator plays {self.robot_symbol}: the symbol cannot change after the"
                             " first move")
         if symbol != self.robot_symbol:
-            self._event("symbol", robot_symbol=symbol)
+            self.add_event("symbol", robot_symbol=symbol)
         self.robot_symbol = symbol
         self.person_symbol = "X" if symbol == "O" else "O"
 
@@ -647,7 +334,7 @@ class GameSession:
                             " after the first move")
         self.engine = engine_for(name)
         if name != self.engine_name:
-            self._event("engine", engine=name)
+            self.add_event("engine", engine=name)
         self.engine_name = name
 
     def person_input(self, name: str, **data: Any) -> None:
@@ -674,8 +361,8 @@ class GameSession:
             raise GameError("it is not your turn to draw: " + (
                 "click Play for the manipulator to move" if self.awaiting == "play" else self.game.message))
         self.robot.board.draw_symbol(self.person_symbol, row, column)
-        self._place(cell, self.person_symbol, "truth")
-        self._event("person_drew", row=row, column=column)
+        self.place(cell, self.person_symbol, "truth")
+        self.add_event("person_drew", row=row, column=column)
         if self.remote:
             self.drawn.append(cell)
 
@@ -687,11 +374,6 @@ class GameSession:
         if self.awaiting == "draw":
             raise GameError("it is your turn: draw your move (click a cell), then click Play")
         raise GameError(f"Play is not taken now: {self.game.message}")
-
-    def _remote_wait(self, what: str, symbol: str) -> Wait:
-        """Wait for the person's Play click, or the symbols to change before the first move, or Stop."""
-        return Wait(lambda: self.play_pressed or self.person_symbol != symbol or self._stopped(),
-                    PERSON_WAIT_S, what)
 
     def play(self, max_moves: int = 25) -> dict[str, Any]:
         """Play one game to its end (or until the person gives up); return the report."""
@@ -705,7 +387,7 @@ class GameSession:
             wall0 = time.perf_counter()
             for wait in self.flow(max_moves):
                 self._run(wait)
-            report = self.report(time.perf_counter() - wall0)
+            report = game_report(self, time.perf_counter() - wall0)
         except GameInterrupted as exc:
             self._end("interrupted", signal=exc.why, boundary=True)
             raise
@@ -727,7 +409,7 @@ class GameSession:
 
     def record_start(self, max_moves: int) -> None:
         """The record's first line: what a replay of the record needs."""
-        self._event("game", seed=self.robot.seed, robot_symbol=self.robot_symbol, engine=self.engine_name,
+        self.add_event("game", seed=self.robot.seed, robot_symbol=self.robot_symbol, engine=self.engine_name,
                     person=getattr(self.person, "name", type(self.person).__name__), camera=self.camera.mode,
                     params_sha256=params_digest(self.params), time_limit_s=self.time_limit_s, max_moves=max_moves)
 
@@ -740,30 +422,14 @@ class GameSession:
         where = {"waiting_for": wait.what if wait is not None else "the start of the game",
                  "control": sorted(self.robot.active("Control")), "game": sorted(self.robot.active("Game"))}
         if how != "finished":
-            self._save_board("final" if "final" not in self.pictures else "erased", ending=how)
-        self._event(how, **data, **({} if how == "finished" else where), pictures=dict(self.pictures),
+            save_board(self, "final" if "final" not in self.pictures else "erased", ending=how)
+        self.add_event(how, **data, **({} if how == "finished" else where), pictures=dict(self.pictures),
                     state=self.checkpoint())
         self.record.close()
 
-    def _save_board(self, which: str, ending: str | None = None) -> None:
-        """The board picture ``board_<which>.png`` in ``out_dir`` (nothing without one)."""
-        if self.out_dir is None:
-            return
-        robot = self.robot
-        ink = robot.board.ink_area_mm2()
-        if which == "final":
-            how = {None: outcome_in_words(self.outcome, self.robot_symbol, self.person_symbol),
-                   "interrupted": "the game interrupted",
-                   "error": "the game stopped by an error"}[ending]
-            title = f"The whiteboard at the end of the game: {how}, {len(self.moves)} moves played"
-        else:
-            title = "The whiteboard after erasing" if ending is None else \
-                f"The whiteboard while erasing: {'interrupted' if ending == 'interrupted' else 'an error'}"
-        path = save_board_picture(
-            robot.board, self.out_dir / f"board_{which}.png", title,
-            f"the robot plays {self.robot_symbol} (blue ink), the person {self.person_symbol} (black ink); "
-            f"seed {robot.seed}, simulated time {robot.t:.1f} s, {ink:.0f} mm² of ink on the board")
-        self.pictures[which] = str(path)
+    def flow(self, max_moves: int = 25) -> Flow:
+        """The game as this session plays it (:func:`.game_flow.flow`): a generator of what it waits for."""
+        return game_flow.flow(self, max_moves)
 
     def drive(self, max_moves: int = 25) -> GameDriver:
         """Play the game from inside the chart steps from now on: whoever steps the robot plays it.
@@ -774,80 +440,6 @@ class GameSession:
             self.record_start(max_moves)
             self.driver = GameDriver(self, max_moves)
         return self.driver
-
-    def flow(self, max_moves: int = 25) -> Flow:
-        """The game as the session plays it: the person's turns, the robot's, the end.
-
-        A generator: it yields a :class:`Wait` whenever the charts must run
-        before it can go on, and does its part (the person draws and clicks
-        Play, the camera looks, the board is updated) between chart steps.
-        :meth:`play` runs it with ``Robot.run_until``, a :class:`GameDriver`
-        from inside the chart steps.
-        """
-        self.say("initialising, then drawing the field")
-        yield Wait(self._waiting_or_stopped, 300.0, "initialising and drawing the field")
-        self._event("field_drawn")
-        # Each turn adds one move; a GUI's person's turn may end without one (the symbols
-        # changed before the first move, or Stop): X moves when the number of moves is even.
-        while result_of(self.board) is None and len(self.moves) < max_moves and not self._stopped():
-            to_move = "X" if len(self.moves) % 2 == 0 else "O"
-            if to_move == self.person_symbol:
-                if not (yield from self._person_turn()):
-                    break
-            else:
-                yield from self._robot_turn()
-        stopped = self._stopped() and result_of(self.board) is None
-        outcome = result_of(self.board) or ("given_up" if self._given_up else "halted" if stopped else "abandoned")
-        self.outcome = outcome
-        self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3, "given_up": 4}.get(outcome, 3)
-        self._event("result", outcome=outcome)
-        self._save_board("final")  # the board as the game ended, before the sponge
-        self.say(f"result: {outcome_in_words(outcome, self.robot_symbol, self.person_symbol)}; "
-                 "erasing and turning off")
-        yield Wait(lambda: self.game.ended, 600.0, "erasing and turning off")
-        self._save_board("erased")
-
-    def report(self, wall_s: float) -> dict[str, Any]:
-        """What a game reports (docs/play.md, "What it reports"); `wall_s`: the wall time it took."""
-        robot = self.robot
-        outcome = self.outcome or "abandoned"
-        ink_left = robot.board.ink_area_mm2()
-        winner = {self.robot_symbol: "robot", self.person_symbol: "person", "given_up": "robot"}.get(outcome, outcome)
-        return {
-            "winner": winner,
-            "outcome": outcome,
-            "moves": self.moves,
-            "robot_symbol": self.robot_symbol,
-            "detections_correct": self.detections_correct,
-            "detections_wrong": self.detections_wrong,
-            "sim_time_s": round(robot.t, 3),
-            "wall_time_s": round(wall_s, 3),
-            "realtime_factor": round(robot.t / wall_s, 1),
-            "setup_wall_s": round(self.setup_wall_s, 3),
-            "erased": ink_left == 0.0,
-            "ink_left_mm2": round(ink_left, 3),
-            "camera": self.camera.mode,
-            "camera_link": self.camera.stats(),
-            "camera_wall_s": round(self.camera.read_wall_s, 3),
-            "ignored_play_clicks": self.activator.ignored_triggers,
-            **self._drawing_precision(),
-        }
-
-    def _drawing_precision(self) -> dict[str, float | None]:
-        """The robot's ink against the desired pen-down paths of the whole game, mm (None without ground truth)."""
-        from .drawing import _distance_to_runs, _pen_down_runs
-
-        if self.pen_path is None:
-            return {"drawing_rms_mm": None, "drawing_max_mm": None}
-        ink = [p for p in self.pen_path.robot_ink() if len(p)]
-        if not ink or not self.pen_path.xyz:
-            return {"drawing_rms_mm": None, "drawing_max_mm": None}
-        runs = _pen_down_runs(np.asarray(self.pen_path.xyz), self.params.board.surface_z)
-        if not runs:
-            return {"drawing_rms_mm": None, "drawing_max_mm": None}
-        err = _distance_to_runs(np.vstack(ink), runs) * 1e3
-        return {"drawing_rms_mm": round(float(np.sqrt(np.mean(err ** 2))), 4),
-                "drawing_max_mm": round(float(err.max()), 4)}
 
     def checkpoint(self) -> dict[str, Any]:
         """The state of a game at a chart-step boundary, as a record keeps it: readable parts and one digest.
@@ -882,100 +474,6 @@ class GameSession:
                 "pending_move": self.pending_move, "erase_started": self.erase_started,
                 "erased_seen": self.erased_seen, "detections": [self.detections_correct, self.detections_wrong]}
 
-    def _click_play(self) -> None:
-        self.robot.post("AlgorithmActivator", "trigger")
-
-    def _person_turn(self) -> Generator[Wait, None, bool]:
-        robot = self.robot
-        step = self.params.control.chart_dt
-        # The Game chart shows whose turn it is before the person is asked.
-        yield Wait(lambda: True, step, "the Game chart to show whose turn it is", tell=False)
-        yield Wait(lambda: True, step, "the person's move")
-        if self.remote:
-            # The person draws by clicking cells (person_draws), then clicks Play: the camera looks then.
-            self.drawn, self.play_pressed, self.awaiting = [], False, "draw"
-            try:
-                yield self._remote_wait("the person's move and Play", self.person_symbol)
-            finally:
-                self.awaiting = None
-            if not self.play_pressed:
-                return True  # the symbols changed before the first move, or Stop: the flow decides again
-            self.play_pressed = False
-            cell = self.drawn[-1]
-        else:
-            self._waiting_for_person = True  # an interrupt now stops the game at once
-            try:
-                if self._stop_request is not None:
-                    raise GameInterrupted(self._stop_request)
-                chosen = self.person.choose(self.truth, self.person_symbol)
-            finally:
-                self._waiting_for_person = False
-            if chosen is None:
-                self._given_up = True
-                self._event("given_up", moves=len(self.moves))
-                return False
-            cell = chosen
-            self.person_draws(cell)
-        percentages, symbols = self._look()
-        try:
-            seen = percent_process(percentages, self.robot_cells, self.person_cells, robot_ink=self.robot_ink,
-                                   symbols=symbols, robot_symbol=self.robot_symbol)
-        except MoveError as exc:
-            self.detections_wrong += 1
-            message = getattr(exc, "message_for_person", str(exc))
-            self.person.tell(message)
-            self._event("detection_rejected", message=message)
-            raise GameError(f"the camera's view was refused: {message}") from exc
-        ok = seen.new == cell
-        self.detections_correct += ok
-        self.detections_wrong += not ok
-        self._event("detected", row=seen.new[0] if seen.new else None,
-                        column=seen.new[1] if seen.new else None, correct=ok,
-                        percentages=[round(p, 1) for p in percentages])
-        if seen.new is not None:
-            self.person_cells.append(seen.new)
-            self._set_board(seen.new, self.person_symbol)
-            self.o_pos |= 1 << cell_index(*seen.new)
-        self.moves.append({"by": "person", "symbol": self.person_symbol, "row": cell[0], "column": cell[1],
-                           "t": round(robot.t, 3), "detected": list(seen.new) if seen.new else None})
-        if result_of(self.board) is None:
-            self._click_play()  # the person's Play click: the robot's turn
-        return True
-
-    def _robot_turn(self) -> Flow:
-        robot = self.robot
-        if not self.moves:
-            if self.remote:  # the person clicks Play for the manipulator to open the game
-                self.play_pressed, self.awaiting = False, "play"
-                try:
-                    yield self._remote_wait("Play for the manipulator's first move", self.person_symbol)
-                finally:
-                    self.awaiting = None
-                if not self.play_pressed:
-                    return  # the symbols changed, or Stop: the flow decides again
-                self.play_pressed = False
-            self._click_play()  # the robot opens: Play without a drawing first
-        self.pending_move = None
-        yield Wait(lambda: self.pending_move is not None or self._stopped(), 10.0, "the algorithm's answer")
-        if self._stopped():
-            return  # Stop: the manipulator returns to its start pose instead
-        cell = self.pending_move
-        assert cell is not None
-        step = self.params.control.chart_dt
-        yield Wait(lambda: True, step, "the Control chart to take the move", tell=False)
-        yield Wait(lambda: True, step, "the Control chart to take the move", tell=False)
-        yield Wait(self._waiting_or_stopped, 120.0, f"drawing the robot's move {cell}")
-        if self._stopped():
-            return  # Stop in the middle of the stroke: the pen is lifted, the move not made
-        self.robot_cells.append(cell)
-        self._set_board(cell, self.robot_symbol)
-        self._place(cell, self.robot_symbol, "truth")
-        percentages, _ = self._look()
-        self.robot_ink[cell] = percentages[cell_index(*cell)]
-        self.moves.append({"by": "robot", "symbol": self.robot_symbol, "row": cell[0], "column": cell[1],
-                           "t": round(robot.t, 3)})
-        self.person.tell(f"The manipulator drew {self.robot_symbol} in row {cell[0]}, column {cell[1]}.")
-
     def save(self, out_dir: Path | None = None) -> dict[str, str]:
         """The files of the game: the record (``game.jsonl``) and the board pictures.
 
@@ -990,7 +488,7 @@ class GameSession:
             self.record.attach(out_dir / "game.jsonl")
             if "final" not in self.pictures:
                 ended = self.record.ended
-                self._save_board("final", ending=ended if ended in ("interrupted", "error") else None)
+                save_board(self, "final", ending=ended if ended in ("interrupted", "error") else None)
         files = {"record": str(self.record.path)}
         if "final" in self.pictures:
             files["board_png"] = self.pictures["final"]
@@ -1006,23 +504,3 @@ class GameSession:
             self.record.close()
         finally:
             self.camera.close()
-
-
-def engine_for(name: str) -> Callable[[str, str], Cell]:
-    """The game algorithm called `name` ("strong" or "thesis") as a function (board text, symbol) -> cell."""
-    from ..game.engine import GameOver
-    from ..game.strong_engine import StrongEngine
-    from ..game.thesis_engine import ThesisEngine
-
-    engines = {"strong": StrongEngine, "thesis": ThesisEngine}
-    if name not in engines:
-        raise ValueError(f"unknown engine {name!r}; choose from {', '.join(engines)}")
-    engine = engines[name]()
-
-    def move(board: str, symbol: str) -> Cell:
-        answer = engine.move(board, symbol)
-        if isinstance(answer, GameOver):
-            raise GameError(f"the {name} engine was asked to move after the end: {answer.reason}")
-        return answer.row, answer.column
-
-    return move

@@ -46,7 +46,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from ..app.game import GameError, GameSession
+from ..app.game import GameSession
+from ..app.game_errors import GameError
 from ..app.robot import Robot, RobotError
 from ..arm import Arm
 from ..params import ArmParams

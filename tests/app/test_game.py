@@ -7,7 +7,7 @@ import cv2
 import pytest
 
 from ttt_sm.app.game import GameSession
-from ttt_sm.app.game_report import result_of
+from ttt_sm.app.game_outcome import result_of
 from ttt_sm.app.person import SimulatedPerson, TerminalPerson
 from ttt_sm.charts.game import MSG_DRAWING, MSG_ERASING, MSG_TURNING_OFF, MSG_YOUR_TURN
 from ttt_sm.cli import main

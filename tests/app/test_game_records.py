@@ -69,7 +69,7 @@ def _dark_pixels(png: str) -> int:
 
 def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_has_its_own_name(
         tmp_path, monkeypatch):
-    import ttt_sm.app.game_report as game_report
+    import ttt_sm.app.game as game_module
 
     titles: list[str] = []
 
@@ -77,7 +77,7 @@ def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_ha
         titles.append(title)
         return save_board_picture(board, path, title, subtitle)
 
-    monkeypatch.setattr(game_report, "save_board_picture", save_and_note_the_title)
+    monkeypatch.setattr(game_module, "save_board_picture", save_and_note_the_title)
     said: list[str] = []
     session = GameSession(P, seed=4, camera="direct", out_dir=tmp_path, progress=said.append)
     try:
@@ -118,7 +118,7 @@ def test_a_perfect_person_is_not_beaten_quickly(tmp_path):
 
 
 def test_every_game_is_bounded_in_simulated_time():
-    from ttt_sm.app.game_errors import GameError
+    from ttt_sm.app.game_outcome import GameError
 
     session = GameSession(P, seed=0, camera="direct", record_trace=False, time_limit_s=20.0)
     try:

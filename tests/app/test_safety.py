@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ttt_sm.app.game import GameSession
-from ttt_sm.app.game_errors import GameError
+from ttt_sm.app.game_outcome import GameError
 from ttt_sm.app.init_wiring import random_power_on
 from ttt_sm.app.robot import Robot
 from ttt_sm.params import load_params

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from .game_errors import GameError
+from .game_outcome import GameError
 from .person import Cell
 
 

@@ -17,43 +17,39 @@ handler; at once while it waits for the person), and its record then ends
 with the ``interrupted`` event; every game is bounded in simulated time
 (``time_limit_s``).
 
-The session holds the game's state and runs it; its parts live beside it:
-who plays against the robot (:mod:`.person`), the engine chosen by name
-(:mod:`.engines`), the turns (:mod:`.game_flow`), the stages the game adds to
-the scheduler (:mod:`.game_stages`) and what a game reports (:mod:`.game_report`).
+Beside the session: who plays against the robot (:mod:`.person`), the engine
+chosen by name (:mod:`.engines`), how a game ends (:mod:`.game_outcome`), and
+the game inside the chart steps, its stages and driver (:mod:`.game_stages`).
 """
-
 from __future__ import annotations
 
 import gc
-import hashlib
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Generator, Sequence
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from ..arm import Arm
 from ..charts.game import AlgorithmActivator, Game
 from ..game.bitboard import cell_index
 from ..params import ArmParams
-from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
 from ..runtime.recordfile import interruption
+from ..twin.board_picture import save_board_picture
 from ..twin.truth import GroundTruth
-from . import game_flow
+from ..vision import MoveError, percent_process
 from .camera_link import CameraLink, CameraLost
 from .engines import engine_for
-from .game_errors import GameError, GameInterrupted
-from .game_record import GameRecord, params_digest
-from .game_report import game_report, result_of, save_board
-from .game_stages import Flow, GameDriver, GameStage, PenPathStage, Wait
+from .game_outcome import GameError, GameInterrupted, outcome_in_words, result_of
+from .game_record import GameRecord, checkpoint, params_digest
+from .game_stages import NO_PRECISION, Flow, GameDriver, GameStage, PenPathStage, Wait
 from .person import Cell, Person, RemotePerson, SimulatedPerson
 from .robot import Robot
 from .wires import GAME_WIRES
 
+#: How long the game waits for a person at a GUI to draw and click Play, simulated s.
+PERSON_WAIT_S = 24 * 3600.0
 #: Longest a game may run, in simulated seconds, unless told otherwise: a whole game of 25 moves
 #: takes about 450 s (a usual one about 190 s), so only a game that is stuck reaches it.
 DEFAULT_TIME_LIMIT_S = 1200.0
@@ -135,6 +131,7 @@ class GameSession:
         #: Plays the flow from inside the chart steps (:meth:`drive`), else None.
         self.driver: GameDriver | None = None
         self._last_message = ""
+        self._given_up = False
         #: A person at a GUI (:class:`RemotePerson`): the game waits for their clicks.
         self.remote = isinstance(self.person, RemotePerson)
         #: The cells the person drew in the current turn (a GUI's person), last one last.
@@ -153,7 +150,7 @@ class GameSession:
         self.robot.add_charts((self.activator, self.game), GAME_WIRES, GameStage(self))
         self.robot.game = self
         # the Safety chart's trips and resets go into the record as they happen, with their reasons
-        self.robot.safety_stage.listeners.append(lambda kind, data: self.add_event(kind, **data))
+        self.robot.safety_stage.listeners.append(lambda kind, data: self._event(kind, **data))
         #: Building the twin (controller design, compiled kernels loaded), the charts and the camera.
         self.setup_wall_s = time.perf_counter() - setup0
 
@@ -170,7 +167,7 @@ class GameSession:
         c.row, c.column, c.symbol = row, column, 1 if self.robot_symbol == "X" else 0
         self.robot.post("Control", "button")
         self.pending_move = (row, column)
-        self.add_event("robot_move", row=row, column=column, think_ms=round(ms, 2))
+        self._event("robot_move", row=row, column=column, think_ms=round(ms, 2))
 
     # -- running -----------------------------------------------------------------------
 
@@ -181,7 +178,7 @@ class GameSession:
             if msg != self._last_message:
                 self._last_message = msg
                 self.person.tell(msg)
-                self.add_event("message", text=msg)
+                self._event("message", text=msg)
         return wait.until()
 
     def wait_failed(self, wait: Wait) -> GameError:
@@ -190,8 +187,7 @@ class GameSession:
         return GameError(f"{wait.what} did not happen within {wait.timeout_s:.0f} s of simulated time "
                          f"(Control: {control}, Game: {game})")
 
-    def add_event(self, kind: str, **data: Any) -> dict[str, Any]:
-        """Add an event of the game to its record, at the simulated time and chart tick of now."""
+    def _event(self, kind: str, **data: Any) -> dict[str, Any]:
         return self.record.add(self.robot.t, kind, tick=self.robot.chart_ticks, **data)
 
     def interrupt(self, why: str) -> None:
@@ -207,16 +203,6 @@ class GameSession:
             self._stop_request = why
             raise GameInterrupted(why)
         self._stop_request = why
-
-    def ask_person(self) -> Cell | None:
-        """The cell the person chooses (None: they give up); an interrupt meanwhile stops the game at once."""
-        self._waiting_for_person = True
-        try:
-            if self._stop_request is not None:
-                raise GameInterrupted(self._stop_request)
-            return self.person.choose(self.truth, self.person_symbol)
-        finally:
-            self._waiting_for_person = False
 
     def _check_stop(self) -> None:
         if self._stop_request is not None:
@@ -260,28 +246,24 @@ class GameSession:
     def _waiting(self) -> bool:
         return bool(self.robot.control.ready)
 
-    def stopped(self) -> bool:
+    def _stopped(self) -> bool:
         """Stop was clicked (the Game chart's `stop`): the Game chart asks the Control chart to finish."""
         return bool(self.game.finish)
 
-    def waiting_or_stopped(self) -> bool:
-        """The Control chart waits for its next job, or Stop was clicked."""
-        return self._waiting() or self.stopped()
+    def _waiting_or_stopped(self) -> bool:
+        return self._waiting() or self._stopped()
 
-    def place(self, cell: Cell, symbol: str, which: str) -> None:
-        """``symbol`` is really drawn in ``cell`` (the truth; ``which="board"``: the robot believes it too)."""
+    def _place(self, cell: Cell, symbol: str, which: str) -> None:
         i = cell_index(*cell)
         self.truth = self.truth[:i] + symbol + self.truth[i + 1:]
         if which == "board":
             self.board = self.board[:i] + symbol + self.board[i + 1:]
 
-    def set_board(self, cell: Cell, symbol: str) -> None:
-        """The robot believes ``symbol`` is in ``cell`` (its move, or the person's move it detected)."""
+    def _set_board(self, cell: Cell, symbol: str) -> None:
         i = cell_index(*cell)
         self.board = self.board[:i] + symbol + self.board[i + 1:]
 
-    def look(self) -> tuple[tuple[float, ...], str | None]:
-        """The camera's photo of the board: the 25 percentages and the symbols read (a lost camera: GameError)."""
+    def _look(self) -> tuple[tuple[float, ...], str | None]:
         try:
             view = self.camera.read()
         except CameraLost as exc:
@@ -302,7 +284,7 @@ class GameSession:
         """
         robot = self.robot
         robot.camera_status.ok = False
-        self.add_event("camera_lost", message=str(exc))
+        self._event("camera_lost", message=str(exc))
         if self.driver is None:
             # held or stopped: tripped, and no lift under way (the chart's outputs, not its state names)
             robot.run_until(lambda: robot.tripped and math.isnan(robot.safety.lift_z), CAMERA_LIFT_S)
@@ -323,7 +305,7 @@ class GameSession:
             raise GameError(f"the manipulator plays {self.robot_symbol}: the symbol cannot change after the"
                             " first move")
         if symbol != self.robot_symbol:
-            self.add_event("symbol", robot_symbol=symbol)
+            self._event("symbol", robot_symbol=symbol)
         self.robot_symbol = symbol
         self.person_symbol = "X" if symbol == "O" else "O"
 
@@ -334,7 +316,7 @@ class GameSession:
                             " after the first move")
         self.engine = engine_for(name)
         if name != self.engine_name:
-            self.add_event("engine", engine=name)
+            self._event("engine", engine=name)
         self.engine_name = name
 
     def person_input(self, name: str, **data: Any) -> None:
@@ -361,8 +343,8 @@ class GameSession:
             raise GameError("it is not your turn to draw: " + (
                 "click Play for the manipulator to move" if self.awaiting == "play" else self.game.message))
         self.robot.board.draw_symbol(self.person_symbol, row, column)
-        self.place(cell, self.person_symbol, "truth")
-        self.add_event("person_drew", row=row, column=column)
+        self._place(cell, self.person_symbol, "truth")
+        self._event("person_drew", row=row, column=column)
         if self.remote:
             self.drawn.append(cell)
 
@@ -374,6 +356,11 @@ class GameSession:
         if self.awaiting == "draw":
             raise GameError("it is your turn: draw your move (click a cell), then click Play")
         raise GameError(f"Play is not taken now: {self.game.message}")
+
+    def _remote_wait(self, what: str, symbol: str) -> Wait:
+        """Wait for the person's Play click, or the symbols to change before the first move, or Stop."""
+        return Wait(lambda: self.play_pressed or self.person_symbol != symbol or self._stopped(),
+                    PERSON_WAIT_S, what)
 
     def play(self, max_moves: int = 25) -> dict[str, Any]:
         """Play one game to its end (or until the person gives up); return the report."""
@@ -387,33 +374,33 @@ class GameSession:
             wall0 = time.perf_counter()
             for wait in self.flow(max_moves):
                 self._run(wait)
-            report = game_report(self, time.perf_counter() - wall0)
+            report = self.report(time.perf_counter() - wall0)
         except GameInterrupted as exc:
-            self._end("interrupted", signal=exc.why, boundary=True)
+            self.end_record("interrupted", signal=exc.why, boundary=True)
             raise
         except KeyboardInterrupt:  # no handler sent it through interrupt(): anywhere in a chart step
-            self._end("interrupted", signal="SIGINT", boundary=False)
+            self.end_record("interrupted", signal="SIGINT", boundary=False)
             raise
         except Exception as exc:
             interrupt = interruption(exc)  # the signal landed in a C extension's import, say
             if interrupt is not None:
-                self._end("interrupted", signal=str(getattr(interrupt, "signal", "SIGINT")), boundary=False)
+                self.end_record("interrupted", signal=str(getattr(interrupt, "signal", "SIGINT")), boundary=False)
             else:
-                self._end("error", message=str(exc) if isinstance(exc, GameError)
+                self.end_record("error", message=str(exc) if isinstance(exc, GameError)
                           else f"{type(exc).__name__}: {exc}", boundary=isinstance(exc, GameError))
             raise
         finally:
             gc.unfreeze()
-        self._end("finished", outcome=report["outcome"], boundary=True)
+        self.end_record("finished", outcome=report["outcome"], boundary=True)
         return report
 
     def record_start(self, max_moves: int) -> None:
         """The record's first line: what a replay of the record needs."""
-        self.add_event("game", seed=self.robot.seed, robot_symbol=self.robot_symbol, engine=self.engine_name,
+        self._event("game", seed=self.robot.seed, robot_symbol=self.robot_symbol, engine=self.engine_name,
                     person=getattr(self.person, "name", type(self.person).__name__), camera=self.camera.mode,
                     params_sha256=params_digest(self.params), time_limit_s=self.time_limit_s, max_moves=max_moves)
 
-    def _end(self, how: str, **data: Any) -> None:
+    def end_record(self, how: str, **data: Any) -> None:
         """The record's last event (where the game stood, and its state), and the board picture of the moment."""
         if self.record.ended is not None:
             return
@@ -422,14 +409,30 @@ class GameSession:
         where = {"waiting_for": wait.what if wait is not None else "the start of the game",
                  "control": sorted(self.robot.active("Control")), "game": sorted(self.robot.active("Game"))}
         if how != "finished":
-            save_board(self, "final" if "final" not in self.pictures else "erased", ending=how)
-        self.add_event(how, **data, **({} if how == "finished" else where), pictures=dict(self.pictures),
+            self._save_board("final" if "final" not in self.pictures else "erased", ending=how)
+        self._event(how, **data, **({} if how == "finished" else where), pictures=dict(self.pictures),
                     state=self.checkpoint())
         self.record.close()
 
-    def flow(self, max_moves: int = 25) -> Flow:
-        """The game as this session plays it (:func:`.game_flow.flow`): a generator of what it waits for."""
-        return game_flow.flow(self, max_moves)
+    def _save_board(self, which: str, ending: str | None = None) -> None:
+        """The board picture ``board_<which>.png`` in ``out_dir`` (nothing without one)."""
+        if self.out_dir is None:
+            return
+        robot = self.robot
+        ink = robot.board.ink_area_mm2()
+        if which == "final":
+            how = {None: outcome_in_words(self.outcome, self.robot_symbol, self.person_symbol),
+                   "interrupted": "the game interrupted",
+                   "error": "the game stopped by an error"}[ending]
+            title = f"The whiteboard at the end of the game: {how}, {len(self.moves)} moves played"
+        else:
+            title = "The whiteboard after erasing" if ending is None else \
+                f"The whiteboard while erasing: {'interrupted' if ending == 'interrupted' else 'an error'}"
+        path = save_board_picture(
+            robot.board, self.out_dir / f"board_{which}.png", title,
+            f"the robot plays {self.robot_symbol} (blue ink), the person {self.person_symbol} (black ink); "
+            f"seed {robot.seed}, simulated time {robot.t:.1f} s, {ink:.0f} mm² of ink on the board")
+        self.pictures[which] = str(path)
 
     def drive(self, max_moves: int = 25) -> GameDriver:
         """Play the game from inside the chart steps from now on: whoever steps the robot plays it.
@@ -441,31 +444,67 @@ class GameSession:
             self.driver = GameDriver(self, max_moves)
         return self.driver
 
-    def checkpoint(self) -> dict[str, Any]:
-        """The state of a game at a chart-step boundary, as a record keeps it: readable parts and one digest.
+    def flow(self, max_moves: int = 25) -> Flow:
+        """The game as the session plays it: the person's turns, the robot's, the end.
 
-        Readable: the chart tick, simulated time, both boards, the moves, every
-        chart's active states.  ``digest``: SHA-256 over all of that plus every
-        chart's data, the session's flags and the simulated arm's ground truth
-        (joint and motor angles, currents, speeds, the encoders, the duties),
-        float for float; a replay that reaches the same digest reached the same state.
+        A generator: it yields a :class:`Wait` whenever the charts must run
+        before it can go on, and does its part (the person draws and clicks
+        Play, the camera looks, the board is updated) between chart steps.
+        :meth:`play` runs it with ``Robot.run_until``, a :class:`GameDriver`
+        from inside the chart steps.
         """
+        self.say("initialising, then drawing the field")
+        yield Wait(self._waiting_or_stopped, 300.0, "initialising and drawing the field")
+        self._event("field_drawn")
+        # Each turn adds one move; a GUI's person's turn may end without one (the symbols
+        # changed before the first move, or Stop): X moves when the number of moves is even.
+        while result_of(self.board) is None and len(self.moves) < max_moves and not self._stopped():
+            to_move = "X" if len(self.moves) % 2 == 0 else "O"
+            if to_move == self.person_symbol:
+                if not (yield from self._person_turn()):
+                    break
+            else:
+                yield from self._robot_turn()
+        stopped = self._stopped() and result_of(self.board) is None
+        outcome = result_of(self.board) or ("given_up" if self._given_up else "halted" if stopped else "abandoned")
+        self.outcome = outcome
+        self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3, "given_up": 4}.get(outcome, 3)
+        self._event("result", outcome=outcome)
+        self._save_board("final")  # the board as the game ended, before the sponge
+        self.say(f"result: {outcome_in_words(outcome, self.robot_symbol, self.person_symbol)}; "
+                 "erasing and turning off")
+        yield Wait(lambda: self.game.ended, 600.0, "erasing and turning off")
+        self._save_board("erased")
+
+    def report(self, wall_s: float) -> dict[str, Any]:
+        """What a game reports (docs/play.md, "What it reports"); `wall_s`: the wall time it took."""
         robot = self.robot
-        charts = {name: sorted(str(s) for s in c.configuration_values) for name, c in robot.charts.items()}
-        state: dict[str, Any] = {"tick": robot.chart_ticks, "steps": robot.steps, "t": robot.t,
-                                 "board": self.board, "truth": self.truth, "moves": len(self.moves),
-                                 "charts": charts}
-        full = {**state, "data": {name: jsonable(c.snapshot()) for name, c in robot.charts.items()},
-                "session": jsonable(self.state())}
-        sim = robot.sim
-        if sim is not None:
-            arrays = [sim.q_encoder, sim.duty, sim.truth.q, sim.truth.q_motor, sim.truth.current_a,
-                      sim.truth.speed_motor, sim.truth.speed_load]
-            full["twin"] = hashlib.sha256(b"".join(np.ascontiguousarray(a, dtype=np.float64).tobytes()
-                                                   for a in arrays)).hexdigest()
-        state["t"] = round(robot.t, 6)
-        state["digest"] = hashlib.sha256(dumps(full, sort_keys=True).encode()).hexdigest()
-        return state
+        outcome = self.outcome or "abandoned"
+        ink_left = robot.board.ink_area_mm2()
+        winner = {self.robot_symbol: "robot", self.person_symbol: "person", "given_up": "robot"}.get(outcome, outcome)
+        return {
+            "winner": winner,
+            "outcome": outcome,
+            "moves": self.moves,
+            "robot_symbol": self.robot_symbol,
+            "detections_correct": self.detections_correct,
+            "detections_wrong": self.detections_wrong,
+            "sim_time_s": round(robot.t, 3),
+            "wall_time_s": round(wall_s, 3),
+            "realtime_factor": round(robot.t / wall_s, 1),
+            "setup_wall_s": round(self.setup_wall_s, 3),
+            "erased": ink_left == 0.0,
+            "ink_left_mm2": round(ink_left, 3),
+            "camera": self.camera.mode,
+            "camera_link": self.camera.stats(),
+            "camera_wall_s": round(self.camera.read_wall_s, 3),
+            "ignored_play_clicks": self.activator.ignored_triggers,
+            **(NO_PRECISION if self.pen_path is None else self.pen_path.precision()),
+        }
+
+    def checkpoint(self) -> dict[str, Any]:
+        """The state of the game now, as its record keeps it (:func:`.game_record.checkpoint`)."""
+        return checkpoint(self.robot, self.state())
 
     def state(self) -> dict[str, Any]:
         """The session's own state (boards, moves, flags), plain data: what a replay must reproduce too."""
@@ -473,6 +512,100 @@ class GameSession:
                 "o_pos": self.o_pos, "result": self.result_code, "outcome": self.outcome,
                 "pending_move": self.pending_move, "erase_started": self.erase_started,
                 "erased_seen": self.erased_seen, "detections": [self.detections_correct, self.detections_wrong]}
+
+    def _click_play(self) -> None:
+        self.robot.post("AlgorithmActivator", "trigger")
+
+    def _person_turn(self) -> Generator[Wait, None, bool]:
+        robot = self.robot
+        step = self.params.control.chart_dt
+        # The Game chart shows whose turn it is before the person is asked.
+        yield Wait(lambda: True, step, "the Game chart to show whose turn it is", tell=False)
+        yield Wait(lambda: True, step, "the person's move")
+        if self.remote:
+            # The person draws by clicking cells (person_draws), then clicks Play: the camera looks then.
+            self.drawn, self.play_pressed, self.awaiting = [], False, "draw"
+            try:
+                yield self._remote_wait("the person's move and Play", self.person_symbol)
+            finally:
+                self.awaiting = None
+            if not self.play_pressed:
+                return True  # the symbols changed before the first move, or Stop: the flow decides again
+            self.play_pressed = False
+            cell = self.drawn[-1]
+        else:
+            self._waiting_for_person = True  # an interrupt now stops the game at once
+            try:
+                if self._stop_request is not None:
+                    raise GameInterrupted(self._stop_request)
+                chosen = self.person.choose(self.truth, self.person_symbol)
+            finally:
+                self._waiting_for_person = False
+            if chosen is None:
+                self._given_up = True
+                self._event("given_up", moves=len(self.moves))
+                return False
+            cell = chosen
+            self.person_draws(cell)
+        percentages, symbols = self._look()
+        try:
+            seen = percent_process(percentages, self.robot_cells, self.person_cells, robot_ink=self.robot_ink,
+                                   symbols=symbols, robot_symbol=self.robot_symbol)
+        except MoveError as exc:
+            self.detections_wrong += 1
+            message = getattr(exc, "message_for_person", str(exc))
+            self.person.tell(message)
+            self._event("detection_rejected", message=message)
+            raise GameError(f"the camera's view was refused: {message}") from exc
+        ok = seen.new == cell
+        self.detections_correct += ok
+        self.detections_wrong += not ok
+        self._event("detected", row=seen.new[0] if seen.new else None,
+                        column=seen.new[1] if seen.new else None, correct=ok,
+                        percentages=[round(p, 1) for p in percentages])
+        if seen.new is not None:
+            self.person_cells.append(seen.new)
+            self._set_board(seen.new, self.person_symbol)
+            self.o_pos |= 1 << cell_index(*seen.new)
+        self.moves.append({"by": "person", "symbol": self.person_symbol, "row": cell[0], "column": cell[1],
+                           "t": round(robot.t, 3), "detected": list(seen.new) if seen.new else None})
+        if result_of(self.board) is None:
+            self._click_play()  # the person's Play click: the robot's turn
+        return True
+
+    def _robot_turn(self) -> Flow:
+        robot = self.robot
+        if not self.moves:
+            if self.remote:  # the person clicks Play for the manipulator to open the game
+                self.play_pressed, self.awaiting = False, "play"
+                try:
+                    yield self._remote_wait("Play for the manipulator's first move", self.person_symbol)
+                finally:
+                    self.awaiting = None
+                if not self.play_pressed:
+                    return  # the symbols changed, or Stop: the flow decides again
+                self.play_pressed = False
+            self._click_play()  # the robot opens: Play without a drawing first
+        self.pending_move = None
+        yield Wait(lambda: self.pending_move is not None or self._stopped(), 10.0, "the algorithm's answer")
+        if self._stopped():
+            return  # Stop: the manipulator returns to its start pose instead
+        cell = self.pending_move
+        assert cell is not None
+        step = self.params.control.chart_dt
+        yield Wait(lambda: True, step, "the Control chart to take the move", tell=False)
+        yield Wait(lambda: True, step, "the Control chart to take the move", tell=False)
+        yield Wait(self._waiting_or_stopped, 120.0, f"drawing the robot's move {cell}")
+        if self._stopped():
+            return  # Stop in the middle of the stroke: the pen is lifted, the move not made
+        self.robot_cells.append(cell)
+        self._set_board(cell, self.robot_symbol)
+        self._place(cell, self.robot_symbol, "truth")
+        percentages, _ = self._look()
+        self.robot_ink[cell] = percentages[cell_index(*cell)]
+        self.moves.append({"by": "robot", "symbol": self.robot_symbol, "row": cell[0], "column": cell[1],
+                           "t": round(robot.t, 3)})
+        self.person.tell(f"The manipulator drew {self.robot_symbol} in row {cell[0]}, column {cell[1]}.")
 
     def save(self, out_dir: Path | None = None) -> dict[str, str]:
         """The files of the game: the record (``game.jsonl``) and the board pictures.
@@ -488,7 +621,7 @@ class GameSession:
             self.record.attach(out_dir / "game.jsonl")
             if "final" not in self.pictures:
                 ended = self.record.ended
-                save_board(self, "final", ending=ended if ended in ("interrupted", "error") else None)
+                self._save_board("final", ending=ended if ended in ("interrupted", "error") else None)
         files = {"record": str(self.record.path)}
         if "final" in self.pictures:
             files["board_png"] = self.pictures["final"]
@@ -500,7 +633,7 @@ class GameSession:
         """Stop the camera emulator; close the record (a game not played to its end: ended as interrupted)."""
         try:
             if self.record.attached and self.record.ended is None and self.record.events:
-                self._end("interrupted", signal="closed before the end", boundary=True)
+                self.end_record("interrupted", signal="closed before the end", boundary=True)
             self.record.close()
         finally:
             self.camera.close()

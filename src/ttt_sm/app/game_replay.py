@@ -15,7 +15,7 @@ from typing import Any
 
 from ..params import ArmParams
 from .game import GameSession
-from .game_errors import GameError, GameInterrupted
+from .game_outcome import GameError, GameInterrupted
 from .game_record import ENDINGS, params_digest, read_record
 
 

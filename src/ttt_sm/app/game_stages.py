@@ -1,13 +1,14 @@
 """The game inside the chart steps: what the flow waits for, and the stages the game adds to the scheduler.
 
-:class:`Wait` is what the session's flow (:meth:`~.game.GameSession.flow`)
+:class:`Wait` is what the session's flow (:meth:`.game.GameSession.flow`)
 yields between two of its moves; a :class:`GameDriver` plays that flow from
 inside the chart steps (a debugger or a GUI stepping the robot).  Two stages
 join the robot's scheduler: :class:`GameStage` runs the Game and
 AlgorithmActivator charts before the Control chart (thesis section 3.6,
 fig. 3.29: the engine asked on the activator's ``enable``), and
 :class:`PenPathStage` keeps where the Control chart sends the pen, for the
-game's drawing precision.
+game's drawing precision.  What they need of the session is
+:class:`StagedSession` (:class:`~.game.GameSession` is one).
 """
 
 from __future__ import annotations
@@ -15,17 +16,18 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Generator
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 import numpy as np
 
+from ..charts.game import AlgorithmActivator, Game
 from ..sched.scheduler import Signals
-from .game_errors import GameError
+from .game_outcome import GameError
 from .robot import Robot
 from .wiring import Wiring, not_wired
 
-if TYPE_CHECKING:
-    from .game import GameSession
+#: The drawing precision of a game with nothing to compare (no ink, no pen-down path, no ground truth).
+NO_PRECISION: dict[str, float | None] = {"drawing_rms_mm": None, "drawing_max_mm": None}
 
 
 @dataclass(frozen=True)
@@ -44,8 +46,35 @@ class Wait:
     tell: bool = True
 
 
-#: The game flow (:func:`.game_flow.flow`): yields what it waits for, returns at the end of the game.
+#: The game flow (:meth:`.game.GameSession.flow`): yields what it waits for, returns at the end of the game.
 Flow = Generator[Wait, None, None]
+
+
+class StagedSession(Protocol):
+    """What the game's stage and driver use of the session: its charts, flags and flow, its record's end."""
+
+    robot: Robot
+    game: Game
+    activator: AlgorithmActivator
+    driver: GameDriver | None
+    outcome: str | None
+    erase_started: bool
+    erased_seen: bool
+
+    def flow(self, max_moves: int = 25) -> Flow:
+        """The game flow, from its start."""
+
+    def watch(self, wait: Wait) -> bool:
+        """After a chart step: whether ``wait`` is over (the person is shown the Game chart's news)."""
+
+    def wait_failed(self, wait: Wait) -> GameError:
+        """The error of a wait that timed out."""
+
+    def robot_turn_now(self) -> None:
+        """The activator enabled the engine: its move goes to the Control chart."""
+
+    def end_record(self, how: str, **data: Any) -> None:
+        """The record's last event: how the game ended."""
 
 
 class GameDriver:
@@ -61,7 +90,7 @@ class GameDriver:
     out of a chart step.
     """
 
-    def __init__(self, session: GameSession, max_moves: int) -> None:
+    def __init__(self, session: StagedSession, max_moves: int) -> None:
         self.session = session
         self._flow: Flow | None = session.flow(max_moves)
         self.wait: Wait | None = None
@@ -97,7 +126,7 @@ class GameDriver:
             self.wait = next(flow)
         except StopIteration:
             self._flow, self.wait, self.done = None, None, True
-            self.session._end("finished", outcome=self.session.outcome, boundary=True)
+            self.session.end_record("finished", outcome=self.session.outcome, boundary=True)
             return
         except GameError as exc:
             self._stop(exc)
@@ -108,7 +137,7 @@ class GameDriver:
         assert self._flow is not None
         self._flow.close()
         self._flow, self.error = None, error
-        self.session._end("error", message=str(error), boundary=True)
+        self.session.end_record("error", message=str(error), boundary=True)
 
 
 class GameStage:
@@ -120,7 +149,7 @@ class GameStage:
     through, the engine asked when the activator enables it.
     """
 
-    def __init__(self, session: GameSession) -> None:
+    def __init__(self, session: StagedSession) -> None:
         self.s = session
         self._feed_game: Callable[[], None] = not_wired
         self._after_game: Callable[[], tuple[bool, bool, bool]] = not_wired
@@ -161,7 +190,7 @@ class GameStage:
 class PenPathStage:
     """Joint stage: where the Control chart sends the pen each chart step while it draws (not erasing).
 
-    For the game's drawing precision (:func:`.game_report.drawing_precision`): the
+    For the game's drawing precision (:meth:`precision`, in :meth:`.game.GameSession.report`): the
     robot's ink against these desired pen-down paths, as ``ttt-sm draw``
     measures one drawing (thesis section 3.5).  Simulation only: the ink is
     the true pen's.
@@ -198,3 +227,16 @@ class PenPathStage:
             self.xyz.append((c.X_out, c.Y_out, math.inf))
             self._down = False
 
+    def precision(self) -> dict[str, float | None]:
+        """The robot's ink against the desired pen-down paths of the whole game, mm (None: nothing to compare)."""
+        from .drawing import _distance_to_runs, _pen_down_runs
+
+        ink = [p for p in self.robot_ink() if len(p)]
+        if not ink or not self.xyz:
+            return dict(NO_PRECISION)
+        runs = _pen_down_runs(np.asarray(self.xyz), self.surface_z)
+        if not runs:
+            return dict(NO_PRECISION)
+        err = _distance_to_runs(np.vstack(ink), runs) * 1e3
+        return {"drawing_rms_mm": round(float(np.sqrt(np.mean(err ** 2))), 4),
+                "drawing_max_mm": round(float(err.max()), 4)}

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..game.bitboard import FULL, bits, cell_index, cell_of, win_cells
 from ..game.rules import parse_board
-from .game_errors import GameError
+from .game_outcome import GameError
 
 #: A cell of the 5x5 field, 1-based: (row, column).
 Cell = tuple[int, int]

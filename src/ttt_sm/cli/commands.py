@@ -78,7 +78,7 @@ def cmd_play(args: argparse.Namespace) -> int:
     import signal
 
     from ..app.game import GameSession
-    from ..app.game_errors import GameInterrupted
+    from ..app.game_outcome import GameInterrupted
     from ..app.game_record import GameRecord
     from ..app.person import SimulatedPerson, TerminalPerson
 
@@ -156,7 +156,7 @@ def cmd_play(args: argparse.Namespace) -> int:
 
 
 def _play_game(session: GameSession) -> dict[str, Any]:
-    from ..app.game_errors import GameError
+    from ..app.game_outcome import GameError
 
     try:
         return session.play()

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from ..app.game_errors import GameError
+from ..app.game_outcome import GameError
 from ..app.robot import Robot, RobotError
 from ..runtime import Data, UnknownEventError
 from .errors import DebugError

@@ -5,17 +5,18 @@ at a time and stops *between control steps*.  A chart tick is the first part
 of the control step it starts (every ``chart_divider``-th step), so when a
 breakpoint hits at chart tick *k* the debugger stops right after the control
 step holding tick *k*: the charts show the configuration and data that tick
-produced, and the twin has moved one control step (1 ms) since.
+produced, and the twin has moved one control step (1 ms) since (the loop:
+:mod:`.stepping`).
 
 It watches the charts through python-statemachine listeners only (a
 :class:`~ttt_sm.runtime.listeners.Trace` and a
 :class:`~.breakpoints.BreakListener`), so it sees exactly what the library did.
 
 Everything the user changes (inputs set or forced, events posted) is recorded
-with the control step it was applied at; :meth:`Debugger.replay` rebuilds the
+with the control step it was applied at (:mod:`.inputs`); :meth:`Debugger.replay` rebuilds the
 robot from its recipe (parameters, seed, power-on pose), re-applies them at the
 same steps and runs to a chart tick, and tells whether it arrived in exactly the
-state recorded when the session was there before.
+state recorded when the session was there before (:mod:`.history`).
 
 A robot built with the game (:class:`~.replay.GameRecipe`, ``ttt-sm debug
 --game``) carries the Game and AlgorithmActivator charts and plays its game
@@ -25,7 +26,7 @@ stops at the robot's turn.
 
 Besides the trace it keeps a :class:`~.timeline.Timeline` (when each state
 was entered and left) and the charts' data as they were just before the last
-chart tick, for :meth:`Debugger.data_diff`.
+chart tick, for :meth:`Debugger.data_diff` (:mod:`.watch`).
 
 Bounded in memory: the trace keeps the newest :data:`TRACE_KEEP` transitions
 (a ring buffer); given a ``trace_path``, the whole trace is streamed to that

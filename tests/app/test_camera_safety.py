@@ -13,7 +13,8 @@ from __future__ import annotations
 import time
 
 from ttt_sm.app.camera_link import CameraLink, CameraLost
-from ttt_sm.app.game import GameError, GameSession
+from ttt_sm.app.game import GameSession
+from ttt_sm.app.game_outcome import GameError
 from ttt_sm.params import load_params
 from ttt_sm.seriallink import Fault
 from ttt_sm.twin.whiteboard import Whiteboard

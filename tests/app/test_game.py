@@ -6,7 +6,9 @@ import json
 import cv2
 import pytest
 
-from ttt_sm.app.game import GameSession, SimulatedPerson, TerminalPerson, result_of
+from ttt_sm.app.game import GameSession
+from ttt_sm.app.game_outcome import result_of
+from ttt_sm.app.person import SimulatedPerson, TerminalPerson
 from ttt_sm.charts.game import MSG_DRAWING, MSG_ERASING, MSG_TURNING_OFF, MSG_YOUR_TURN
 from ttt_sm.cli import main
 from ttt_sm.params import load_params

@@ -26,9 +26,10 @@ import cv2
 import numpy as np
 import pytest
 
-from ttt_sm.app.game import GameSession, SimulatedPerson, TerminalPerson
+from ttt_sm.app.game import GameSession
 from ttt_sm.app.game_record import ENDINGS, read_record
 from ttt_sm.app.game_replay import replay_record
+from ttt_sm.app.person import SimulatedPerson, TerminalPerson
 from ttt_sm.charts.game import RESULT_MESSAGES
 from ttt_sm.params import load_params
 from ttt_sm.twin.board_picture import save_board_picture
@@ -117,7 +118,7 @@ def test_a_perfect_person_is_not_beaten_quickly(tmp_path):
 
 
 def test_every_game_is_bounded_in_simulated_time():
-    from ttt_sm.app.game import GameError
+    from ttt_sm.app.game_outcome import GameError
 
     session = GameSession(P, seed=0, camera="direct", record_trace=False, time_limit_s=20.0)
     try:

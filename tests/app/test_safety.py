@@ -10,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ttt_sm.app.game import GameError, GameSession
+from ttt_sm.app.game import GameSession
+from ttt_sm.app.game_outcome import GameError
 from ttt_sm.app.init_wiring import random_power_on
 from ttt_sm.app.robot import Robot
 from ttt_sm.params import load_params

@@ -12,7 +12,8 @@ import re
 
 import pytest
 
-from ttt_sm.app.game import GameSession, Wait
+from ttt_sm.app.game import GameSession
+from ttt_sm.app.game_stages import Wait
 from ttt_sm.charts.game import MSG_DRAWING
 from ttt_sm.debug import Debugger
 from ttt_sm.debug.replay import differences

@@ -16,377 +16,46 @@ step's end when asked to (:meth:`GameSession.interrupt`, from a signal
 handler; at once while it waits for the person), and its record then ends
 with the ``interrupted`` event; every game is bounded in simulated time
 (``time_limit_s``).
-"""
 
+Beside the session: who plays against the robot (:mod:`.person`), the engine
+chosen by name (:mod:`.engines`), how a game ends (:mod:`.game_outcome`), and
+the game inside the chart steps, its stages and driver (:mod:`.game_stages`).
+"""
 from __future__ import annotations
 
 import gc
-import hashlib
 import math
-import sys
 import time
-from collections import deque
 from collections.abc import Callable, Generator, Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
-
-import numpy as np
+from typing import Any
 
 from ..arm import Arm
 from ..charts.game import AlgorithmActivator, Game
-from ..game.bitboard import FULL, bits, cell_index, cell_of, win_cells
-from ..game.rules import is_full, parse_board, winner
+from ..game.bitboard import cell_index
 from ..params import ArmParams
-from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
 from ..runtime.recordfile import interruption
-from ..sched.scheduler import Signals
 from ..twin.board_picture import save_board_picture
 from ..twin.truth import GroundTruth
 from ..vision import MoveError, percent_process
 from .camera_link import CameraLink, CameraLost
-from .game_record import GameRecord, params_digest
+from .engines import engine_for
+from .game_outcome import GameError, GameInterrupted, outcome_in_words, result_of
+from .game_record import GameRecord, checkpoint, params_digest
+from .game_stages import NO_PRECISION, Flow, GameDriver, GameStage, PenPathStage, Wait
+from .person import Cell, Person, RemotePerson, SimulatedPerson
 from .robot import Robot
 from .wires import GAME_WIRES
-from .wiring import Wiring, not_wired
-
-Cell = tuple[int, int]
 
 #: How long the game waits for a person at a GUI to draw and click Play, simulated s.
 PERSON_WAIT_S = 24 * 3600.0
-
-
 #: Longest a game may run, in simulated seconds, unless told otherwise: a whole game of 25 moves
 #: takes about 450 s (a usual one about 190 s), so only a game that is stuck reaches it.
 DEFAULT_TIME_LIMIT_S = 1200.0
 #: Longest the game waits, once the camera is lost, for the Safety chart to lift the pen and hold, s of simulated
 #: time (its lift gives up after 2 s).
 CAMERA_LIFT_S = 3.0
-
-#: The strengths of the simulated person (``ttt-sm play --person``).
-PERSON_STRENGTHS = ("random", "greedy", "thesis", "perfect")
-
-
-class GameError(RuntimeError):
-    """The game cannot go on (a chart did not finish its job in time, the camera went silent)."""
-
-
-class GameInterrupted(Exception):
-    """The game was stopped from outside (:meth:`GameSession.interrupt`: Ctrl-C, SIGTERM); ``why`` says how."""
-
-    def __init__(self, why: str) -> None:
-        super().__init__(f"interrupted ({why})")
-        self.why = why
-
-
-class Person(Protocol):
-    """Who plays against the robot."""
-
-    def choose(self, board: str, symbol: str) -> Cell | None:
-        """A free cell to draw `symbol` in (1-based), or None to give up."""
-
-    def tell(self, message: str) -> None:
-        """Show the person a message (the Tic-tac-toe GUI's text box)."""
-
-
-def _masks(board: str) -> tuple[int, int]:
-    b = parse_board(board)
-    return b.marks("X"), b.marks("O")
-
-
-def result_of(board: str) -> str | None:
-    """'X' or 'O' for a win, 'draw' for a full board, None while the game is on."""
-    b = parse_board(board)
-    won = winner(b)
-    if won is not None:
-        return won
-    return "draw" if is_full(b) else None
-
-
-def outcome_in_words(outcome: str | None, robot_symbol: str, person_symbol: str) -> str:
-    """How a game ended, for a person to read: who won, or why there is no winner."""
-    return {robot_symbol: f"the robot ({robot_symbol}) won", person_symbol: f"the person ({person_symbol}) won",
-            "draw": "a draw: the board is full", "given_up": "the person gave up",
-            "halted": "stopped before a result", "abandoned": "ended without a result"}.get(outcome or "abandoned",
-                                                                                           str(outcome))
-
-
-class SimulatedPerson:
-    """A simulated person at the board, at one of :data:`PERSON_STRENGTHS`:
-
-    - ``random``: any free cell;
-    - ``greedy`` (the default): wins when one move wins, blocks when one move loses, else random;
-    - ``thesis``: the thesis' three-ply minimax (:class:`~ttt_sm.game.thesis_engine.ThesisEngine`);
-    - ``perfect``: never a move that lets the robot force a win, else random
-      (:class:`~ttt_sm.game.opponents.PerfectEngine`): against the strong engine, a draw.
-    """
-
-    def __init__(self, seed: int = 0, say: Callable[[str], None] | None = None, strength: str = "greedy") -> None:
-        if strength not in PERSON_STRENGTHS:
-            raise ValueError(f"unknown person strength {strength!r}; choose from {', '.join(PERSON_STRENGTHS)}")
-        self.rng = np.random.default_rng(seed)
-        self.say = say
-        self.strength = strength
-        self.name = f"simulated {strength}"
-        self._engine: Any = None
-        if strength != "greedy":
-            from ..game.opponents import PerfectEngine, RandomEngine
-            from ..game.thesis_engine import ThesisEngine
-
-            self._engine = {"random": lambda: RandomEngine(seed), "thesis": ThesisEngine,
-                            "perfect": lambda: PerfectEngine(seed)}[strength]()
-
-    def choose(self, board: str, symbol: str) -> Cell | None:
-        if self._engine is not None:
-            from ..game.engine import GameOver
-
-            answer = self._engine.move(board, symbol)
-            return None if isinstance(answer, GameOver) else (answer.row, answer.column)
-        x, o = _masks(board)
-        mine, theirs = (x, o) if symbol == "X" else (o, x)
-        empty = FULL & ~(x | o)
-        for mask in (win_cells(mine, theirs), win_cells(theirs, mine)):
-            if mask & empty:
-                return cell_of(bits(mask & empty)[0])
-        free = bits(empty)
-        return cell_of(int(self.rng.choice(free))) if free else None
-
-    def tell(self, message: str) -> None:
-        if self.say:
-            self.say(f"  [person] {message}")
-
-
-class TerminalPerson:
-    """The person at the terminal: types a cell ("2 3" = row 2, column 3); q gives up."""
-
-    name = "terminal"
-
-    def __init__(self, stdin: Any = None, stdout: Any = None) -> None:
-        self.stdin = stdin or sys.stdin
-        self.stdout = stdout or sys.stdout
-
-    def choose(self, board: str, symbol: str) -> Cell | None:
-        self.stdout.write(_board_picture(board) + "\n")
-        while True:
-            self.stdout.write(f"Your move ({symbol}): row column, e.g. 2 3 (q to give up): ")
-            self.stdout.flush()
-            line = self.stdin.readline()
-            if not line or line.strip().lower() in ("q", "quit"):
-                return None
-            parts = line.replace(",", " ").split()
-            if len(parts) == 2 and all(p.isdigit() for p in parts):
-                r, c = int(parts[0]), int(parts[1])
-                if 1 <= r <= 5 and 1 <= c <= 5 and board[cell_index(r, c)] == ".":
-                    return r, c
-                self.stdout.write(f"cell ({r}, {c}) is not a free cell of the 5x5 field\n")
-            else:
-                self.stdout.write(f"not a cell: {line.strip()!r}\n")
-
-    def tell(self, message: str) -> None:
-        self.stdout.write(message + "\n")
-        self.stdout.flush()
-
-
-class RemotePerson:
-    """The person at a GUI (the browser's ``/game`` page): draws by clicking cells, then clicks Play.
-
-    Nothing here decides: the page's clicks reach the :class:`GameSession`
-    (:meth:`GameSession.person_draws`, :meth:`GameSession.press_play`), whose
-    flow waits for them; the simulated hand draws each clicked cell on the
-    whiteboard and the camera reads the board when Play is clicked, as in
-    ``ttt-sm play``.  What the game tells the person is kept for the page.
-    """
-
-    def __init__(self, keep: int = 50) -> None:
-        self.messages: deque[str] = deque(maxlen=keep)
-        #: Messages told so far (the page shows the newest ones).
-        self.told = 0
-
-    def choose(self, board: str, symbol: str) -> Cell | None:
-        raise GameError("the person at the page plays by clicking cells; the flow does not ask them")
-
-    def tell(self, message: str) -> None:
-        self.messages.append(message)
-        self.told += 1
-
-
-def _board_picture(board: str) -> str:
-    rows = ["    1 2 3 4 5"]
-    for r in range(5):
-        rows.append(f"  {r + 1} " + " ".join(board[5 * r:5 * r + 5]))
-    return "\n".join(rows)
-
-
-@dataclass(frozen=True)
-class Wait:
-    """What the game flow waits for between two of its moves.
-
-    Chart steps run until ``until()`` holds (checked after each step), at most
-    ``timeout_s`` of simulated time; ``what`` names it in the error a timeout
-    raises.  ``tell``: the Game chart's new messages are shown to the person
-    meanwhile.
-    """
-
-    until: Callable[[], bool]
-    timeout_s: float
-    what: str
-    tell: bool = True
-
-
-#: The game flow (:meth:`GameSession.flow`): yields what it waits for, returns at the end of the game.
-Flow = Generator[Wait, None, None]
-
-
-class GameDriver:
-    """Plays the game flow from inside the chart steps: whoever steps the robot plays the game.
-
-    :meth:`GameSession.play` runs the flow itself (``Robot.run_until`` for each
-    :class:`Wait`).  A debugger or a GUI steps the robot one control step at a
-    time instead; with a driver (:meth:`GameSession.drive`) the Game stage
-    checks the flow's wait at the start of each chart step, that is right after
-    the previous chart step, where ``run_until`` checks it: the same game,
-    move for move.  A wait that times out, or a camera view the game refuses,
-    ends the flow with :attr:`error` (the charts run on); nothing is raised
-    out of a chart step.
-    """
-
-    def __init__(self, session: GameSession, max_moves: int) -> None:
-        self.session = session
-        self._flow: Flow | None = session.flow(max_moves)
-        self.wait: Wait | None = None
-        #: Chart steps run since the flow began its current wait.
-        self.waited = 0
-        #: Why the flow stopped before the end of the game (a wait that timed out, a refused view).
-        self.error: GameError | None = None
-        #: The flow ran to its end: the game is over and the arm turned off.
-        self.done = False
-
-    @property
-    def running(self) -> bool:
-        """The flow has not ended (neither finished nor stopped by an error)."""
-        return self._flow is not None
-
-    def before_chart_step(self) -> None:
-        """Called at the start of every chart step: check the wait, go on with the flow when it holds."""
-        flow = self._flow
-        if flow is None:
-            return
-        wait = self.wait
-        if self.session.robot.tripped:
-            self._stop(GameError(f"safety stop: {self.session.robot.safety.reason}"))
-            return
-        if wait is not None:
-            self.waited += 1
-            if not self.session.watch(wait):
-                limit = self.session.robot.sched.ticks_for(wait.timeout_s)
-                if self.waited >= limit:
-                    self._stop(self.session.wait_failed(wait))
-                return
-        try:
-            self.wait = next(flow)
-        except StopIteration:
-            self._flow, self.wait, self.done = None, None, True
-            self.session._end("finished", outcome=self.session.outcome, boundary=True)
-            return
-        except GameError as exc:
-            self._stop(exc)
-            return
-        self.waited = 0
-
-    def _stop(self, error: GameError) -> None:
-        assert self._flow is not None
-        self._flow.close()
-        self._flow, self.error = None, error
-        self.session._end("error", message=str(error), boundary=True)
-
-
-class GameStage:
-    """Task stage before the Control chart: the Game and AlgorithmActivator charts and the engine.
-
-    What feeds the two charts and where their outputs go is the wiring
-    table's (:data:`~ttt_sm.app.wires.GAME_WIRES`); this stage runs them and
-    the session's part: the erase flag set once per game, the erasing seen
-    through, the engine asked when the activator enables it.
-    """
-
-    def __init__(self, session: GameSession) -> None:
-        self.s = session
-        self._feed_game: Callable[[], None] = not_wired
-        self._after_game: Callable[[], tuple[bool, bool, bool]] = not_wired
-        self._feed_activator: Callable[[], None] = not_wired
-        self._enable: Callable[[], bool] = not_wired
-
-    def blocks(self) -> dict[str, object]:
-        """The session holds the Session block's outputs."""
-        return {"Session": self.s}
-
-    def wire(self, wiring: Wiring) -> None:
-        """Compile this stage's part of the wiring table."""
-        s = self.s
-        self._feed_game = wiring.feed([s.game.chart_name])
-        self._after_game = wiring.collect("EraseFlag.request", "Session.erasing", "Session.field_drawn")
-        self._feed_activator = wiring.feed([s.activator.chart_name])
-        self._enable = wiring.collect("Session.enable")
-
-    def tick(self, signals: Signals) -> None:
-        s = self.s
-        if s.driver is not None:
-            s.driver.before_chart_step()
-        self._feed_game()
-        s.game.tick()
-        request, erasing, field_drawn = self._after_game()
-        flag = s.robot.control_stage
-        if request and not flag.erase_requested and not s.erase_started:
-            flag.erase_requested = True
-            s.erase_started = True
-        if s.erase_started and not s.erased_seen and not erasing and not field_drawn:
-            s.erased_seen = True
-        self._feed_activator()
-        s.activator.tick()
-        if self._enable():
-            s.robot_turn_now()
-
-
-class PenPathStage:
-    """Joint stage: where the Control chart sends the pen each chart step while it draws (not erasing).
-
-    For the game's drawing precision (:meth:`GameSession.report`): the
-    robot's ink against these desired pen-down paths, as ``ttt-sm draw``
-    measures one drawing (thesis section 3.5).  Simulation only: the ink is
-    the true pen's.
-    """
-
-    #: At most this many pen-down samples are kept (a game draws ~60 s of them: 30 000).
-    MAX_SAMPLES = 250_000
-
-    def __init__(self, robot: Robot) -> None:
-        self.control = robot.control
-        self.surface_z = robot.params.board.surface_z
-        #: Desired pen positions while it is down, one row per chart step; a row at z = inf where it lifts.
-        self.xyz: list[tuple[float, float, float]] = []
-        self._down = False
-        self.board = robot.board
-        #: The robot's ink as it was when the sponge set off (the points of each stroke), kept for the report.
-        self.ink: list[np.ndarray] | None = None
-
-    def robot_ink(self) -> list[np.ndarray]:
-        """The robot's ink strokes: as they were before erasing when the board was erased, else as they are."""
-        if self.ink is not None:
-            return self.ink
-        return [s.points for s in self.board.strokes if s.author == "robot"]
-
-    def tick(self, signals: Signals) -> None:
-        c = self.control
-        if c.erasing and self.ink is None:
-            self.ink = [np.array(s.points) for s in self.board.strokes if s.author == "robot"]
-        if c.busy and not c.erasing and c.Z_out <= self.surface_z:
-            if len(self.xyz) < self.MAX_SAMPLES:
-                self.xyz.append((c.X_out, c.Y_out, c.Z_out))
-            self._down = True
-        elif self._down:
-            self.xyz.append((c.X_out, c.Y_out, math.inf))
-            self._down = False
 
 
 class GameSession:
@@ -707,22 +376,22 @@ class GameSession:
                 self._run(wait)
             report = self.report(time.perf_counter() - wall0)
         except GameInterrupted as exc:
-            self._end("interrupted", signal=exc.why, boundary=True)
+            self.end_record("interrupted", signal=exc.why, boundary=True)
             raise
         except KeyboardInterrupt:  # no handler sent it through interrupt(): anywhere in a chart step
-            self._end("interrupted", signal="SIGINT", boundary=False)
+            self.end_record("interrupted", signal="SIGINT", boundary=False)
             raise
         except Exception as exc:
             interrupt = interruption(exc)  # the signal landed in a C extension's import, say
             if interrupt is not None:
-                self._end("interrupted", signal=str(getattr(interrupt, "signal", "SIGINT")), boundary=False)
+                self.end_record("interrupted", signal=str(getattr(interrupt, "signal", "SIGINT")), boundary=False)
             else:
-                self._end("error", message=str(exc) if isinstance(exc, GameError)
+                self.end_record("error", message=str(exc) if isinstance(exc, GameError)
                           else f"{type(exc).__name__}: {exc}", boundary=isinstance(exc, GameError))
             raise
         finally:
             gc.unfreeze()
-        self._end("finished", outcome=report["outcome"], boundary=True)
+        self.end_record("finished", outcome=report["outcome"], boundary=True)
         return report
 
     def record_start(self, max_moves: int) -> None:
@@ -731,7 +400,7 @@ class GameSession:
                     person=getattr(self.person, "name", type(self.person).__name__), camera=self.camera.mode,
                     params_sha256=params_digest(self.params), time_limit_s=self.time_limit_s, max_moves=max_moves)
 
-    def _end(self, how: str, **data: Any) -> None:
+    def end_record(self, how: str, **data: Any) -> None:
         """The record's last event (where the game stood, and its state), and the board picture of the moment."""
         if self.record.ended is not None:
             return
@@ -830,50 +499,12 @@ class GameSession:
             "camera_link": self.camera.stats(),
             "camera_wall_s": round(self.camera.read_wall_s, 3),
             "ignored_play_clicks": self.activator.ignored_triggers,
-            **self._drawing_precision(),
+            **(NO_PRECISION if self.pen_path is None else self.pen_path.precision()),
         }
 
-    def _drawing_precision(self) -> dict[str, float | None]:
-        """The robot's ink against the desired pen-down paths of the whole game, mm (None without ground truth)."""
-        from .drawing import _distance_to_runs, _pen_down_runs
-
-        if self.pen_path is None:
-            return {"drawing_rms_mm": None, "drawing_max_mm": None}
-        ink = [p for p in self.pen_path.robot_ink() if len(p)]
-        if not ink or not self.pen_path.xyz:
-            return {"drawing_rms_mm": None, "drawing_max_mm": None}
-        runs = _pen_down_runs(np.asarray(self.pen_path.xyz), self.params.board.surface_z)
-        if not runs:
-            return {"drawing_rms_mm": None, "drawing_max_mm": None}
-        err = _distance_to_runs(np.vstack(ink), runs) * 1e3
-        return {"drawing_rms_mm": round(float(np.sqrt(np.mean(err ** 2))), 4),
-                "drawing_max_mm": round(float(err.max()), 4)}
-
     def checkpoint(self) -> dict[str, Any]:
-        """The state of a game at a chart-step boundary, as a record keeps it: readable parts and one digest.
-
-        Readable: the chart tick, simulated time, both boards, the moves, every
-        chart's active states.  ``digest``: SHA-256 over all of that plus every
-        chart's data, the session's flags and the simulated arm's ground truth
-        (joint and motor angles, currents, speeds, the encoders, the duties),
-        float for float; a replay that reaches the same digest reached the same state.
-        """
-        robot = self.robot
-        charts = {name: sorted(str(s) for s in c.configuration_values) for name, c in robot.charts.items()}
-        state: dict[str, Any] = {"tick": robot.chart_ticks, "steps": robot.steps, "t": robot.t,
-                                 "board": self.board, "truth": self.truth, "moves": len(self.moves),
-                                 "charts": charts}
-        full = {**state, "data": {name: jsonable(c.snapshot()) for name, c in robot.charts.items()},
-                "session": jsonable(self.state())}
-        sim = robot.sim
-        if sim is not None:
-            arrays = [sim.q_encoder, sim.duty, sim.truth.q, sim.truth.q_motor, sim.truth.current_a,
-                      sim.truth.speed_motor, sim.truth.speed_load]
-            full["twin"] = hashlib.sha256(b"".join(np.ascontiguousarray(a, dtype=np.float64).tobytes()
-                                                   for a in arrays)).hexdigest()
-        state["t"] = round(robot.t, 6)
-        state["digest"] = hashlib.sha256(dumps(full, sort_keys=True).encode()).hexdigest()
-        return state
+        """The state of the game now, as its record keeps it (:func:`.game_record.checkpoint`)."""
+        return checkpoint(self.robot, self.state())
 
     def state(self) -> dict[str, Any]:
         """The session's own state (boards, moves, flags), plain data: what a replay must reproduce too."""
@@ -1002,27 +633,7 @@ class GameSession:
         """Stop the camera emulator; close the record (a game not played to its end: ended as interrupted)."""
         try:
             if self.record.attached and self.record.ended is None and self.record.events:
-                self._end("interrupted", signal="closed before the end", boundary=True)
+                self.end_record("interrupted", signal="closed before the end", boundary=True)
             self.record.close()
         finally:
             self.camera.close()
-
-
-def engine_for(name: str) -> Callable[[str, str], Cell]:
-    """The game algorithm called `name` ("strong" or "thesis") as a function (board text, symbol) -> cell."""
-    from ..game.engine import GameOver
-    from ..game.strong_engine import StrongEngine
-    from ..game.thesis_engine import ThesisEngine
-
-    engines = {"strong": StrongEngine, "thesis": ThesisEngine}
-    if name not in engines:
-        raise ValueError(f"unknown engine {name!r}; choose from {', '.join(engines)}")
-    engine = engines[name]()
-
-    def move(board: str, symbol: str) -> Cell:
-        answer = engine.move(board, symbol)
-        if isinstance(answer, GameOver):
-            raise GameError(f"the {name} engine was asked to move after the end: {answer.reason}")
-        return answer.row, answer.column
-
-    return move

@@ -12,7 +12,7 @@ every line it wrote, and its last line says how it ended:
   each with ``t`` (simulated s) and ``tick`` (chart steps since power-on);
 - the last line: ``finished``, ``interrupted`` (which signal, and what the
   game was waiting for) or ``error`` (why), each with a checkpoint of the
-  state at that moment (:meth:`~.game.GameSession.checkpoint`).
+  state at that moment (:func:`checkpoint`).
 
 :func:`~.game_replay.replay_record` plays the game again from the record's
 seed and the person's recorded moves up to the last line's tick and compares
@@ -27,16 +27,46 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import IO, Any
 
+import numpy as np
+
 from ..params import ArmParams
-from ..runtime.jsonable import dumps
+from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
 from ..runtime.recordfile import ENDINGS
 from ..runtime.recordfile import read_lines as read_record
+from .robot import Robot
 
 
 def params_digest(params: ArmParams) -> str:
     """SHA-256 of the parameters in force (their SI values as JSON): which arm a record was made on."""
     return hashlib.sha256(dumps(asdict(params), sort_keys=True).encode()).hexdigest()
+
+
+def checkpoint(robot: Robot, session: dict[str, Any]) -> dict[str, Any]:
+    """The state of a game at a chart-step boundary, as a record keeps it: readable parts and one digest.
+
+    ``session``: the game session's own state (:meth:`.game.GameSession.state`).
+    Readable: the chart tick, simulated time, both boards, the moves, every
+    chart's active states.  ``digest``: SHA-256 over all of that plus every
+    chart's data, the session's flags and the simulated arm's ground truth
+    (joint and motor angles, currents, speeds, the encoders, the duties),
+    float for float; a replay that reaches the same digest reached the same state.
+    """
+    charts = {name: sorted(str(s) for s in c.configuration_values) for name, c in robot.charts.items()}
+    state: dict[str, Any] = {"tick": robot.chart_ticks, "steps": robot.steps, "t": robot.t,
+                             "board": session["board"], "truth": session["truth"], "moves": len(session["moves"]),
+                             "charts": charts}
+    full = {**state, "data": {name: jsonable(c.snapshot()) for name, c in robot.charts.items()},
+            "session": jsonable(session)}
+    sim = robot.sim
+    if sim is not None:
+        arrays = [sim.q_encoder, sim.duty, sim.truth.q, sim.truth.q_motor, sim.truth.current_a,
+                  sim.truth.speed_motor, sim.truth.speed_load]
+        full["twin"] = hashlib.sha256(b"".join(np.ascontiguousarray(a, dtype=np.float64).tobytes()
+                                               for a in arrays)).hexdigest()
+    state["t"] = round(robot.t, 6)
+    state["digest"] = hashlib.sha256(dumps(full, sort_keys=True).encode()).hexdigest()
+    return state
 
 
 class GameRecord:

@@ -14,7 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from ..params import ArmParams
-from .game import GameError, GameInterrupted, GameSession
+from .game import GameSession
+from .game_outcome import GameError, GameInterrupted
 from .game_record import ENDINGS, params_digest, read_record
 
 

@@ -77,8 +77,10 @@ def cmd_demo(args: argparse.Namespace) -> int:
 def cmd_play(args: argparse.Namespace) -> int:
     import signal
 
-    from ..app.game import GameInterrupted, GameSession, SimulatedPerson, TerminalPerson
+    from ..app.game import GameSession
+    from ..app.game_outcome import GameInterrupted
     from ..app.game_record import GameRecord
+    from ..app.person import SimulatedPerson, TerminalPerson
 
     if not 0 < args.time_limit < float("inf"):
         raise CliError(f"--time-limit must be a positive number of seconds, got {args.time_limit}")
@@ -154,7 +156,7 @@ def cmd_play(args: argparse.Namespace) -> int:
 
 
 def _play_game(session: GameSession) -> dict[str, Any]:
-    from ..app.game import GameError
+    from ..app.game_outcome import GameError
 
     try:
         return session.play()

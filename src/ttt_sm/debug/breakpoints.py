@@ -1,4 +1,4 @@
-"""Breakpoints: what they watch, how their commands are parsed, and the listener that hits them.
+"""Breakpoints: what they watch, how their commands are parsed, the listener that hits them, the session's table.
 
 Five kinds, written as in the REPL:
 
@@ -22,7 +22,7 @@ debugger stops right after the control step holding that tick.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -241,3 +241,83 @@ class BreakListener:
             for bp in self._watching("event", chart):
                 if bp.event == event:
                     self._hit(bp, machine, f"{event} handled")
+
+
+class BreakpointTable:
+    """The session's breakpoints, by number: added from their command text, enabled, disabled, deleted.
+
+    :attr:`items` is the list the :attr:`listener` (attached to every chart)
+    watches; ``when`` breakpoints are checked after every chart tick
+    (:meth:`check_conditions`) and hit when their condition *becomes* true.
+    ``index``: the charts as they are now (a replay or a Safety reset replaces
+    them); ``names``: what conditions read.
+    """
+
+    def __init__(self, index: Callable[[], ChartIndex], names: Names) -> None:
+        #: The breakpoints, in the order they were added.
+        self.items: list[Breakpoint] = []
+        self.listener = BreakListener(self.items)
+        self._index = index
+        self._names = names
+        self._next_id = 1
+
+    def add(self, text: str) -> Breakpoint:
+        """Add a breakpoint from its command text, e.g. ``"enter DriveInit1.turn_back"``,
+        ``"transition DriveInit1 turn_fwd->turn_back"``, ``"event DriveInit1.tick"``,
+        ``"when DriveInit1.pos_Encoder > 1.0"``."""
+        bp = parse_breakpoint(self._next_id, text, self._index(), self._names)
+        if bp.condition is not None:
+            bp.last_value = bp.condition.evaluate(self._names)
+        self._next_id += 1
+        self.items.append(bp)
+        return bp
+
+    def find(self, bp_id: int) -> Breakpoint:
+        """The breakpoint numbered ``bp_id``; :class:`DebugError` lists the numbers there are."""
+        for bp in self.items:
+            if bp.id == bp_id:
+                return bp
+        known = ", ".join(str(b.id) for b in self.items) or "none"
+        raise DebugError(f"no breakpoint {bp_id}; breakpoints: {known}")
+
+    def delete(self, bp_id: int | None = None) -> None:
+        """Delete one breakpoint, or all of them (``None``)."""
+        if bp_id is None:
+            self.items.clear()
+        else:
+            self.items.remove(self.find(bp_id))
+
+    def enable(self, bp_id: int, enabled: bool = True) -> None:
+        """Enable a breakpoint (``enabled=False``: disable it); a condition enabled hits when it *becomes* true."""
+        bp = self.find(bp_id)
+        if enabled and not bp.enabled and bp.condition is not None:
+            bp.last_value = bp.condition.evaluate(self._names)  # hits when it *becomes* true
+        bp.enabled = enabled
+
+    def disable(self, bp_id: int) -> None:
+        """Keep a breakpoint, unchecked."""
+        self.enable(bp_id, False)
+
+    def conditions(self) -> list[Breakpoint]:
+        """The enabled ``when`` breakpoints: checked after every chart tick."""
+        return [bp for bp in self.items if bp.enabled and bp.kind == "when"]
+
+    def watch_events(self) -> bool:
+        """An enabled ``event`` breakpoint needs the events each chart tick handles."""
+        return any(bp.enabled and bp.kind == "event" for bp in self.items)
+
+    def check_conditions(self, when: list[Breakpoint], tick: int) -> None:
+        """After chart tick ``tick``: each condition that became true hits."""
+        for bp in when:
+            assert bp.condition is not None
+            value = bp.condition.evaluate(self._names)
+            if value and not bp.last_value:
+                bp.hits += 1
+                self.listener.hits.append(Hit(bp.id, bp.spec, None, tick, "became true"))
+            bp.last_value = value
+
+    def rearm(self) -> None:
+        """Read every condition again (the robot was rebuilt under it): it hits when it becomes true from now."""
+        for bp in self.items:
+            if bp.condition is not None:
+                bp.last_value = bp.condition.evaluate(self._names)

@@ -15,7 +15,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Protocol
 
-from ..app.game import GameSession, RemotePerson
+from ..app.game import GameSession
+from ..app.person import RemotePerson
 from ..app.robot import Robot
 from ..arm import Arm
 from ..params import ArmParams

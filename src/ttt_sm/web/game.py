@@ -24,7 +24,8 @@ from typing import Any
 
 import cv2
 
-from ..app.game import GameSession, RemotePerson
+from ..app.game import GameSession
+from ..app.person import RemotePerson
 from ..charts.game import (
     MSG_COMPILING,
     MSG_DRAWING,

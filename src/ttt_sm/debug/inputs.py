@@ -1,0 +1,117 @@
+"""What the user changes from outside the charts, applied now and recorded for replay.
+
+Inputs set or forced, events posted and the clicks of a person at a GUI are
+each an :class:`~.records.Action` with the control step it was applied at;
+a replay applies them again at the same steps (:meth:`Inputs.apply`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from ..app.game_outcome import GameError
+from ..app.robot import Robot, RobotError
+from ..runtime import Data, UnknownEventError
+from .errors import DebugError
+from .history import History
+from .names import RobotNames, datum_decl, parse_input_value
+from .records import Action
+from .replay import game_of
+
+
+class Inputs:
+    """The inputs set, forced and released, the events posted and a GUI person's clicks, as :class:`Action`\\ s.
+
+    ``forced``: the inputs forced now, kept against the wiring until released
+    (the dict is shared with :class:`~.history.History`, whose fingerprints
+    include it).  Each change forgets the fingerprints after its step: that
+    future is no longer what the session saw.
+    """
+
+    def __init__(self, robot: Callable[[], Robot], names: RobotNames, history: History,
+                 forced: dict[tuple[str, str], Any]) -> None:
+        self._robot = robot
+        self._names = names
+        self._history = history
+        #: What the user did, in order: a replay applies them again at their control steps.
+        self.actions: list[Action] = []
+        self.forced = forced
+
+    def datum_decl(self, chart: str, name: str) -> Data:
+        """The declaration of a chart datum (name, unit, default, doc, kind)."""
+        return datum_decl(self._robot(), chart, name)
+
+    def parse_value(self, chart: str, name: str, text: str) -> Any:
+        """A value typed for a chart input, by its declared unit (see :func:`.names.parse_input_value`)."""
+        return parse_input_value(self.datum_decl(chart, name), f"{chart}.{name}", text)
+
+    def set_input(self, chart: str, name: str, value: Any, force: bool = False) -> Any:
+        """Set a chart input (``force``: keep it against the wiring until :meth:`release`).
+
+        A string is parsed by :meth:`parse_value`.  Returns the value set.
+        """
+        if isinstance(value, str):
+            value = self.parse_value(chart, name, value)
+        self._do(Action(self._robot().steps, "force" if force else "set", chart, name, value))
+        return value
+
+    def release(self, chart: str | None = None, name: str | None = None) -> list[tuple[str, str]]:
+        """Stop forcing one input, or every forced input (no arguments); returns those released."""
+        if chart is None:
+            keys = list(self.forced)
+        else:
+            if name is None or (chart, name) not in self.forced:
+                forced = ", ".join(f"{c}.{n}" for c, n in self.forced) or "none"
+                raise DebugError(f"{chart}.{name} is not forced; forced: {forced}")
+            keys = [(chart, name)]
+        for c, n in keys:
+            self._do(Action(self._robot().steps, "release", c, n))
+        return keys
+
+    def post(self, chart: str, event: str, **data: Any) -> None:
+        """Post an event to a chart; it is handled at the chart's next tick."""
+        self._do(Action(self._robot().steps, "post", chart, event, data=dict(data)))
+
+    def game_input(self, name: str, **data: Any) -> None:
+        """An input of the person at a GUI (``cell`` row= column=, ``play``, ``symbol`` symbol=, ``engine``
+        engine=; :meth:`GameSession.person_input`), recorded with its control step like a posted event,
+        so a replay repeats the person's clicks where they happened.  A refused one (not the person's
+        turn, a locked symbol) raises :class:`DebugError` and is not recorded."""
+        self._do(Action(self._robot().steps, "game", "Game", name, data=dict(data)))
+
+    def apply(self, action: Action) -> None:
+        """Do what ``action`` says to the robot now (a replay: at the control step it was recorded at)."""
+        robot = self._robot()
+        if action.kind == "game":
+            game = game_of(robot)
+            if game is None:
+                raise DebugError("this robot plays no game: build it with the game (ttt-sm gui --game)")
+            try:
+                game.person_input(action.name, **action.data)
+            except GameError as exc:
+                raise DebugError(str(exc)) from None
+            return
+        try:
+            if action.kind in ("set", "force"):
+                robot.set_input(action.chart, action.name, action.value, force=action.kind == "force")
+                if action.kind == "force":
+                    self.forced[(action.chart, action.name)] = action.value
+            elif action.kind == "release":
+                robot.release(action.chart, action.name)
+                self.forced.pop((action.chart, action.name), None)
+            else:
+                robot.post(action.chart, action.name, **action.data)
+        except (RobotError, UnknownEventError) as exc:
+            raise DebugError(str(exc)) from None
+
+    def _do(self, action: Action) -> None:
+        """Apply an action and record it (a refused one raises and is not recorded)."""
+        self.apply(action)
+        self.actions.append(action)
+        # The future after this step is no longer what the session saw.
+        self._history.forget_after(action.steps)
+        self._history.remember()
+        # Conditions keep their last checked value: one the user just made true
+        # hits at the next chart tick.
+        self._names.forget()

@@ -1,5 +1,5 @@
-"""Shared fixtures of the debugger tests: the packaged arm, a debugger at the rest pose,
-and a robot with one extra event-driven chart (the drive-init charts take no events)."""
+"""Shared fixtures of the debugger tests: a debugger at the rest pose (``params`` is the
+suite's, tests/conftest.py) and a robot with one extra event-driven chart (the drive-init charts take no events)."""
 
 from __future__ import annotations
 
@@ -8,13 +8,8 @@ from statemachine import State
 
 from ttt_sm.app.robot import Robot
 from ttt_sm.debug import Debugger, RobotRecipe
-from ttt_sm.params import ArmParams, load_params
+from ttt_sm.params import ArmParams
 from ttt_sm.runtime import Data, TickChart, after
-
-
-@pytest.fixture(scope="session")
-def params() -> ArmParams:
-    return load_params()
 
 
 @pytest.fixture

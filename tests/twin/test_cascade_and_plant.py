@@ -13,27 +13,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ttt_sm.params import load_params
 from ttt_sm.twin import _cascade as C
 from ttt_sm.twin import _plant as P
 from ttt_sm.twin import layout
 from ttt_sm.twin.cascade import CascadeController
 from ttt_sm.twin.plant import Plant
 from ttt_sm.twin.sim import ArmSim
-from ttt_sm.twin.tuning import design_gains
 
 POSE = (0.3, 0.6, -1.0, 0.1)
 STEPS = 1500
-
-
-@pytest.fixture(scope="module")
-def params():
-    return load_params()
-
-
-@pytest.fixture(scope="module")
-def gains(params):
-    return design_gains(params)
 
 
 def _moving(params, gains) -> ArmSim:

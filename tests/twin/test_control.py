@@ -8,7 +8,6 @@ import control as ct
 import numpy as np
 import pytest
 
-from ttt_sm.params import load_params
 from ttt_sm.twin.control import (
     Gains,
     check_drive,
@@ -16,19 +15,8 @@ from ttt_sm.twin.control import (
     setpoint_filter_matrices,
 )
 from ttt_sm.twin.sim import ArmSim
-from ttt_sm.twin.tuning import design_gains
 
 WORK_POSE = (0.0, 0.6, -1.0, 0.0)
-
-
-@pytest.fixture(scope="module")
-def params():
-    return load_params()
-
-
-@pytest.fixture(scope="module")
-def gains(params):
-    return design_gains(params)
 
 
 def homed(params, gains, q0=WORK_POSE) -> tuple[ArmSim, np.ndarray]:

@@ -12,20 +12,8 @@ import textwrap
 import numpy as np
 import pytest
 
-from ttt_sm.params import load_params
 from ttt_sm.twin.control import DriveNumberError
 from ttt_sm.twin.sim import REST_POSE, ArmSim, SimError, gravity_torques
-from ttt_sm.twin.tuning import design_gains
-
-
-@pytest.fixture(scope="module")
-def params():
-    return load_params()
-
-
-@pytest.fixture(scope="module")
-def gains(params):
-    return design_gains(params)
 
 
 def open_loop_pattern(params, gains, substeps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

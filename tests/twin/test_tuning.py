@@ -8,7 +8,6 @@ import control as ct
 import numpy as np
 import pytest
 
-from ttt_sm.params import load_params
 from ttt_sm.twin.control import setpoint_filter_matrices
 from ttt_sm.twin.sim import ArmSim
 from ttt_sm.twin.step_response import (
@@ -23,21 +22,11 @@ from ttt_sm.twin.step_response import (
     step_response,
     tune_report,
 )
-from ttt_sm.twin.tuning import design_gains, drive_plant, loop_margins, loop_models, loops_figure
+from ttt_sm.twin.tuning import drive_plant, loop_margins, loop_models, loops_figure
 
 REPORT_KEYS = {"drive", "step_rad", "rise_time_s", "settling_time_s", "overshoot_pct", "error_at_0_5s_rad",
                "static_error_rad", "inner_phase_margin_deg", "outer_phase_margin_deg",
                "outer_gain_margin_db", "plot"}
-
-
-@pytest.fixture(scope="module")
-def params():
-    return load_params()
-
-
-@pytest.fixture(scope="module")
-def gains(params):
-    return design_gains(params)
 
 
 @pytest.mark.parametrize("drive", [1, 2, 3])

@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 
 from ttt_sm.params import ArmParams, load_params
-from ttt_sm.twin.control import Gains
+from ttt_sm.twin.gains import Gains
 from ttt_sm.twin.tuning import design_gains
 
 # The repository's development tools (tools/: the layering checker, docs/architecture.md's generator)

@@ -16,7 +16,7 @@ from ttt_sm.app.camera_link import CameraLink, CameraLost
 from ttt_sm.app.game import GameSession
 from ttt_sm.app.game_outcome import GameError
 from ttt_sm.params import load_params
-from ttt_sm.seriallink import Fault
+from ttt_sm.smartcam import Fault
 from ttt_sm.twin.whiteboard import Whiteboard
 from ttt_sm.vision.scenes import draw_field
 

@@ -55,7 +55,7 @@ def test_a_whole_game_reads_every_move_right_through_the_serial_camera(serial_ga
 
 def test_the_camera_link_photographs_once_per_reading_and_asks_again_for_a_lost_photo():
     from ttt_sm.app.camera_link import CameraLink
-    from ttt_sm.seriallink import Fault
+    from ttt_sm.smartcam import Fault
     from ttt_sm.twin.whiteboard import Whiteboard
     from ttt_sm.vision.scenes import draw_field
 
@@ -184,7 +184,7 @@ def test_the_camera_link_is_silent_between_readings_without_a_silence_warning(ca
     from ttt_sm.twin.whiteboard import Whiteboard
     from ttt_sm.vision.scenes import draw_field
 
-    caplog.set_level(logging.WARNING, logger="ttt_sm.seriallink")
+    caplog.set_level(logging.WARNING, logger="ttt_sm.smartcam")
     board = Whiteboard(P, seed=2)
     draw_field(board)
     # the limit must exceed one reading (a photo and its detection: ~0.1 s, more on a loaded machine)

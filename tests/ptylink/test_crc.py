@@ -1,4 +1,4 @@
-"""The one CRC-16 of both serial links: CCITT-FALSE, as docs/seriallink.md writes it out bit by bit.
+"""The one CRC-16 of both serial links: CCITT-FALSE, as docs/smartcam.md writes it out bit by bit.
 
 tests/hardware/test_link.py holds it to the firmware's C (``ttt_crc16``) on
 random bytes; here it is held to the catalogue's parameters, and both links
@@ -12,11 +12,11 @@ from hypothesis import strategies as st
 
 from ttt_sm.hardware import link
 from ttt_sm.ptylink import crc16
-from ttt_sm.seriallink import protocol
+from ttt_sm.smartcam import protocol
 
 
 def bit_by_bit(data: bytes, init: int = 0xFFFF) -> int:
-    """docs/seriallink.md's loop: polynomial 0x1021, unreflected, no final XOR."""
+    """docs/smartcam.md's loop: polynomial 0x1021, unreflected, no final XOR."""
     crc = init
     for byte in data:
         crc ^= byte << 8

@@ -11,7 +11,7 @@ from ttt_sm import params as params_module
 from ttt_sm.app import _monitor_layout
 from ttt_sm.params import load_params
 from ttt_sm.twin import _cascade, _plant, layout
-from ttt_sm.twin.control import setpoint_filter_row
+from ttt_sm.twin.gains import setpoint_filter_row
 from ttt_sm.twin.plant import gravity_coefficients, gravity_torques
 
 P = load_params()

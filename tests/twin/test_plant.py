@@ -12,7 +12,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from ttt_sm.twin.control import DriveNumberError
+from ttt_sm.twin.gains import DriveNumberError
 from ttt_sm.twin.sim import REST_POSE, ArmSim, SimError, gravity_torques
 
 
@@ -233,7 +233,7 @@ def test_numba_disabled_runs_the_same_kernel(params, gains, tmp_path):
     code = textwrap.dedent("""
         import json, dataclasses
         from ttt_sm.params import load_params
-        from ttt_sm.twin.control import Gains, DriveGains
+        from ttt_sm.twin.gains import Gains, DriveGains
         from ttt_sm.twin.sim import ArmSim
         g = json.load(open(%r))
         gains = Gains(tuple(DriveGains(**d) for d in g))

@@ -8,7 +8,7 @@ import control as ct
 import numpy as np
 import pytest
 
-from ttt_sm.twin.control import setpoint_filter_matrices
+from ttt_sm.twin.gains import setpoint_filter_matrices
 from ttt_sm.twin.sim import ArmSim
 from ttt_sm.twin.step_response import (
     LOOPS_PNG,

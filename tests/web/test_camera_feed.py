@@ -22,8 +22,8 @@ from starlette.testclient import TestClient
 
 from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params
-from ttt_sm.seriallink import CameraEmulator
-from ttt_sm.seriallink.sources import board_source
+from ttt_sm.smartcam import CameraEmulator
+from ttt_sm.smartcam.sources import board_source
 from ttt_sm.twin.whiteboard import Whiteboard
 from ttt_sm.vision import board_text, detect
 from ttt_sm.vision.scenes import draw_field

@@ -347,7 +347,7 @@ THESIS_MODULES: tuple[tuple[str, str, str], ...] = (
      "ttt_sm.twin._cascade"),
     ("§3.2 (gains)", "the gains, designed with python-control, and their margins", "ttt_sm.twin.tuning"),
     ("figs. 3.7-3.9", "step responses of drives 1-3", "ttt_sm.twin.step_response"),
-    ("fig. 3.25 (fr_sw)", "the setpoint filters and their cut-off switch", "ttt_sm.twin.control"),
+    ("fig. 3.25 (fr_sw)", "the setpoint filters and their cut-off switch", "ttt_sm.twin.gains"),
     ("§3.3", "the pen servo's duty and angle", "ttt_sm.params"),
     ("(the loop's memory)", "the layouts of the controller's and the plant's flat arrays", "ttt_sm.twin.layout"),
     ("§3.1.2 note (1 kHz, charts at half rate)", "controller and plant fused in one compiled loop",
@@ -382,7 +382,7 @@ definition of each formula (`ttt_sm.twin._cascade` for the controller step and
 the setpoint filter, `ttt_sm.twin._plant` for gravity, `ttt_sm.params` for the
 servo), one table of each memory layout (`ttt_sm.twin.layout`), the design of
 the gains apart from the step that uses them (`ttt_sm.twin.tuning`,
-`ttt_sm.twin.control`), and the loop that fuses controller and plant
+`ttt_sm.twin.gains`), and the loop that fuses controller and plant
 (`ttt_sm.twin._kernel`).
 
 {chr(10).join(rows)}

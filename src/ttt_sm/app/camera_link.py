@@ -4,9 +4,9 @@ Two ways to get the 25 per-cell percentages of the board (thesis 3.6.3):
 
 - ``direct``: photograph the simulated whiteboard and detect in-process;
 - ``serial``: the smart camera is emulated on a real pseudo-terminal
-  (:class:`ttt_sm.seriallink.CameraEmulator`), photographing and detecting
+  (:class:`ttt_sm.smartcam.CameraEmulator`), photographing and detecting
   in its own thread, and the game reads the frames through pyserial
-  (:class:`ttt_sm.seriallink.SerialCameraReader`), as the thesis' PC did.
+  (:class:`ttt_sm.smartcam.SerialCameraReader`), as the thesis' PC did.
 
 The simulation and the camera thread share the whiteboard: the camera only
 photographs while the simulation is paused for a reading (a lock, and an event
@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from ..params import ArmParams
-from ..seriallink.protocol import SEQ_MODULUS
+from ..smartcam.protocol import SEQ_MODULUS
 from ..twin.whiteboard import Whiteboard
 from ..vision import Detection, board_text, board_values, detect
 from ..vision.simulated import SimulatedCamera
@@ -72,7 +72,7 @@ class CameraLink:
             self._start_serial(rate_hz, silence_s)
 
     def _start_serial(self, rate_hz: float, silence_s: float) -> None:
-        from ..seriallink import CameraEmulator, SerialCameraReader
+        from ..smartcam import CameraEmulator, SerialCameraReader
 
         def source() -> list[float]:
             while True:

@@ -6,9 +6,9 @@ It plays the ``Monitor`` block of the wiring table: from what the arm
 reports (encoder counts and angles, currents, the offsets the init charts
 set) and what the PC commanded, it computes each drive's following error
 against a model of the controller's setpoint filter (the same filter,
-``twin.control.setpoint_filter_row``, stepped with the same setpoints,
+``twin.gains.setpoint_filter_row``, stepped with the same setpoints,
 followed no faster than the controller's speed clamp
-``twin.control.max_joint_speed``), the encoder speed from the counts, the
+``twin.gains.max_joint_speed``), the encoder speed from the counts, the
 commanded speed (the model's) and the current; and the pen servo's error:
 a model of the servo (its lag and slew rate, ``[servo]``) stepped with the
 servo's setpoints, minus the angle its feedback wire reads.  It
@@ -41,7 +41,7 @@ from ..arm import Arm
 from ..charts.safety import Safety
 from ..params import ArmParams
 from ..sched.scheduler import Scheduler, Signals
-from ..twin.control import max_joint_speed, setpoint_filter_row
+from ..twin.gains import max_joint_speed, setpoint_filter_row
 from ..twin.kinematics import IKError
 from . import _monitor
 from . import _monitor_layout as ML

@@ -22,10 +22,10 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from ..seriallink.emulator import CameraEmulator, Fault
-from ..seriallink.errors import SerialLinkError
-from ..seriallink.reader import ReconnectPolicy, SerialCameraReader
-from ..seriallink.sources import board_source
+from ..smartcam.emulator import CameraEmulator, Fault
+from ..smartcam.errors import SerialLinkError
+from ..smartcam.reader import ReconnectPolicy, SerialCameraReader
+from ..smartcam.sources import board_source
 from .common import print_json, seed
 
 DEFAULT_LINK = str(Path(tempfile.gettempdir()) / "ttt-sm-camera")
@@ -44,7 +44,7 @@ def register(sub: Any) -> argparse.ArgumentParser:
 
     serve = actions.add_parser("serve", help="send frames on a pseudo-terminal until Ctrl-C",
                                description="Emulate the smart camera: frames of a fixed board on a"
-                               " pseudo-terminal, reachable through a stable symlink (see docs/seriallink.md).")
+                               " pseudo-terminal, reachable through a stable symlink (see docs/smartcam.md).")
     serve.add_argument("--link", default=DEFAULT_LINK, help=f"stable symlink to the pty (default {DEFAULT_LINK})")
     serve.add_argument("--board", default=DEMO_BOARD,
                        help=f"25 cells of . X O, rows split by / (default {DEMO_BOARD})")
@@ -82,7 +82,7 @@ def _log_to_stderr(level: int) -> Iterator[None]:
     """Show the link's log (rejections, reconnects) on standard error while the command runs."""
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(levelname)s %(message)s"))
-    log = logging.getLogger("ttt_sm.seriallink")
+    log = logging.getLogger("ttt_sm.smartcam")
     old_level = log.level
     log.addHandler(handler)
     log.setLevel(level)

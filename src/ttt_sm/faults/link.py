@@ -42,7 +42,7 @@ from ..hardware import link as L
 from ..hardware.emulator import ArmEmulator
 from ..hardware.serial_arm import SerialArm
 from ..params import ArmParams
-from ..twin.control import Gains
+from ..twin.gains import Gains
 from ..twin.plant import REST_POSE
 from ..twin.tuning import design_gains
 

@@ -71,7 +71,7 @@ from ..hardware.emulator import ArmEmulator
 from ..hardware.serial_arm import LinkTruth, SerialArm
 from ..params import ArmParams
 from ..sched.scheduler import Signals
-from ..twin.control import Gains
+from ..twin.gains import Gains
 from ..twin.kinematics import arm_chain_py, link_points
 from ..twin.sim import ArmSim
 from ..twin.truth import ArmTruth

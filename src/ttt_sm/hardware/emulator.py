@@ -8,7 +8,7 @@ place of a board, each control step reads the twin's plant
 currents) into the firmware's sensors and applies the firmware's commands
 (H-bridge duties and flags, the servo's PWM) to the plant.  Bytes go over
 the master side of a pseudo-terminal; the PC opens the slave (``port``, a
-stable symlink, as the camera emulator does: docs/seriallink.md) with
+stable symlink, as the camera emulator does: docs/smartcam.md) with
 pyserial like any serial port.
 
 Two clocks (``pace``):

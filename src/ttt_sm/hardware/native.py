@@ -21,7 +21,7 @@ import numpy as np
 from ..params import ArmParams
 from ..twin import layout
 from ..twin.cascade import CascadeController
-from ..twin.control import Gains, check_drive
+from ..twin.gains import Gains, check_drive
 from .firmware import FirmwareError, Precision
 
 _REAL = {"float": ctypes.c_float, "double": ctypes.c_double}

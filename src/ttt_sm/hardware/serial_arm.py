@@ -54,7 +54,7 @@ from ..arm import Sensors
 from ..params import ArmParams
 from ..twin import layout
 from ..twin.cascade import CascadeController
-from ..twin.control import Gains, check_drive
+from ..twin.gains import Gains, check_drive
 from ..twin.kinematics import fk
 from ..twin.tuning import design_gains
 from . import link as L

@@ -1,6 +1,6 @@
 """What every serial device of ``ttt_sm`` shares, on the PC's side and in its emulators.
 
-The camera's link (:mod:`ttt_sm.seriallink`) and the arm's
+The camera's link (:mod:`ttt_sm.smartcam`) and the arm's
 (:mod:`ttt_sm.hardware.link`) are two protocols over two serial ports; beneath
 both lie the same few pieces, one module each:
 

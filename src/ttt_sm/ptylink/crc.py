@@ -1,6 +1,6 @@
 """CRC-16/CCITT-FALSE: the checksum of both serial links (the camera's lines, the arm's frames).
 
-The camera's sentences carry it as four hex digits (docs/seriallink.md), the
+The camera's sentences carry it as four hex digits (docs/smartcam.md), the
 arm's frames as two bytes, MSB first (docs/hardware.md); the firmware
 computes the same CRC bit by bit in C (``ttt_crc16``, ``firmware/src/link.c``),
 and tests/hardware/test_link.py holds the two to each other on random bytes.

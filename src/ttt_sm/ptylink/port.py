@@ -1,12 +1,12 @@
 """A pseudo-terminal behind a stable symlink: the port of every emulated serial device.
 
-The camera's emulator (:mod:`ttt_sm.seriallink.emulator`) and the arm's
+The camera's emulator (:mod:`ttt_sm.smartcam.emulator`) and the arm's
 (:mod:`ttt_sm.hardware.emulator`) each stand for a device on a serial port.
 :class:`PtyLink` is the port they share: a pseudo-terminal in raw mode (bytes
 pass as on a UART: no echo, no line discipline) whose master side the
 emulator reads and writes without blocking, and whose slave side the PC opens
 through a stable symlink, as udev's ``/dev/serial/by-id/...`` follows a USB
-adapter from one ``/dev/ttyUSBn`` to the next (docs/seriallink.md).
+adapter from one ``/dev/ttyUSBn`` to the next (docs/smartcam.md).
 
 The link path is checked when the :class:`PtyLink` is made: its folder must
 exist, and a path already there must be a symlink (an emulator replaces only

@@ -27,8 +27,8 @@ from ..params import ArmParams
 from . import _cascade as C
 from . import layout
 from ._buffers import flat_view
-from .control import Gains, check_drive, setpoint_filter_row, speed_filter_alpha
 from .errors import SimError
+from .gains import Gains, check_drive, setpoint_filter_row, speed_filter_alpha
 
 # slots of the controllers' shared state that every chart step writes
 _FR_SW, _SV_SET = layout.CGS_FR_SW, layout.CGS_SV_SET

@@ -33,8 +33,8 @@ from ..params import ArmParams
 from . import _kernel as K
 from . import layout
 from .cascade import CascadeController
-from .control import Gains
 from .errors import SimError
+from .gains import Gains
 from .plant import CURRENT_NOISE_A, REST_POSE, SUBSTEPS, Angles, Plant, check_pose, gravity_torques
 from .truth import ArmTruth
 from .tuning import design_gains

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..params import ArmParams
-from .control import Gains, check_drive
+from .gains import Gains, check_drive
 from .sim import ArmSim
 from .tuning import design_gains, plot_loops
 

@@ -27,7 +27,7 @@ import control as ct
 import numpy as np
 
 from ..params import ArmParams, ParameterError
-from .control import DriveGains, Gains, check_drive, max_joint_speed, speed_filter_alpha
+from .gains import DriveGains, Gains, check_drive, max_joint_speed, speed_filter_alpha
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -7,7 +7,7 @@ Three kinds of camera, named by ``--camera`` (:func:`open_feed`):
   first again after the last (a recorded session, a test);
 - the serial smart camera (``serial:PORT``, or a port path such as
   ``/dev/ttyUSB0``): the thesis' camera that sends the 25 cells' ink
-  percentages over a serial line (section 3.6.3, :mod:`ttt_sm.seriallink`);
+  percentages over a serial line (section 3.6.3, :mod:`ttt_sm.smartcam`);
   it sends no picture.
 
 A :class:`CameraFeed` grabs in a thread of its own, ``rate_hz`` times a
@@ -195,8 +195,8 @@ def device_feed(index: int, rate_hz: float = DEFAULT_RATE_HZ) -> CameraFeed:
 
 def serial_feed(port: str, rate_hz: float = DEFAULT_RATE_HZ) -> CameraFeed:
     """The serial smart camera on ``port``: its newest frame of 25 percentages at each grab."""
-    from ..seriallink import SerialCameraReader
-    from ..seriallink.errors import SerialLinkError
+    from ..smartcam import SerialCameraReader
+    from ..smartcam.errors import SerialLinkError
 
     reader = SerialCameraReader(port, 1.0)
     try:

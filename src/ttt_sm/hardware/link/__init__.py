@@ -6,7 +6,7 @@ The same specification as the firmware's ``firmware/src/link.c`` and
     type (u8) | seq (u16 LE) | body | CRC-16/CCITT-FALSE of the above (u16, MSB first)
 
 COBS-encoded and closed by a 0x00 byte.  Bodies are little-endian.  One
-module an idea, as the camera's link (:mod:`ttt_sm.seriallink`) is cut:
+module an idea, as the camera's link (:mod:`ttt_sm.smartcam`) is cut:
 
 - :mod:`.rejections` -- :class:`Reason` (the firmware's ``TTT_REJ_*``) and
   :class:`Rejection`;

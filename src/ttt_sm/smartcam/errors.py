@@ -10,7 +10,7 @@ class Reason(StrEnum):
 
     Transmission damage shows as the framing and checksum reasons; a line whose
     checksum is right but whose content is wrong was *sent* wrong (a camera
-    bug) and gets a content reason.  See docs/seriallink.md, "Rejections".
+    bug) and gets a content reason.  See docs/smartcam.md, "Rejections".
     """
 
     # framing: found by the framer before a line is complete

@@ -12,7 +12,7 @@ import time
 import pytest
 
 from ttt_sm.cli.camera import register
-from ttt_sm.seriallink import CameraEmulator, board_source
+from ttt_sm.smartcam import CameraEmulator, board_source
 
 
 def run(*argv: str) -> int:
@@ -111,7 +111,7 @@ def test_serve_refuses_to_replace_a_real_file(tmp_path, capsys):
 
 
 def test_read_json_that_loses_its_link_still_prints_the_frames_it_read(tmp_path, capsys):
-    from ttt_sm.seriallink import Fault
+    from ttt_sm.smartcam import Fault
 
     with CameraEmulator(board_source("...../...../..O../...../....."), rate_hz=50, link=tmp_path / "cam") as cam:
         def pull_the_cable() -> None:

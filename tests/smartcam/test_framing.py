@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ttt_sm.seriallink import MAX_SENTENCE_BYTES, LineFramer, Reason, Rejection, encode_frame
+from ttt_sm.smartcam import MAX_SENTENCE_BYTES, LineFramer, Reason, Rejection, encode_frame
 
 LINE = encode_frame(1, [12.5] * 25)
 LINE2 = encode_frame(2, [0.0] * 25)

@@ -1,4 +1,4 @@
-"""docs/seriallink.md stays true: its example runs and prints what the page says; the numbers it quotes hold."""
+"""docs/smartcam.md stays true: its example runs and prints what the page says; the numbers it quotes hold."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from ttt_sm.seriallink import MAX_SENTENCE_BYTES, board_source, crc16, decode_line, encode_frame, encode_status
-from ttt_sm.seriallink.errors import Reason
+from ttt_sm.smartcam import MAX_SENTENCE_BYTES, board_source, crc16, decode_line, encode_frame, encode_status
+from ttt_sm.smartcam.errors import Reason
 
-DOC = Path(__file__).resolve().parents[2] / "docs" / "seriallink.md"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "smartcam.md"
 TEXT = DOC.read_text(encoding="utf-8")
 
 
@@ -18,7 +18,7 @@ def test_the_game_example_runs_and_prints_what_the_page_says(capsys):
     pytest.importorskip("ttt_sm.vision")
     blocks = re.findall(r"```python\n(.*?)```", TEXT, re.S)
     assert len(blocks) == 1
-    exec(compile(blocks[0], f"{DOC.name}[example]", "exec"), {"__name__": "seriallink_docs"})  # noqa: S102
+    exec(compile(blocks[0], f"{DOC.name}[example]", "exec"), {"__name__": "smartcam_docs"})  # noqa: S102
     out = capsys.readouterr().out
     assert "-> /dev/pts/" in out
     assert "the person played (3, 3)" in out

@@ -9,7 +9,7 @@ import os
 import pytest
 import serial
 
-from ttt_sm.seriallink import (
+from ttt_sm.smartcam import (
     CameraEmulator,
     Fault,
     LinkLost,
@@ -18,7 +18,7 @@ from ttt_sm.seriallink import (
     SerialCameraReader,
 )
 
-LOGGER = "ttt_sm.seriallink.reader"
+LOGGER = "ttt_sm.smartcam.reader"
 TIGHT = ReconnectPolicy(first_delay_s=0.01, max_delay_s=0.05, max_attempts=5, max_duration_s=30.0)
 
 

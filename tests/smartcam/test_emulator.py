@@ -7,7 +7,7 @@ import threading
 
 import pytest
 
-from ttt_sm.seriallink import (
+from ttt_sm.smartcam import (
     CameraEmulator,
     EmulatorError,
     Fault,

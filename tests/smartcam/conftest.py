@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterator
 
 import pytest
 
-from ttt_sm.seriallink import CameraEmulator, Frame, ReconnectPolicy, SerialCameraReader
+from ttt_sm.smartcam import CameraEmulator, Frame, ReconnectPolicy, SerialCameraReader
 
 FAST = ReconnectPolicy(first_delay_s=0.01, max_delay_s=0.1, max_attempts=1000, max_duration_s=20.0)
 """Reconnect quickly in tests, still bounded."""

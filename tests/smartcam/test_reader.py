@@ -9,7 +9,7 @@ import random
 import pytest
 import serial
 
-from ttt_sm.seriallink import (
+from ttt_sm.smartcam import (
     CameraSilent,
     Fault,
     Frame,
@@ -21,7 +21,7 @@ from ttt_sm.seriallink import (
     encode_frame,
 )
 
-LOGGER = "ttt_sm.seriallink.reader"
+LOGGER = "ttt_sm.smartcam.reader"
 
 
 def wrap(body: bytes) -> bytes:

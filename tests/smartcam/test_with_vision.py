@@ -8,7 +8,7 @@ import pytest
 vision = pytest.importorskip("ttt_sm.vision")
 
 from ttt_sm.params import load_params  # noqa: E402
-from ttt_sm.seriallink import CameraEmulator, detection_source  # noqa: E402
+from ttt_sm.smartcam import CameraEmulator, detection_source  # noqa: E402
 from ttt_sm.vision.scenes import random_scene  # noqa: E402
 from ttt_sm.vision.simulated import SimulatedCamera  # noqa: E402
 

@@ -12,7 +12,7 @@ fields over a serial port; the PC reads them.  Layers, one way:
 - :mod:`.sources` -- frame sources for the emulator (the vision detector,
   a text board).
 
-Nothing here imports the game or the vision package.  See docs/seriallink.md.
+Nothing here imports the game or the vision package.  See docs/smartcam.md.
 """
 
 from .emulator import CameraEmulator, EmulatorError, EmulatorStats, Fault, FaultKind, FrameSource, apply_fault

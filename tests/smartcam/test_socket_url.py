@@ -9,7 +9,7 @@ from __future__ import annotations
 import socket
 import threading
 
-from ttt_sm.seriallink import encode_frame
+from ttt_sm.smartcam import encode_frame
 
 
 def converter(server: socket.socket, stop: threading.Event, values) -> None:

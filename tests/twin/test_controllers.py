@@ -1,4 +1,4 @@
-"""The cascade controllers on the nonlinear twin: tracking, fr_sw, saturation, offsets."""
+"""The cascade controllers on the nonlinear twin: tracking, fr_sw, saturation, offsets (gains from twin/gains.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import control as ct
 import numpy as np
 import pytest
 
-from ttt_sm.twin.control import (
+from ttt_sm.twin.gains import (
     Gains,
     check_drive,
     max_joint_speed,

@@ -12,7 +12,7 @@ terminal shows it readably::
 ``seq`` is 0..65535 (wrapping), each ``p`` is 0.0..100.0 with exactly one
 decimal, ``CRC`` is CRC-16/CCITT-FALSE (:func:`ttt_sm.ptylink.crc16`, the arm's
 link's too) of the bytes between ``$`` and ``*`` as 4 upper-case hex digits.
-The full grammar is in docs/seriallink.md.  A CRC rather than NMEA's XOR,
+The full grammar is in docs/smartcam.md.  A CRC rather than NMEA's XOR,
 because XOR cannot see a dropped pair of equal bytes (``100.0`` losing ``00``
 reads as a valid ``1.0``); a CRC-16 catches every error burst up to 16 bits
 and all but 1 in 65536 of the rest.

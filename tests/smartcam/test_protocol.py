@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ttt_sm.seriallink import (
+from ttt_sm.smartcam import (
     MAX_SENTENCE_BYTES,
     EncodeError,
     Frame,
@@ -21,7 +21,7 @@ from ttt_sm.seriallink import (
     encode_frame,
     encode_status,
 )
-from ttt_sm.seriallink.protocol import format_percentage
+from ttt_sm.smartcam.protocol import format_percentage
 
 # Reproducible (derandomized) and without per-example deadlines: a loaded machine is slow, not wrong.
 PROPERTY = settings(derandomize=True, max_examples=150, deadline=None)

@@ -171,7 +171,8 @@ def test_draw_with_the_reference_from_a_file_draws_the_same_x(tmp_path, capsys):
 def test_a_skeleton_in_a_slot_changes_what_the_robot_does(tmp_path, capsys):
     ex = next(e for e in exercises() if e.name == "drive_init3")
     status, out, err = _run(capsys, "--chart", f"DriveInit3={ex.chart_file}:MyDriveInit3", "draw", "X")
-    assert status == 2 and err.strip().splitlines()[-1] == "ttt-sm draw: error: the drives did not initialise within 40 s"
+    last = err.strip().splitlines()[-1]
+    assert status == 2 and last == "ttt-sm draw: error: the drives did not initialise within 40 s"
 
 
 # -- the commands -------------------------------------------------------------------------------------
@@ -198,7 +199,8 @@ def test_lab_check_json_scores_the_skeleton_and_exits_1(tmp_path, capsys):
 def test_lab_check_passes_a_solved_exercise(tmp_path, capsys):
     target = tmp_path / "work"
     _run(capsys, "lab", "start", "algorithm_activator", str(target))
-    text = (CHARTS_SRC / "game.py").read_text(encoding="utf-8").replace("from ..runtime import", "from ttt_sm.runtime import")
+    text = (CHARTS_SRC / "game.py").read_text(encoding="utf-8")
+    text = text.replace("from ..runtime import", "from ttt_sm.runtime import")
     (target / "algorithm_activator.py").write_text(text + "\n\nclass MyActivator(AlgorithmActivator):\n    pass\n")
     status, out, _ = _run(capsys, "lab", "check", str(target))
     assert status == 0 and out.rstrip().endswith("every check passed"), out

@@ -34,8 +34,8 @@ from ..twin.workspace import check_reach
 from .compensation import GearPlayCompensation
 from .control_wiring import ControlStage, make_control_chart
 from .init_wiring import DriveInitStage, make_init_charts, settled_pose
-from .slots import ChartSlots, chosen_slots
 from .safety_wiring import CameraStatus, SafetyStage, make_safety_chart
+from .slots import ChartSlots, chosen_slots
 from .wires import BLOCKS, ROBOT_WIRES
 from .wiring import Wire, WiredStage, wire_stages
 

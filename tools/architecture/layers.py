@@ -85,6 +85,7 @@ CONTRACT: tuple[Component, ...] = (
     Component("scenario", 4, ("ttt_sm.scenario",), "scenario tests of event sequences (YAML)"),
     Component("faults", 4, ("ttt_sm.faults",),
               "faults injected into the twin and the serial link; the Safety chart's fault matrices"),
+    Component("lab", 5, ("ttt_sm.lab",), "the lab: exercises, a student's chart in a slot, behaviour checks"),
     Component("web", 5, ("ttt_sm.web",),
               "the browser cockpit (ttt-sm gui): a session over the debugger, its protocol, server and pages"),
     Component("bench", 6, ("ttt_sm.bench",), "the speed and quality targets",

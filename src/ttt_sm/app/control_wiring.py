@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from typing import cast
 
 import numpy as np
 
@@ -20,24 +21,30 @@ from ..params import ArmParams
 from ..sched.scheduler import Signals
 from ..twin.kinematics import arm_chain_py
 from .init_wiring import DriveInitStage
+from .slots import THESIS_SLOTS, ChartSlots
 from .wiring import Wiring, not_wired
 
 
-def make_control_chart(params: ArmParams, listeners: Sequence[object] = ()) -> Control:
-    """The Control chart with the field, heights and poses of `params`."""
+def control_chart_data(params: ArmParams) -> dict[str, float]:
+    """What the builder sets in the Control chart from `params`: the field, the heights."""
     b = params.board
     x_min, x_max, y_min, y_max = b.field_bounds()
-    return Control(
-        tick_period_s=params.control.chart_dt, listeners=list(listeners),
-        data={
-            "x11": x_max, "y11": y_max, "L": b.cell_size, "cells": b.cells,
-            # the pen is pressed 1.5 mm into its spring while it draws; the sponge 2.5 mm
-            "z_draw": b.surface_z - 0.0015,
-            "z_up": b.surface_z + 0.008,
-            "z_travel": b.surface_z + b.zone_clearance,
-            "z_sponge": b.surface_z + params.sponge.offset - 0.0025,
-        },
-    )
+    return {
+        "x11": x_max, "y11": y_max, "L": b.cell_size, "cells": b.cells,
+        # the pen is pressed 1.5 mm into its spring while it draws; the sponge 2.5 mm
+        "z_draw": b.surface_z - 0.0015,
+        "z_up": b.surface_z + 0.008,
+        "z_travel": b.surface_z + b.zone_clearance,
+        "z_sponge": b.surface_z + params.sponge.offset - 0.0025,
+    }
+
+
+def make_control_chart(params: ArmParams, listeners: Sequence[object] = (),
+                       slots: ChartSlots = THESIS_SLOTS) -> Control:
+    """The Control chart with the field, heights and poses of `params` (its class: `slots`' Control)."""
+    chart = slots.make("Control", tick_period_s=params.control.chart_dt, listeners=list(listeners),
+                       data=control_chart_data(params))
+    return cast(Control, chart)  # a slotted class meets Control's contract (checked when chosen), not its type
 
 
 class ControlStage:

@@ -28,7 +28,7 @@ import math
 import time
 from collections.abc import Callable, Generator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 from ..arm import Arm
 from ..charts.game import AlgorithmActivator, Game
@@ -88,8 +88,12 @@ class GameSession:
         self.pen_path = PenPathStage(self.robot) if self.robot.truth is not None else None
         if self.pen_path is not None:
             self.robot.sched.joint_stages.append(self.pen_path)
-        self.activator = AlgorithmActivator(tick_period_s=params.control.chart_dt, listeners=listeners)
-        self.game = Game(tick_period_s=params.control.chart_dt, listeners=listeners)
+        # the game's charts from the robot's slots (a student's chart in the lab: :mod:`.slots`)
+        slots = self.robot.slots
+        period = params.control.chart_dt
+        self.activator = cast(AlgorithmActivator,
+                              slots.make("AlgorithmActivator", tick_period_s=period, listeners=listeners))
+        self.game = cast(Game, slots.make("Game", tick_period_s=period, listeners=listeners))
         self.robot_symbol = robot_symbol
         self.person_symbol = "X" if robot_symbol == "O" else "O"
         self.person = person or SimulatedPerson(seed, self.say)

@@ -20,7 +20,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -31,6 +31,7 @@ from ..sched.scheduler import Scheduler, Signals
 from ..twin.kinematics import link_points
 from ..twin.sim import ArmSim
 from ..twin.truth import GroundTruth
+from .slots import THESIS_SLOTS, ChartSlots
 from .wires import BLOCKS, INIT_WIRES
 from .wiring import Wiring, not_wired, wire_stages
 
@@ -40,23 +41,27 @@ def servo_init_angle(params: ArmParams) -> float:
     return -(params.drives[1].park_rad + params.drives[2].park_rad)
 
 
+def init_chart_data(params: ArmParams, offsets: Sequence[float] = (0.0, 0.0, 0.0)) -> tuple[dict[str, float], ...]:
+    """What the builder sets in each init chart from `params`: switch and parking angles, the offset."""
+    return tuple({"index_angle": d.index_rad, "park": d.park_rad, "offset": offsets[k]}
+                 for k, d in enumerate(params.drives))
+
+
 def make_init_charts(params: ArmParams, listeners: Sequence[object] = (),
-                     offsets: Sequence[float] = (0.0, 0.0, 0.0)) -> tuple[DriveInit1, DriveInit2, DriveInit3]:
+                     offsets: Sequence[float] = (0.0, 0.0, 0.0),
+                     slots: ChartSlots = THESIS_SLOTS) -> tuple[DriveInit1, DriveInit2, DriveInit3]:
     """The three init charts with the switch and parking angles of `params`.
 
     `offsets`: the encoder offsets the arm applies when the charts start (0 at
     power-on; a re-initialisation sets those that make every encoder read 0).
+    `slots`: the class of each (:mod:`.slots`; the thesis' by default).
     """
-    d1, d2, d3 = params.drives
     period = params.control.chart_dt
     lst = list(listeners)
-    c1 = DriveInit1(tick_period_s=period, listeners=lst,
-                    data={"index_angle": d1.index_rad, "park": d1.park_rad, "offset": offsets[0]})
-    c2 = DriveInit2(tick_period_s=period, listeners=lst,
-                    data={"index_angle": d2.index_rad, "park": d2.park_rad, "offset": offsets[1]})
-    c3 = DriveInit3(tick_period_s=period, listeners=lst,
-                    data={"index_angle": d3.index_rad, "park": d3.park_rad, "offset": offsets[2]})
-    return c1, c2, c3
+    c1, c2, c3 = (slots.make(f"DriveInit{k + 1}", tick_period_s=period, listeners=lst, data=data)
+                  for k, data in enumerate(init_chart_data(params, offsets)))
+    # a slotted class meets the thesis chart's contract (checked when it was chosen), not its type
+    return cast(tuple[DriveInit1, DriveInit2, DriveInit3], (c1, c2, c3))
 
 
 class EncoderBlock:

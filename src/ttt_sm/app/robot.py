@@ -35,6 +35,7 @@ from .compensation import GearPlayCompensation
 from .control_wiring import ControlStage, make_control_chart
 from .init_wiring import DriveInitStage, make_init_charts, settled_pose
 from .safety_wiring import CameraStatus, SafetyStage, make_safety_chart
+from .slots import ChartSlots, chosen_slots
 from .wires import BLOCKS, ROBOT_WIRES
 from .wiring import Wire, WiredStage, wire_stages
 
@@ -86,14 +87,21 @@ class Robot:
         The wiring table (default :data:`~ttt_sm.app.wires.ROBOT_WIRES`); a row
         that does not fit the charts' declarations raises
         :class:`~ttt_sm.app.wiring.WiringError` naming it.
+    slots : ChartSlots, optional
+        The class in each replaceable chart's place (:mod:`.slots`: a student's
+        chart in the lab); None takes the command's choice
+        (:func:`~.slots.chosen_slots`, the thesis' charts unless ``--chart``).
     """
 
     def __init__(self, params: ArmParams, seed: int = 0, q_start: Sequence[float] | None = None,
                  settle_s: float = 0.0, listeners: Sequence[object] = (), arm: Arm | None = None,
-                 truth: GroundTruth | None = None, wires: Sequence[Wire] = ROBOT_WIRES) -> None:
+                 truth: GroundTruth | None = None, wires: Sequence[Wire] = ROBOT_WIRES,
+                 slots: ChartSlots | None = None) -> None:
         check_reach(params)  # a field out of reach would be drawn as nothing, silently
         self.params = params
         self.seed = seed
+        #: The class in each replaceable chart's place (the game takes its charts' from here too).
+        self.slots = slots if slots is not None else chosen_slots()
         #: The simulated arm when this robot built it, else None.
         self.sim: ArmSim | None = None
         if arm is None:
@@ -108,7 +116,7 @@ class Robot:
         self.truth = truth
         self.sched = Scheduler(params, arm)
         self.listeners = list(listeners)
-        init = make_init_charts(params, listeners)
+        init = make_init_charts(params, listeners, slots=self.slots)
         self.init_stage = DriveInitStage(params, arm, self.sched, init)
         self.compensation = GearPlayCompensation(params, lambda: self.init_stage.done)
         self.board = Whiteboard(params, seed=seed)
@@ -120,7 +128,7 @@ class Robot:
         if truth is not None:
             joint_stages.append(BoardStage(self.board, truth))
         self.sched.joint_stages = joint_stages
-        self.control = make_control_chart(params, listeners)
+        self.control = make_control_chart(params, listeners, self.slots)
         self.control_stage = ControlStage(params, arm, self.init_stage, self.control)
         self.sched.task_stages = [self.control_stage]
         self.charts: dict[str, TickChart] = {c.chart_name: c for c in (*init, self.control, self.safety)}
@@ -174,10 +182,10 @@ class Robot:
         for drive in (1, 2, 3):
             self.arm.set_offset_estimate(drive, offsets[drive - 1])
         self.sched.forget_homing()
-        init = make_init_charts(self.params, self.listeners, offsets)
+        init = make_init_charts(self.params, self.listeners, offsets, self.slots)
         old_init, old_control = self.init_stage, self.control_stage
         self.init_stage = DriveInitStage(self.params, self.arm, self.sched, init)
-        self.control = make_control_chart(self.params, self.listeners)
+        self.control = make_control_chart(self.params, self.listeners, self.slots)
         self.control_stage = ControlStage(self.params, self.arm, self.init_stage, self.control)
         self.sched.joint_stages = [self.init_stage if s is old_init else s for s in self.sched.joint_stages]
         self.sched.task_stages = [self.control_stage if s is old_control else s for s in self.sched.task_stages]

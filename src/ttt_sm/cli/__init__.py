@@ -17,8 +17,8 @@ strict JSON output); each other module adds its subcommands with a
 ``ttt-sm --help`` shows them:
 
 - :mod:`.commands`: play, demo, draw, tune, bench, ik, init, charts, params;
-- :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.arm`, :mod:`.vision`, :mod:`.ai`:
-  the command of that name.
+- :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.arm`, :mod:`.vision`, :mod:`.ai`,
+  :mod:`.lab`: the command of that name (:mod:`.lab` also the global ``--chart``).
 
 (Regenerating the repository's generated files is a development tool, ``make docs``
 (``python -m tools.docs``), not a command of the installed package.)
@@ -38,11 +38,11 @@ from collections.abc import Sequence
 
 from ..params import shown_path
 from ..runtime.recordfile import interruption
-from . import ai, arm, camera, commands, debug, gui, scenario, vision
+from . import ai, arm, camera, commands, debug, gui, lab, scenario, vision
 from .common import join_negative_values, terminate_interrupts
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
-SUBCOMMANDS = (commands, scenario, debug, gui, camera, arm, vision, ai)
+SUBCOMMANDS = (commands, scenario, debug, gui, camera, arm, vision, ai, lab)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -50,6 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="ttt-sm", description=__doc__.splitlines()[0])
     p.add_argument("--params", metavar="FILE", default=None,
                    help="parameter file (default: the packaged arm.toml)")
+    lab.add_global_options(p)
     sub = p.add_subparsers(dest="command", required=True)
     for module in SUBCOMMANDS:
         module.register(sub)
@@ -128,7 +129,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else argv))
         command = args.command
         args.ttt_sm_process = argv is None  # the process exits when the command returns
-        status = int(args.func(args))
+        with lab.chosen_charts(args):
+            status = int(args.func(args))
         if argv is None:
             _ignore_late_signals()
         if sys.stdout is not None:

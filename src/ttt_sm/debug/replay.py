@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Protocol
@@ -18,6 +18,7 @@ from typing import Any, Protocol
 from ..app.game import GameSession
 from ..app.person import RemotePerson
 from ..app.robot import Robot
+from ..app.slots import ChartSlots, chosen_slots, using_slots
 from ..arm import Arm
 from ..params import ArmParams
 from ..twin.sim import ArmSim
@@ -43,16 +44,18 @@ class RobotRecipe:
     """Parameters, seed and power-on pose: a :class:`Robot` built again bit for bit.
 
     ``q_start`` and ``settle_s`` are the Robot's own arguments: the pose before
-    the unpowered arm settles under gravity for ``settle_s`` seconds.
+    the unpowered arm settles under gravity for ``settle_s`` seconds; ``slots``
+    the class in each replaceable chart's place (the command's, by default).
     """
 
     params: ArmParams
     seed: int = 0
     q_start: tuple[float, ...] | None = None
     settle_s: float = 0.0
+    slots: ChartSlots = field(default_factory=chosen_slots)
 
     def build(self) -> Robot:
-        return Robot(self.params, seed=self.seed, q_start=self.q_start, settle_s=self.settle_s)
+        return Robot(self.params, seed=self.seed, q_start=self.q_start, settle_s=self.settle_s, slots=self.slots)
 
     @classmethod
     def of(cls, robot: Robot) -> RobotRecipe:
@@ -60,7 +63,7 @@ class RobotRecipe:
         if robot.steps:
             raise DebugError(f"the robot has run {robot.steps} control steps: its recipe cannot be"
                              " read back; pass recipe=RobotRecipe(params, seed, q_start, settle_s)")
-        return cls(robot.params, robot.seed, tuple(float(v) for v in _sim(robot).truth.q))
+        return cls(robot.params, robot.seed, tuple(float(v) for v in _sim(robot).truth.q), slots=robot.slots)
 
 
 @dataclass(frozen=True)
@@ -90,6 +93,7 @@ class GameRecipe:
     person: str = "simulated"
     record_root: Path | None = None
     number: int = 1
+    slots: ChartSlots = field(default_factory=chosen_slots)
 
     @property
     def out_dir(self) -> Path | None:
@@ -101,9 +105,10 @@ class GameRecipe:
             raise ValueError(f"the person is 'simulated' or 'page', got {self.person!r}")
         person = RemotePerson() if self.person == "page" else None
         out_dir = self.out_dir
-        session = GameSession(self.params, seed=self.seed, robot_symbol=self.robot_symbol, engine=self.engine,
-                              person=person, camera="direct", record_trace=out_dir is not None,
-                              q_start=self.q_start, settle_s=self.settle_s, out_dir=out_dir)
+        with using_slots(self.slots):  # the game's charts and the robot's from the same slots
+            session = GameSession(self.params, seed=self.seed, robot_symbol=self.robot_symbol, engine=self.engine,
+                                  person=person, camera="direct", record_trace=out_dir is not None,
+                                  q_start=self.q_start, settle_s=self.settle_s, out_dir=out_dir)
         session.drive()
         return session.robot
 

@@ -223,14 +223,19 @@ class Catalog:
     def default(cls) -> Catalog:
         """The project's charts (named by class, as :class:`~ttt_sm.app.robot.Robot` names them).
 
-        The robot holds the drive-initialisation charts, Control and Safety; the game's
+        A slot a command filled (:func:`~ttt_sm.app.slots.chosen_slots`) names the class
+        in it.  The robot holds the drive-initialisation charts, Control and Safety; the game's
         charts (AlgorithmActivator, Game) are added by the game session, so a
         scenario runs them bare.
         """
+        from ..app.slots import chosen_slots
         from ..charts import ALL_CHARTS, INIT_CHARTS, Control, Safety
 
         robot = tuple(c.__name__ for c in (*INIT_CHARTS, Control, Safety))
-        return cls({c.__name__: c for c in ALL_CHARTS}, SIGNALS, robot)
+        # a chart slot filled by a student's class (``ttt-sm --chart``) names that class
+        slots = chosen_slots()
+        charts = {c.__name__: (slots.cls(c.__name__) if c.__name__ in slots.chosen else c) for c in ALL_CHARTS}
+        return cls(charts, SIGNALS, robot)
 
     def chart(self, name: str) -> type[TickChart] | None:
         return self.charts.get(name)

@@ -1,0 +1,103 @@
+"""``ttt-sm lab`` and the global ``--chart`` option: a student's chart in the robot (docs/lab.md).
+
+``ttt-sm --chart SLOT=path/to/file.py:ClassName COMMAND ...`` (repeatable)
+builds the robot of COMMAND with that class in the slot (:mod:`ttt_sm.app.slots`);
+the commands that build one honour it (:data:`HONOURED`), the others refuse it.
+
+``ttt-sm lab list``: the exercises.  ``ttt-sm lab start EXERCISE DIR``: copy
+one into DIR.  ``ttt-sm lab check DIR [--json]``: judge DIR's chart; exit
+status 0 when every check passes, 1 when one fails, 2 when the chart cannot
+be loaded (one line, ``file:line``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from .common import CliError, print_json
+
+#: The commands that build a robot from the chosen slots.
+HONOURED = ("play", "draw", "demo", "debug", "scenario")
+
+
+def add_global_options(parser: argparse.ArgumentParser) -> None:
+    """Add ``--chart`` to the options that come before the subcommand."""
+    from ..app.slots import SLOT_NAMES
+
+    parser.add_argument("--chart", action="append", default=[], metavar="SLOT=FILE.py:CLASS",
+                        help=f"run your chart class in a slot ({', '.join(SLOT_NAMES)}); repeatable;"
+                             f" taken by {', '.join(HONOURED)}")
+
+
+@contextlib.contextmanager
+def chosen_charts(args: argparse.Namespace) -> Iterator[None]:
+    """Run the command with the slots ``--chart`` chose (nothing to do without it)."""
+    choices = getattr(args, "chart", None) or []
+    if not choices:
+        yield
+        return
+    if args.command not in HONOURED:
+        raise CliError(f"--chart is not taken by {args.command}; it is taken by {', '.join(HONOURED)}")
+    from ..app.chart_file import slots_from
+    from ..app.slots import using_slots
+
+    with using_slots(slots_from(choices)):
+        yield
+
+
+def register(sub: Any) -> None:
+    """Add the ``lab`` command to the subcommands of ``ttt-sm``."""
+    help_ = "exercises: write one of the thesis' charts, check what it does (docs/lab.md)"
+    sp = sub.add_parser("lab", help=help_, description=help_)
+    actions = sp.add_subparsers(dest="lab_command", required=True)
+    ls = actions.add_parser("list", help="list the exercises")
+    ls.add_argument("--json", action="store_true", help="print one JSON document")
+    ls.set_defaults(func=cmd_lab_list)
+    st = actions.add_parser("start", help="copy an exercise (task page, skeleton, checks) into a new folder")
+    st.add_argument("exercise", help="the exercise's name (ttt-sm lab list)")
+    st.add_argument("dir", help="a new or empty folder")
+    st.set_defaults(func=cmd_lab_start)
+    ck = actions.add_parser("check", help="run the checks of the exercise in DIR on its chart")
+    ck.add_argument("dir", help="the folder ttt-sm lab start made")
+    ck.add_argument("--json", action="store_true", help="print one JSON document")
+    ck.set_defaults(func=cmd_lab_check)
+
+
+def cmd_lab_list(args: argparse.Namespace) -> int:
+    from ..lab.exercise import exercises
+
+    found = exercises()
+    if args.json:
+        print_json({"exercises": [{"name": e.name, "title": e.title, "slot": e.slot, "section": e.section}
+                                  for e in found]})
+    else:
+        width = max(len(e.name) for e in found)
+        for e in found:
+            print(f"{e.name:<{width}}  {e.title} (section {e.section}, slot {e.slot})")
+    return 0
+
+
+def cmd_lab_start(args: argparse.Namespace) -> int:
+    from ..lab.exercise import start
+    from ..params import shown_path
+
+    ex = start(args.exercise, Path(args.dir))
+    where = shown_path(Path(args.dir))
+    print(f"{ex.title}: read {where}/task.md, write {where}/{ex.file}, then: ttt-sm lab check {where}")
+    return 0
+
+
+def cmd_lab_check(args: argparse.Namespace) -> int:
+    from ..lab.checks import check_folder
+    from ..twin.workspace import load_arm
+
+    report = check_folder(Path(args.dir), load_arm(args.params))
+    if args.json:
+        print_json(report.to_dict())
+    else:
+        print(report.to_text(), end="")
+    return 0 if report.passed else 1

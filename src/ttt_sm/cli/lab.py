@@ -4,7 +4,8 @@
 builds the robot of COMMAND with that class in the slot (:mod:`ttt_sm.app.slots`);
 the commands that build one honour it (:data:`HONOURED`), the others refuse it.
 
-``ttt-sm lab list``: the exercises.  ``ttt-sm lab start EXERCISE DIR``: copy
+``ttt-sm lab list``: the exercises.  ``ttt-sm lab grade SUBMISSIONS --exercise E --out DIR``:
+every student's chart, each in a process of its own (:mod:`ttt_sm.lab.grade`).  ``ttt-sm lab start EXERCISE DIR``: copy
 one into DIR.  ``ttt-sm lab check DIR [--json]``: judge DIR's chart; exit
 status 0 when every check passes, 1 when one fails, 2 when the chart cannot
 be loaded (one line, ``file:line``).
@@ -65,6 +66,44 @@ def register(sub: Any) -> None:
     ck.add_argument("dir", help="the folder ttt-sm lab start made")
     ck.add_argument("--json", action="store_true", help="print one JSON document")
     ck.set_defaults(func=cmd_lab_check)
+    gr = actions.add_parser("grade", help="check every student's chart of a class, each in a process of its own",
+                            description="grade a folder of submissions (one sub-folder per student); reports in --out")
+    gr.add_argument("submissions", help="a folder with one sub-folder per student, as ttt-sm lab start made it")
+    gr.add_argument("--exercise", required=True, help="the exercise (ttt-sm lab list); its packaged checks are run")
+    gr.add_argument("--out", required=True, help="the report folder: results.jsonl, grades.csv, report.json/.html")
+    gr.add_argument("--workers", type=whole_number, default=None,
+                    help="submissions graded at once on this machine (default: the CPU count)")
+    gr.add_argument("--dask", metavar="ADDRESS", default=None,
+                    help="grade on the Dask cluster whose scheduler is at ADDRESS (needs ttt_sm[cluster])")
+    gr.add_argument("--timeout", type=seconds, default=120.0, metavar="S",
+                    help="wall-clock seconds a submission may take (default 120)")
+    gr.add_argument("--memory", type=whole_number, default=2048, metavar="MB",
+                    help="address space a submission's process may map, MB (default 2048)")
+    gr.add_argument("--again", action="store_true",
+                    help="grade every student anew (by default a rerun grades only those not in results.jsonl)")
+    gr.set_defaults(func=cmd_lab_grade)
+
+
+def whole_number(text: str) -> int:
+    """A count or a size: a whole number 1 .. 10**6."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text[:40]!r}") from None
+    if not 1 <= value <= 10**6:
+        raise argparse.ArgumentTypeError(f"expected a whole number 1 .. 1000000, got {text[:40]}")
+    return value
+
+
+def seconds(text: str) -> float:
+    """A time limit: a number of seconds in (0, 86400]."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text[:40]!r}") from None
+    if not 0 < value <= 86400:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds in (0, 86400], got {text[:40]}")
+    return value
 
 
 def cmd_lab_list(args: argparse.Namespace) -> int:
@@ -101,3 +140,43 @@ def cmd_lab_check(args: argparse.Namespace) -> int:
     else:
         print(report.to_text(), end="")
     return 0 if report.passed else 1
+
+
+def cmd_lab_grade(args: argparse.Namespace) -> int:
+    import os
+
+    from ..lab.exercise import exercise
+    from ..lab.grade import Limits, ResultsFile, dask_client, grade_class, submissions
+    from ..lab.grade_report import build_reports
+    from ..params import shown_path
+    from ..twin.workspace import load_arm
+    from .common import out_dir, progress
+
+    ex = exercise(args.exercise)
+    jobs = submissions(Path(args.submissions), ex)
+    load_arm(args.params)  # a parameter file that does not load is one line now, not one per student
+    out = out_dir(args.out)
+    client = dask_client(args.dask) if args.dask is not None else None
+    limits = Limits(timeout_s=args.timeout, memory_mb=args.memory, params_file=args.params)
+    results = ResultsFile(out, ex.name, again=args.again)
+    say = progress(True)
+    if results.done:
+        say(f"{shown_path(results.path)} already holds {len(results.done)} of these students"
+            " (--again grades them anew)")
+    try:
+        grade_class(jobs, limits, results, workers=args.workers or os.cpu_count() or 1, client=client, say=say)
+    except KeyboardInterrupt:
+        results.close()
+        build_reports(out)
+        say(f"stopped: {len(results.done)} of {len(jobs)} graded; reports in {shown_path(out)}"
+            " (run again to grade the others)")
+        raise
+    finally:
+        results.close()
+        if client is not None:
+            client.close()
+    report = build_reports(out)
+    graded = report["statuses"].get("graded", 0)
+    say(f"{report['students']} students: {report['passed']} passed, {graded} graded,"
+        f" {report['students'] - graded} not; reports in {shown_path(out)}/report.html, grades.csv, report.json")
+    return 0

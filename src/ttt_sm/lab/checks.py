@@ -101,10 +101,15 @@ def check_folder(folder: Any, params: ArmParams) -> LabReport:
     return run_checks(ex, cls, where, params)
 
 
-def run_checks(ex: Exercise, cls: type[TickChart], where: str, params: ArmParams) -> LabReport:
-    """Every check of exercise `ex` with `cls` in its slot (the thesis' own class, for the reference)."""
+def run_checks(ex: Exercise, cls: type[TickChart], where: str, params: ArmParams,
+               coverage: Coverage | None = None) -> LabReport:
+    """Every check of exercise `ex` with `cls` in its slot (the thesis' own class, for the reference).
+
+    `coverage` records the transitions the checks take (a fresh one when None; ``lab grade`` passes its
+    own to draw which transitions each student's chart took).
+    """
     slots = ChartSlots().with_chart(ex.slot, cls, where)
-    cov = Coverage().include(cls)
+    cov = coverage if coverage is not None else Coverage().include(cls)
     results: list[CheckResult] = []
     with using_slots(slots):
         for path in ex.scenario_files():

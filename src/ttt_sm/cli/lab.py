@@ -153,9 +153,9 @@ def cmd_lab_grade(args: argparse.Namespace) -> int:
     from .common import out_dir, progress
 
     ex = exercise(args.exercise)
+    out = out_dir(args.out)
     jobs = submissions(Path(args.submissions), ex)
     load_arm(args.params)  # a parameter file that does not load is one line now, not one per student
-    out = out_dir(args.out)
     client = dask_client(args.dask) if args.dask is not None else None
     limits = Limits(timeout_s=args.timeout, memory_mb=args.memory, params_file=args.params)
     results = ResultsFile(out, ex.name, again=args.again)

@@ -289,7 +289,7 @@ def dask_client(address: str) -> Any:
     except ImportError:
         raise GradeError("--dask needs Dask: pip install 'ttt_sm[cluster]' (or 'dask[distributed]')") from None
     try:
-        return Client(address, timeout="10s")
+        return Client(address, timeout="5s")
     except (OSError, TimeoutError, ValueError) as exc:
         raise GradeError(f"--dask {address}: cannot reach a Dask scheduler there ({' '.join(str(exc).split())})"
                          ) from None

@@ -131,6 +131,15 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     cases.append((["lab", "start", "no_such_exercise", str(tmp / "lab-new")], "no_such_exercise"))
     cases.append((["lab", "start", "drive_init3", p["folder"]], p["folder"]))
     in_files(["lab", "check"], None, ("missing", "folder", "garbage"))
+    grade = ["lab", "grade", p["folder"], "--exercise", "algorithm_activator"]
+    cases.append((["lab", "grade", p["folder"], "--exercise", "no_such_exercise", "--out", str(tmp / "g")],
+                  "no_such_exercise"))
+    cases.append((["lab", "grade", p["missing"], "--exercise", "algorithm_activator", "--out", str(tmp / "g")],
+                  p["missing"]))
+    out_dirs(grade)
+    numbers([*grade, "--out", str(tmp / "g")], "--workers", (*BAD_INTS, "0", "-1"))
+    numbers([*grade, "--out", str(tmp / "g")], "--timeout", BAD_POSITIVE)
+    numbers([*grade, "--out", str(tmp / "g")], "--memory", (*BAD_INTS, "0"))
     cases.append((["--chart", "DriveInit3", "draw", "X"], "--chart"))
     cases.append((["--chart", f"DriveInit3={p['garbage']}:A", "draw", "X"], p["garbage"]))
     cases.append((["--chart", f"Nothing={p['missing']}:A", "draw", "X"], "Nothing"))

@@ -91,7 +91,7 @@ CONTRACT: tuple[Component, ...] = (
     Component("bench", 6, ("ttt_sm.bench",), "the speed and quality targets",
               only=("package", "runtime", "params", "arm", "charts", "twin", "game", "smartcam", "vision", "sched",
                     "hardware",
-                    "vision staging", "app", "debug", "scenario", "web")),
+                    "vision staging", "app", "debug", "scenario", "web", "lab")),
     Component("cli common", 4, ("ttt_sm.cli.common",), "the CLI's one-line error, options and strict JSON output",
               only=("runtime",)),
     Component("cli", 7, ("ttt_sm.cli",), "ttt-sm: parse, call, print; one module per command group"),

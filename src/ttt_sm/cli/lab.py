@@ -4,11 +4,12 @@
 builds the robot of COMMAND with that class in the slot (:mod:`ttt_sm.app.slots`);
 the commands that build one honour it (:data:`HONOURED`), the others refuse it.
 
-``ttt-sm lab list``: the exercises.  ``ttt-sm lab grade SUBMISSIONS --exercise E --out DIR``:
-every student's chart, each in a process of its own (:mod:`ttt_sm.lab.grade`).  ``ttt-sm lab start EXERCISE DIR``: copy
+``ttt-sm lab list``: the exercises.  ``ttt-sm lab start EXERCISE DIR``: copy
 one into DIR.  ``ttt-sm lab check DIR [--json]``: judge DIR's chart; exit
 status 0 when every check passes, 1 when one fails, 2 when the chart cannot
-be loaded (one line, ``file:line``).
+be loaded (one line, ``file:line``).  ``ttt-sm lab grade SUBMISSIONS
+--exercise E --out DIR``: every student's chart of a class, each in a process
+of its own, on this machine or a Dask cluster (:mod:`ttt_sm.lab.grade`).
 """
 
 from __future__ import annotations

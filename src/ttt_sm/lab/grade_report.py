@@ -38,10 +38,14 @@ def check_names(results: list[dict[str, Any]]) -> list[str]:
     return names
 
 
+def short_paths(reason: str) -> str:
+    """A reason with the folders of its files left out (``.../checks/x.yaml:14`` -> ``x.yaml:14``)."""
+    return re.sub(r"[^\s'\"]*/([^/\s'\"]+\.(yaml|py))", r"\1", reason)
+
+
 def _pattern(reason: str) -> str:
     """A reason with its numbers and paths blurred, so two students failing the same way compare equal."""
-    first = reason.splitlines()[0] if reason else ""
-    first = re.sub(r"\S*/(\S+\.(yaml|py))", r"\1", first)
+    first = short_paths(reason.splitlines()[0] if reason else "")
     return re.sub(r"-?\d+(\.\d+)?", "#", first)
 
 
@@ -143,12 +147,12 @@ def render_html(exercise: str, results: list[dict[str, Any]], names: list[str]) 
             elif c["passed"]:
                 out.append(f"<td class='pass' title='{_e(n)}'>\u2713</td>")
             else:
-                out.append(f"<td class='fail' title='{_e(c.get('reason', ''))}'>\u2717</td>")
+                out.append(f"<td class='fail' title='{_e(short_paths(c.get('reason', '')))}'>\u2717</td>")
         out.append(f"<td class='err'>{_e(r.get('error', ''))}</td></tr>")
     out.append("</table>")
 
     heat = transition_heat(results)
-    graded = [r for r in results if r["status"] == "graded"]
+    checked = [r for r in results if r.get("checks")]  # the checks ran (a memory limit may strike in one)
     charted = [r for r in results if r.get("transitions")]  # a chart cut short by a limit has its coverage too
     out.append("<h2>Transitions each chart took</h2>")
     out.append("<p class='key'>Each student's own transitions, as the checks' coverage counted them:"
@@ -173,17 +177,17 @@ def render_html(exercise: str, results: list[dict[str, Any]], names: list[str]) 
     out.append("<h2>The failures most of the class shares</h2>")
     shared = shared_failures(results)
     if shared:
-        out.append("<table><tr><th>check</th><th>failed by</th><th>a typical reason</th></tr>")
+        out.append("<table><tr><th>check</th><th>failed by (of those checked)</th><th>a typical reason</th></tr>")
         for f in shared:
-            out.append(f"<tr><td>{_e(f['check'])}</td><td class='num'>{f['failed_by']}/{len(graded)}</td>"
-                       f"<td class='reason'>{_e(f['typical_reason'])}"
+            out.append(f"<tr><td>{_e(f['check'])}</td><td class='num'>{f['failed_by']}/{len(checked)}</td>"
+                       f"<td class='reason'>{_e(short_paths(f['typical_reason']))}"
                        f"<br>({f['students_with_that_reason']} of them this way)</td></tr>")
         out.append("</table>")
     else:
         out.append("<p>No check failed.</p>")
     others = [r for r in results if r["status"] != "graded"]
     if others:
-        out.append(f"<p>{len(others)} could not be graded: "
+        out.append(f"<p>{len(others)} did not finish their checks: "
                    + "; ".join(f"{_e(r['student'])} ({_e(r['status'])})" for r in others) + ".</p>")
     out.append("</body></html>\n")
     return "".join(out)

@@ -35,6 +35,7 @@ def kinds() -> dict[str, str]:
         "dee_endless_loop": _action("        while True:\n            self.enable = True\n"),
         "eve_memory_hog": _action("        self.hoard = []\n        while True:\n"
                                   "            self.hoard.append(bytearray(50_000_000))\n"),
+        "hal_wrong_contract": _skeleton().replace('Data("enable", "bool"', 'Data("enable_it", "bool"'),
         "fay_never_finishes": _action("        import time\n\n        time.sleep(1e6)\n"),
     }
 

@@ -34,6 +34,7 @@ EXPECTED = {
     "eve_memory_hog": ("memory limit", False),
     "fay_never_finishes": ("time limit", False),
     "gus_no_file": ("load error", False),
+    "hal_wrong_contract": ("load error", False),
 }
 
 
@@ -75,6 +76,8 @@ def test_each_submission_gets_its_result_line(graded):
     assert results["cy_syntax_error"]["error"] == ("cy_syntax_error/algorithm_activator.py:14:"
                                                    " syntax error: invalid syntax")
     assert results["gus_no_file"]["error"] == "gus_no_file/algorithm_activator.py: no such file"
+    assert results["hal_wrong_contract"]["error"].startswith(
+        "hal_wrong_contract/algorithm_activator.py:14: class MyActivator does not fit the AlgorithmActivator slot")
     for name in ("dee_endless_loop", "fay_never_finishes"):
         assert results[name]["error"].startswith(f"still running after {TIMEOUT} s: stopped"), results[name]
     assert "ran out of memory" in results["eve_memory_hog"]["error"]
@@ -102,7 +105,7 @@ def test_the_csv_json_and_html_hold_every_student(graded):
 
     report = json.loads((out / "report.json").read_text(encoding="utf-8"))
     assert report["students"] == len(EXPECTED) and report["passed"] == 1
-    assert report["statuses"] == {"graded": 2, "load error": 2, "time limit": 2, "memory limit": 1}
+    assert report["statuses"] == {"graded": 2, "load error": 3, "time limit": 2, "memory limit": 1}
     [shared, *_] = report["shared_failures"]
     assert shared["check"] == check and set(shared["students"]) == {"ben_skeleton", "eve_memory_hog"}
     assert shared["typical_reason"]
@@ -170,7 +173,7 @@ def test_a_dask_cluster_gives_the_same_grades(graded, tmp_path, capsys):
     from dask.distributed import LocalCluster
 
     subs, out, _ = graded
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
         status, err = _grade(capsys, subs, tmp_path / "on-dask", "--dask", cluster.scheduler_address)
     assert status == 0, err
     local, on_dask = _by_student(out), _by_student(tmp_path / "on-dask")

@@ -178,6 +178,7 @@ def cmd_lab_grade(args: argparse.Namespace) -> int:
             client.close()
     report = build_reports(out)
     graded = report["statuses"].get("graded", 0)
-    say(f"{report['students']} students: {report['passed']} passed, {graded} graded,"
+    students = f"{report['students']} student" + ("s" if report["students"] != 1 else "")
+    say(f"{students}: {report['passed']} passed, {graded} graded,"
         f" {report['students'] - graded} not; reports in {shown_path(out)}/report.html, grades.csv, report.json")
     return 0

@@ -25,8 +25,14 @@ from typing import Any
 _RESERVE_MB = 8
 
 
+#: The largest file the process may write, bytes (its result is a few kB; a student's code may write more).
+MAX_FILE_BYTES = 64 * 2**20
+
+
 def limit(memory_mb: int, cpu_s: float) -> None:
-    """Limit this process to `memory_mb` of address space and `cpu_s` seconds of processor time."""
+    """Limit this process to `memory_mb` of address space, `cpu_s` seconds of processor time and files of
+    :data:`MAX_FILE_BYTES`."""
+    resource.setrlimit(resource.RLIMIT_FSIZE, (MAX_FILE_BYTES, MAX_FILE_BYTES))
     if memory_mb > 0:
         size = memory_mb * 2**20
         resource.setrlimit(resource.RLIMIT_AS, (size, size))
@@ -38,7 +44,7 @@ def limit(memory_mb: int, cpu_s: float) -> None:
 def grade(exercise_name: str, chart_file: Path, params_file: str | None) -> dict[str, Any]:
     """Load `chart_file` and run exercise `exercise_name`'s checks on it: the result as a JSON-ready dict."""
     from ..app.chart_file import ChartFileError, load_chart
-    from ..app.slots import SlotError
+    from ..app.slots import ChartSlots, SlotError
     from ..runtime.listeners import Coverage
     from ..twin.workspace import load_arm
     from .checks import run_checks
@@ -48,6 +54,7 @@ def grade(exercise_name: str, chart_file: Path, params_file: str | None) -> dict
     params = load_arm(params_file)
     try:
         cls, where = load_chart(chart_file, ex.class_name)
+        ChartSlots().with_chart(ex.slot, cls, where)  # a class that does not fit the slot is a load error too
     except (ChartFileError, SlotError) as exc:
         return {"status": "load error", "error": " ".join(str(exc).split())}
     coverage = Coverage().include(cls)

@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from ..params import shown_path
+from ..runtime.jsonable import dumps
 from .exercise import Exercise, LabError
 
 #: The file of results, one JSON line per student, that the reports are built from.
@@ -206,7 +207,7 @@ class ResultsFile:
         self._lock = threading.Lock()
 
     def _write(self, line: dict[str, Any]) -> None:
-        self._file.write(json.dumps(line) + "\n")
+        self._file.write(dumps(line) + "\n")
         self._file.flush()
 
     def add(self, result: dict[str, Any]) -> None:

@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import csv
 import html
-import json
 import re
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from ..runtime.jsonable import dumps
 from .grade import RESULTS, STATUSES, read_results
 
 #: How many shared failures the reports list.
@@ -202,6 +202,6 @@ def build_reports(folder: Path) -> dict[str, Any]:
     write_csv(folder / "grades.csv", results, names)
     report = {**summary(exercise, results), "checks": names, "shared_failures": shared_failures(results),
               "transitions": transition_heat(results), "results": results}
-    (folder / "report.json").write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
+    (folder / "report.json").write_text(dumps(report, indent=2) + "\n", encoding="utf-8")
     (folder / "report.html").write_text(render_html(exercise, results, names), encoding="utf-8")
     return report

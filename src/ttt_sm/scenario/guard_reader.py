@@ -30,7 +30,7 @@ import inspect
 import math
 import operator
 import textwrap
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Container, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -336,25 +336,25 @@ def value(node: Node, data: Mapping[str, Any]) -> Any:
     raise Unknown(kind)
 
 
-def kleene(node: Node, data: Mapping[str, Any], fixed: Mapping[Node, bool]) -> bool | None:
-    """A tree's truth with the atoms in ``fixed`` so, the others read from ``data``; None: either."""
-    if node in fixed:
-        return fixed[node]
+def kleene(node: Node, data: Mapping[str, Any], free: Container[Node] = ()) -> bool | None:
+    """A tree's truth on ``data``, the atoms in ``free`` and opaque parts unknown; None: either value."""
+    if node in free:
+        return None
     kind = node[0]
     if kind == "not":
-        inner = kleene(node[1], data, fixed)
+        inner = kleene(node[1], data, free)
         return None if inner is None else not inner
     if kind in ("and", "or"):
-        results = [kleene(n, data, fixed) for n in node[1]]
+        results = [kleene(n, data, free) for n in node[1]]
         decisive = kind == "or"  # an `or` is decided by a true item, an `and` by a false one
         if decisive in results:
             return decisive
         return None if None in results else not decisive
     if kind == "ifexp":
-        test = kleene(node[1], data, fixed)
+        test = kleene(node[1], data, free)
         if test is not None:
-            return kleene(node[2] if test else node[3], data, fixed)
-        a, b = kleene(node[2], data, fixed), kleene(node[3], data, fixed)
+            return kleene(node[2] if test else node[3], data, free)
+        a, b = kleene(node[2], data, free), kleene(node[3], data, free)
         return a if a == b else None
     try:
         return bool(value(node, data))

@@ -1,0 +1,378 @@
+"""Breadth-first search over a chart's behaviour, by running it: which input steps take which transitions.
+
+A **path** is a list of :class:`Step`: set some inputs, maybe post an event,
+then tick the chart until it takes a transition (at most
+:attr:`Bounds.max_ticks` chart steps).  The search runs the chart alone, as
+bare-chart mode does (docs/scenarios.md, "Bare-chart mode"): built with the
+arm's chart period, nothing feeding its inputs.  A chart cannot be copied, so
+a path is replayed from power-on each time it is extended; that is exact, and
+it is what the generated scenario file does too.
+
+From each node the candidate steps come from the guards of the transitions
+leaving the active states (:mod:`.guard_reader`): for every combination of
+truth values of the comparisons on inputs (the truth table of the guards'
+``and``/``or``/``not``), input values at the comparisons' boundaries, kept
+once per transition that would then go first (Stateflow's priority: the order
+written, docs/runtime.md); each comparison alone set just true and just false
+(``x >= limit``: at ``limit`` and just below); the comparisons the active
+states' actions make on inputs; every event the active states handle; and
+waiting.  Time is no input: a step ticks until something happens, so
+``after(n)``, ``after_s(t)`` and data that an action counts up are reached by
+waiting.
+
+Nodes are told apart by the active states and the data the guards read
+(floating-point local data, which change every tick, left out); a step that
+leads to a node seen before is kept only if it takes a transition no step took
+before.  The first path that takes a transition is the shortest (fewest steps)
+one found.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections import deque
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..runtime import TickChart
+from ..runtime.structure import TransitionInfo
+from ..runtime.temporal import duration_of, temporal_of
+from .guard_reader import GuardReader, Node, Setting, atoms, has_clock, kleene, refs, settings_for, show
+from .model import chart_states
+from .runner import StateLog
+
+#: How many comparisons of one decision the truth table enumerates (2**n combinations); above it,
+#: only each comparison alone.
+MAX_TABLE_ATOMS = 6
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """How far the search goes."""
+
+    max_ticks: int = 20_000  #: longest a step waits for a transition, chart steps (40 s at 2 ms)
+    max_depth: int = 80  #: longest path, steps
+    max_nodes: int = 2_000  #: nodes expanded
+    time_s: float = 8.0  #: wall-clock budget of one search
+
+
+@dataclass(frozen=True)
+class Step:
+    """One step of a path: inputs set, an event posted, then ``ticks`` chart steps.
+
+    ``why`` says where each input value came from; ``taken`` (the labels of the
+    transitions the step took), ``active`` (the leaf states after it) and
+    ``outputs`` (outputs it changed, with their new values) are what running it did.
+    """
+
+    sets: tuple[tuple[str, Any], ...] = ()
+    event: str | None = None
+    ticks: int = 0
+    why: tuple[str, ...] = ()
+    taken: tuple[str, ...] = ()
+    active: tuple[str, ...] = ()
+    outputs: tuple[tuple[str, Any], ...] = ()
+
+
+@dataclass
+class Sim:
+    """One bare chart, run from power-on through steps."""
+
+    cls: type[TickChart]
+    dt: float
+    chart: TickChart = field(init=False)
+    log: StateLog = field(init=False)
+    taken: list[str] = field(init=False, default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.log = StateLog()
+        labels = self.cls.structure().by_transition
+
+        class Taken:
+            @staticmethod
+            def after_transition(machine: TickChart, transition: Any) -> None:
+                info = labels.get(id(transition))
+                if info is not None:
+                    self.taken.append(info.label)
+
+        self.chart = self.cls(tick_period_s=self.dt, chart_name=self.cls.__name__, listeners=[self.log, Taken()])
+        self.log.record_initial([self.chart])
+
+    def replay(self, path: Iterable[Step]) -> Sim:
+        for step in path:
+            self._start(step)
+            for _ in range(step.ticks):
+                self.chart.tick()
+        return self
+
+    def _start(self, step: Step) -> None:
+        if step.sets:
+            self.chart.set_inputs(**dict(step.sets))
+        if step.event is not None:
+            self.chart.post(step.event)
+
+    def run(self, step: Step, max_ticks: int, clock: float) -> Step | None:
+        """Run a new step: tick until a transition is taken; None if none is within ``max_ticks``
+        (or the chart stands still past ``clock`` ticks, when its temporal operators change no more)."""
+        before = self.chart.snapshot(("output",))
+        self._start(step)
+        start = len(self.taken)
+        previous = None
+        for n in range(1, max_ticks + 1):
+            self.chart.tick()
+            if len(self.taken) > start:
+                return self._done(step, n, start, before)
+            if n > clock and n % 64 == 0:  # the clock decides nothing more: the same data again means never
+                now = _comparable(self.chart.snapshot())
+                if now == previous:
+                    return None
+                previous = now
+        return None
+
+    def _done(self, step: Step, ticks: int, start: int, before: dict[str, Any]) -> Step:
+        kinds = chart_states(self.cls)
+        after = self.chart.snapshot(("output",))
+        changed = tuple((k, v) for k, v in after.items() if not _same(v, before.get(k)))
+        leaves = tuple(s for s in self.chart.configuration_values if kinds.get(s) == "leaf")
+        return Step(step.sets, step.event, ticks, step.why, tuple(dict.fromkeys(self.taken[start:])),
+                    leaves, changed)
+
+    def leaf_sequence(self) -> list[str]:
+        """The leaf states entered since power-on, as ``expect_states`` with ``match: exact`` sees them."""
+        kinds = chart_states(self.cls)
+        return [e.state for e in self.log.entries[self.cls.__name__] if kinds.get(e.state) == "leaf"]
+
+
+def has_clock_spec(spec: Any) -> bool:
+    """Whether a guard spec is a temporal operator or a ``duration``."""
+    func = getattr(spec, "func", None)
+    return temporal_of(func) is not None or duration_of(func) is not None
+
+
+def _comparable(data: dict[str, Any]) -> dict[str, Any]:
+    """Data with NaN as text: NaN is not equal to itself, and "not yet set" is the same each tick."""
+    return {k: "nan" if isinstance(v, float) and math.isnan(v) else v for k, v in data.items()}
+
+
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return bool(a == b) and type(a) is type(b)
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """Inputs to set (and an event to post) before a step, with the reasons."""
+
+    sets: tuple[tuple[str, Any], ...]
+    event: str | None
+    why: tuple[str, ...]
+
+
+class Explorer:
+    """The search over one chart class (see the module's docstring)."""
+
+    def __init__(self, cls: type[TickChart], dt: float, bounds: Bounds | None = None) -> None:
+        self.cls = cls
+        self.dt = dt
+        self.bounds = bounds or Bounds()
+        self.structure = cls.structure()
+        self.reader = GuardReader(cls)
+        self.guards: dict[str, Node] = {t.label: self.reader.guard(t.transition) for t in self.structure.transitions}
+        self.relevant = set(self.reader.inputs).union(*(refs(g) for g in self.guards.values()))
+        # comparisons of the chart's own data alone: what its actions will make of them is not known
+        self.free = {a for g in self.guards.values() for a in atoms(g) if not refs(a) & self.reader.inputs}
+        self._actions: dict[str, list[Node]] = {}
+        self.first: dict[str, tuple[Step, ...]] = {}  #: transition label -> the first path that took it
+        self.nodes = 0
+        self.complete = True  #: the search ended by exhausting the nodes, not a bound
+        self.seen_states: set[str] = set()
+
+    # -- candidates ---------------------------------------------------------------------
+
+    def outgoing(self, active: Iterable[str]) -> dict[tuple[str, str], list[TransitionInfo]]:
+        """The transitions that may leave the active states, by (source, trigger), in priority order."""
+        active = set(active)
+        groups: dict[tuple[str, str], list[TransitionInfo]] = {}
+        for t in self.structure.transitions:
+            if t.source in active:
+                groups.setdefault((t.source, t.trigger), []).append(t)
+        for ts in groups.values():
+            ts.sort(key=lambda t: ({"outer": 0, "inner": 1, "segment": 2, "action": 3}[t.scope], t.priority))
+        return groups
+
+    def candidates(self, chart: TickChart) -> list[Candidate]:
+        data = dict(chart.data_mapping())
+        found: dict[tuple[Any, ...], Candidate] = {}
+
+        groups = self.outgoing(chart.configuration_values)
+
+        def add(values: dict[str, Any], event: str | None, why: Iterable[str], action: bool = False) -> None:
+            sets = tuple(sorted((k, v) for k, v in values.items() if not _same(v, data.get(k))))
+            # settings that change no decision the same way are one candidate (the first: the fewest changes);
+            # one that changes what an action does is its own
+            trial = {**data, **dict(sets)}
+            key = (sets, event) if action else (event, self._predict(groups, event, trial))
+            if key not in found:
+                found[key] = Candidate(sets, event, tuple(dict.fromkeys(why)))
+
+        add({}, None, ())
+        for (_source, trigger), ts in groups.items():
+            event = None if trigger == "tick" else trigger.split()[0]
+            if event is not None:
+                add({}, event, ())
+            for values, why in self._decision(ts, data):
+                add(values, event, why)
+        for state in chart.configuration_values:
+            for atom in self._action_atoms(state):
+                for setting in settings_for(atom, self.reader, data).values():
+                    add(dict(setting.values), None, (f"{setting.why} (an action of {state})",), action=True)
+        return list(found.values())
+
+    def _predict(self, groups: dict[tuple[str, str], list[TransitionInfo]], event: str | None,
+                 data: dict[str, Any]) -> tuple[Any, ...]:
+        """Per decision of the tick (and of ``event``), whether each transition's guard holds with these
+        data (None: it may)."""
+        out = []
+        for (_source, trigger), ts in groups.items():
+            if trigger != "tick" and (event is None or trigger.split()[0] != event):
+                continue
+            out.append(tuple(kleene(self.guards[t.label], data, self.free) for t in ts))
+        return tuple(out)
+
+    def _decision(self, ts: list[TransitionInfo], data: dict[str, Any]) -> list[tuple[dict[str, Any], list[str]]]:
+        """Input values that let each transition of one decision go first (the truth table), and
+        each comparison on inputs alone just true and just false."""
+        table: list[Node] = []
+        for t in ts:
+            for a in atoms(self.guards[t.label]):
+                if a[0] != "opaque" and refs(a) & self.reader.inputs and a not in table:
+                    table.append(a)
+        settings = {a: settings_for(a, self.reader, data) for a in table}
+        out: list[tuple[dict[str, Any], list[str]]] = []
+        for opts in settings.values():
+            for setting in opts.values():
+                out.append((dict(setting.values), [setting.why]))
+        if len(table) <= MAX_TABLE_ATOMS:
+            tables = [table]
+        else:  # one table per transition, over its own comparisons
+            tables = [own for t in ts
+                      if len(own := [a for a in table if a in atoms(self.guards[t.label])]) <= MAX_TABLE_ATOMS]
+        best: dict[str, tuple[int, dict[str, Any], list[str]]] = {}
+        for part in tables:
+            self._table(ts, [settings[a] for a in part if settings[a]], data, best)
+        out.extend((values, why) for _n, values, why in best.values())
+        return out
+
+    def _table(self, ts: list[TransitionInfo], options: list[dict[bool, Setting]], data: dict[str, Any],
+               best: dict[str, tuple[int, dict[str, Any], list[str]]]) -> None:
+        """The truth table of some comparisons: per transition that goes first, the fewest changes."""
+        choices = [[None, *opts.values()] for opts in options]  # None: leave the inputs as they are
+        for combo in itertools.product(*choices):
+            values: dict[str, Any] = {}
+            why: list[str] = []
+            conflict = False
+            for setting in combo:
+                if setting is None:
+                    continue
+                for k, v in setting.values:
+                    conflict |= k in values and not _same(values[k], v)
+                    values[k] = v
+                why.append(setting.why)
+            if conflict:
+                continue
+            trial = {**data, **values}
+            for t in ts:
+                truth = kleene(self.guards[t.label], trial, self.free)
+                if truth is False:
+                    continue
+                changes = sum(not _same(v, data.get(k)) for k, v in values.items())
+                if t.label not in best or changes < best[t.label][0]:
+                    best[t.label] = (changes, values, why + [f"so '{t.label}' goes first"])
+                break
+
+    def _action_atoms(self, state: str) -> list[Node]:
+        if state not in self._actions:
+            info = next((s for s in self.structure.states if s.id == state), None)
+            found: list[Node] = []
+            for name in (info.during if info is not None else ()):
+                func = getattr(self.cls, name, None)
+                if callable(func):
+                    found += [a for a in self.reader.action_atoms(func) if refs(a) & self.reader.inputs]
+            self._actions[state] = found
+        return self._actions[state]
+
+    # -- search ---------------------------------------------------------------------------
+
+    def key(self, chart: TickChart) -> tuple[Any, ...]:
+        data = chart.data_mapping()
+        kept = []
+        for name in sorted(self.relevant):
+            v = data[name]
+            if isinstance(v, float):
+                continue  # a measured quantity: it changes every tick, or has boundary values without end
+            kept.append((name, v if not (isinstance(v, float) and math.isnan(v)) else "nan"))
+        return (frozenset(chart.configuration_values), tuple(kept))
+
+    def clock(self, active: Iterable[str]) -> float:
+        """Ticks after which the temporal operators of the transitions leaving ``active`` change no more
+        (0: there are none; infinite: ``every``, ``duration``, an event count)."""
+        limit = 0.0
+        for ts in self.outgoing(active).values():
+            for t in ts:
+                if not has_clock(self.guards[t.label]):
+                    continue
+                for spec in t.transition.cond:
+                    temporal = temporal_of(getattr(spec, "func", None))
+                    if temporal is None or temporal.op == "every" or temporal.event is not None:
+                        limit = max(limit, math.inf) if has_clock_spec(spec) else limit
+                    else:
+                        limit = max(limit, temporal.ticks(self.dt))
+        return limit
+
+    def search(self, prefix: tuple[Step, ...] = (), wanted: set[str] | None = None,
+               stop_at_first: bool = False) -> dict[str, tuple[Step, ...]]:
+        """Breadth-first from the end of ``prefix``: for each transition (of ``wanted``, default all)
+        the first path found that takes it.  ``stop_at_first``: return at the first one."""
+        t0 = time.perf_counter()
+        labels = {t.label for t in self.structure.transitions}
+        wanted = set(labels if wanted is None else wanted)
+        found: dict[str, tuple[Step, ...]] = {}
+        root = Sim(self.cls, self.dt).replay(prefix)
+        self.seen_states |= set(root.chart.configuration_values)
+        seen = {self.key(root.chart)}
+        queue: deque[tuple[Step, ...]] = deque([prefix])
+        self.complete = True
+        while queue and wanted - set(found):
+            path = queue.popleft()
+            if len(path) - len(prefix) >= self.bounds.max_depth:
+                self.complete = False
+                continue
+            if self.nodes >= self.bounds.max_nodes or time.perf_counter() - t0 > self.bounds.time_s:
+                self.complete = False
+                break
+            self.nodes += 1
+            probe = Sim(self.cls, self.dt).replay(path)
+            active = tuple(probe.chart.configuration_values)
+            clock = self.clock(active)
+            for cand in self.candidates(probe.chart):
+                sim = probe if probe is not None else Sim(self.cls, self.dt).replay(path)
+                probe = None  # the first candidate runs on the replay made for the candidates
+                step = sim.run(Step(cand.sets, cand.event, why=cand.why), self.bounds.max_ticks, clock)
+                if step is None:
+                    continue
+                new = [label for label in step.taken if label in wanted and label not in found]
+                child = (*path, step)
+                for label in new:
+                    found[label] = child
+                self.seen_states |= set(sim.chart.configuration_values)
+                key = self.key(sim.chart)
+                if key not in seen:
+                    seen.add(key)
+                    queue.append(child)
+                if new and stop_at_first:
+                    return found
+        return found

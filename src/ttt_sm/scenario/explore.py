@@ -33,7 +33,7 @@ import itertools
 import math
 import time
 from collections import deque
-from collections.abc import Iterable
+from collections.abc import Container, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -69,7 +69,7 @@ class Step:
     """
 
     sets: tuple[tuple[str, Any], ...] = ()
-    event: str | None = None
+    events: tuple[str, ...] = ()
     ticks: int = 0
     why: tuple[str, ...] = ()
     taken: tuple[str, ...] = ()
@@ -111,8 +111,8 @@ class Sim:
     def _start(self, step: Step) -> None:
         if step.sets:
             self.chart.set_inputs(**dict(step.sets))
-        if step.event is not None:
-            self.chart.post(step.event)
+        for event in step.events:
+            self.chart.post(event)
 
     def run(self, step: Step, max_ticks: int, clock: float) -> Step | None:
         """Run a new step: tick until a transition is taken; None if none is within ``max_ticks``
@@ -132,12 +132,17 @@ class Sim:
                 previous = now
         return None
 
+    def hold(self, step: Step) -> Step:
+        """A step that only sets inputs: no chart step runs (what a later step needs may be more)."""
+        self._start(step)
+        return self._done(step, 0, len(self.taken), self.chart.snapshot(("output",)))
+
     def _done(self, step: Step, ticks: int, start: int, before: dict[str, Any]) -> Step:
         kinds = chart_states(self.cls)
         after = self.chart.snapshot(("output",))
         changed = tuple((k, v) for k, v in after.items() if not _same(v, before.get(k)))
         leaves = tuple(s for s in self.chart.configuration_values if kinds.get(s) == "leaf")
-        return Step(step.sets, step.event, ticks, step.why, tuple(dict.fromkeys(self.taken[start:])),
+        return Step(step.sets, step.events, ticks, step.why, tuple(dict.fromkeys(self.taken[start:])),
                     leaves, changed)
 
     def leaf_sequence(self) -> list[str]:
@@ -168,7 +173,7 @@ class Candidate:
     """Inputs to set (and an event to post) before a step, with the reasons."""
 
     sets: tuple[tuple[str, Any], ...]
-    event: str | None
+    events: tuple[str, ...]
     why: tuple[str, ...]
 
 
@@ -182,7 +187,7 @@ class Explorer:
         self.structure = cls.structure()
         self.reader = GuardReader(cls)
         self.guards: dict[str, Node] = {t.label: self.reader.guard(t.transition) for t in self.structure.transitions}
-        self.relevant = set(self.reader.inputs).union(*(refs(g) for g in self.guards.values()))
+        self.region = self._region_refs()
         # comparisons of the chart's own data alone: what its actions will make of them is not known
         self.free = {a for g in self.guards.values() for a in atoms(g) if not refs(a) & self.reader.inputs}
         self._actions: dict[str, list[Node]] = {}
@@ -204,44 +209,82 @@ class Explorer:
             ts.sort(key=lambda t: ({"outer": 0, "inner": 1, "segment": 2, "action": 3}[t.scope], t.priority))
         return groups
 
-    def candidates(self, chart: TickChart) -> list[Candidate]:
+    def candidates(self, chart: TickChart, covered: Container[str] = ()) -> list[Candidate]:
+        """The steps to try from where ``chart`` stands (see the module's docstring).
+
+        A setting whose first transition is sure, already ``covered`` and leads where the search has
+        been (a button ignored once more, ``finish`` from one more drawing state) is left out.
+        """
         data = dict(chart.data_mapping())
         found: dict[tuple[Any, ...], Candidate] = {}
-
         groups = self.outgoing(chart.configuration_values)
 
-        def add(values: dict[str, Any], event: str | None, why: Iterable[str], action: bool = False) -> None:
+        waiting = self._predict(groups, None, data)
+
+        def add(values: dict[str, Any], events: tuple[str, ...], why: Iterable[str], action: bool = False) -> None:
             sets = tuple(sorted((k, v) for k, v in values.items() if not _same(v, data.get(k))))
             # settings that change no decision the same way are one candidate (the first: the fewest changes);
             # one that changes what an action does is its own
             trial = {**data, **dict(sets)}
-            key = (sets, event) if action else (event, self._predict(groups, event, trial))
-            if key not in found:
-                found[key] = Candidate(sets, event, tuple(dict.fromkeys(why)))
+            prediction = self._predict(groups, events[0] if events else None, trial)
+            key = (sets, events) if action else (events, tuple(prediction.items()))
+            changed = {g: truths for g, truths in prediction.items() if waiting.get(g) != truths}
+            if key in found or (not action and (sets or events) and self._known(groups, changed, covered)):
+                return
+            found[key] = Candidate(sets, events, tuple(dict.fromkeys(why)))
 
-        add({}, None, ())
-        for (_source, trigger), ts in groups.items():
-            event = None if trigger == "tick" else trigger.split()[0]
-            if event is not None:
-                add({}, event, ())
+        add({}, (), ())
+        for (source, trigger), ts in groups.items():
+            events = () if trigger == "tick" else (trigger.split()[0],)
+            if events:
+                add({}, events, ())
+                if self._again(ts, events[0], covered):
+                    add({}, events * 2, ("the event twice in one chart step",))
             for values, why in self._decision(ts, data):
-                add(values, event, why)
+                add(values, events, why)
         for state in chart.configuration_values:
             for atom in self._action_atoms(state):
                 for setting in settings_for(atom, self.reader, data).values():
-                    add(dict(setting.values), None, (f"{setting.why} (an action of {state})",), action=True)
+                    add(dict(setting.values), (), (f"{setting.why} (an action of {state})",), action=True)
         return list(found.values())
 
     def _predict(self, groups: dict[tuple[str, str], list[TransitionInfo]], event: str | None,
-                 data: dict[str, Any]) -> tuple[Any, ...]:
+                 data: dict[str, Any]) -> dict[tuple[str, str], tuple[bool | None, ...]]:
         """Per decision of the tick (and of ``event``), whether each transition's guard holds with these
         data (None: it may)."""
-        out = []
-        for (_source, trigger), ts in groups.items():
+        out = {}
+        for (source, trigger), ts in groups.items():
             if trigger != "tick" and (event is None or trigger.split()[0] != event):
                 continue
-            out.append(tuple(kleene(self.guards[t.label], data, self.free) for t in ts))
-        return tuple(out)
+            out[(source, trigger)] = tuple(kleene(self.guards[t.label], data, self.free) for t in ts)
+        return out
+
+    def _known(self, groups: dict[tuple[str, str], list[TransitionInfo]],
+               changed: dict[tuple[str, str], tuple[bool | None, ...]], covered: Container[str]) -> bool:
+        """Whether in each decision a step changes (from waiting), the first transition is sure, covered,
+        and stays or goes to a state seen: the step would only repeat what the search did."""
+        if not changed:
+            return False
+        for group, truths in changed.items():
+            ts = groups[group]
+            first = next((t for t, truth in zip(ts, truths, strict=True) if truth is not False), None)
+            if first is None:
+                continue
+            if truths[ts.index(first)] is not True or first.label not in covered:
+                return False
+            if first.target is not None and first.target not in self.seen_states:
+                return False
+        return True
+
+    def _again(self, ts: list[TransitionInfo], event: str, covered: Container[str]) -> bool:
+        """Whether posting ``event`` twice may take, the second time, a transition not yet covered: one
+        on the same event from the state the first one enters (a double click)."""
+        inside = {t.target for t in ts if t.target is not None}
+        for s in self.structure.states:
+            if s.parent in inside:
+                inside.add(s.id)
+        return any(t.source in inside and event in t.events and t.label not in covered
+                   for t in self.structure.transitions)
 
     def _decision(self, ts: list[TransitionInfo], data: dict[str, Any]) -> list[tuple[dict[str, Any], list[str]]]:
         """Input values that let each transition of one decision go first (the truth table), and
@@ -261,14 +304,14 @@ class Explorer:
         else:  # one table per transition, over its own comparisons
             tables = [own for t in ts
                       if len(own := [a for a in table if a in atoms(self.guards[t.label])]) <= MAX_TABLE_ATOMS]
-        best: dict[str, tuple[int, dict[str, Any], list[str]]] = {}
+        best: dict[str, tuple[Any, dict[str, Any], list[str]]] = {}
         for part in tables:
             self._table(ts, [settings[a] for a in part if settings[a]], data, best)
         out.extend((values, why) for _n, values, why in best.values())
         return out
 
     def _table(self, ts: list[TransitionInfo], options: list[dict[bool, Setting]], data: dict[str, Any],
-               best: dict[str, tuple[int, dict[str, Any], list[str]]]) -> None:
+               best: dict[str, tuple[Any, dict[str, Any], list[str]]]) -> None:
         """The truth table of some comparisons: per transition that goes first, the fewest changes."""
         choices = [[None, *opts.values()] for opts in options]  # None: leave the inputs as they are
         for combo in itertools.product(*choices):
@@ -285,14 +328,19 @@ class Explorer:
             if conflict:
                 continue
             trial = {**data, **values}
+            changes = sum(not _same(v, data.get(k)) for k, v in values.items())
+            blocked = False  # a transition before it may hold
             for t in ts:
                 truth = kleene(self.guards[t.label], trial, self.free)
                 if truth is False:
                     continue
-                changes = sum(not _same(v, data.get(k)) for k, v in values.items())
-                if t.label not in best or changes < best[t.label][0]:
-                    best[t.label] = (changes, values, why + [f"so '{t.label}' goes first"])
-                break
+                # best: the ones before it surely false, its own guard surely true, the fewest changes
+                rank = (blocked, truth is not True, changes)
+                if t.label not in best or rank < best[t.label][0]:
+                    best[t.label] = (rank, values, why + [f"so '{t.label}' goes first"])
+                if truth is True:
+                    break
+                blocked = True
 
     def _action_atoms(self, state: str) -> list[Node]:
         if state not in self._actions:
@@ -307,15 +355,33 @@ class Explorer:
 
     # -- search ---------------------------------------------------------------------------
 
+    def _region_refs(self) -> dict[str, set[str]]:
+        """Per top-level state, the data the guards inside it read (and the inputs)."""
+        parent = {s.id: s.parent for s in self.structure.states}
+
+        def top(state: str) -> str:
+            while parent.get(state) is not None:
+                state = parent[state]  # type: ignore[assignment]
+            return state
+
+        region: dict[str, set[str]] = {}
+        for t in self.structure.transitions:
+            region.setdefault(top(t.source), set()).update(refs(self.guards[t.label]))
+        return region
+
     def key(self, chart: TickChart) -> tuple[Any, ...]:
+        """What tells two nodes apart: the active states, and the data that the guards of the active
+        top-level states' region read, floating-point values left out."""
         data = chart.data_mapping()
+        active = frozenset(chart.configuration_values)
+        names = set().union(*(self.region.get(s, set()) for s in active))
         kept = []
-        for name in sorted(self.relevant):
+        for name in sorted(names):
             v = data[name]
             if isinstance(v, float):
                 continue  # a measured quantity: it changes every tick, or has boundary values without end
             kept.append((name, v if not (isinstance(v, float) and math.isnan(v)) else "nan"))
-        return (frozenset(chart.configuration_values), tuple(kept))
+        return (active, tuple(kept))
 
     def clock(self, active: Iterable[str]) -> float:
         """Ticks after which the temporal operators of the transitions leaving ``active`` change no more
@@ -344,10 +410,10 @@ class Explorer:
         root = Sim(self.cls, self.dt).replay(prefix)
         self.seen_states |= set(root.chart.configuration_values)
         seen = {self.key(root.chart)}
-        queue: deque[tuple[Step, ...]] = deque([prefix])
+        queue: deque[tuple[tuple[Step, ...], Sim | None]] = deque([(prefix, root)])
         self.complete = True
         while queue and wanted - set(found):
-            path = queue.popleft()
+            path, probe = queue.popleft()
             if len(path) - len(prefix) >= self.bounds.max_depth:
                 self.complete = False
                 continue
@@ -355,13 +421,20 @@ class Explorer:
                 self.complete = False
                 break
             self.nodes += 1
-            probe = Sim(self.cls, self.dt).replay(path)
+            if probe is None:
+                probe = Sim(self.cls, self.dt).replay(path)
             active = tuple(probe.chart.configuration_values)
             clock = self.clock(active)
-            for cand in self.candidates(probe.chart):
+            covered = set(found) | (labels - wanted)
+            for cand in self.candidates(probe.chart, covered):
+                # the first candidate runs on the node's own chart, the others on replays of its path
                 sim = probe if probe is not None else Sim(self.cls, self.dt).replay(path)
-                probe = None  # the first candidate runs on the replay made for the candidates
-                step = sim.run(Step(cand.sets, cand.event, why=cand.why), self.bounds.max_ticks, clock)
+                probe = None
+                step = sim.run(Step(cand.sets, cand.events, why=cand.why), self.bounds.max_ticks, clock)
+                if step is None and cand.sets and not cand.events:
+                    # nothing happens with these inputs alone, but they may be half of what a later step needs
+                    sim = Sim(self.cls, self.dt).replay(path)
+                    step = sim.hold(Step(cand.sets, why=cand.why))
                 if step is None:
                     continue
                 new = [label for label in step.taken if label in wanted and label not in found]
@@ -372,7 +445,7 @@ class Explorer:
                 key = self.key(sim.chart)
                 if key not in seen:
                     seen.add(key)
-                    queue.append(child)
+                    queue.append((child, sim))
                 if new and stop_at_first:
                     return found
         return found

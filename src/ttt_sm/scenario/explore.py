@@ -33,7 +33,7 @@ import itertools
 import math
 import time
 from collections import deque
-from collections.abc import Container, Iterable
+from collections.abc import Container, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -47,6 +47,8 @@ from .runner import StateLog
 #: How many comparisons of one decision the truth table enumerates (2**n combinations); above it,
 #: only each comparison alone.
 MAX_TABLE_ATOMS = 6
+#: A step that takes no transition ends once what the guards read stood still this many chart steps.
+STILL_TICKS = 512
 
 
 @dataclass(frozen=True)
@@ -65,7 +67,8 @@ class Step:
 
     ``why`` says where each input value came from; ``taken`` (the labels of the
     transitions the step took), ``active`` (the leaf states after it) and
-    ``outputs`` (outputs it changed, with their new values) are what running it did.
+    ``outputs`` (the outputs it changed, and the local data other than measured
+    quantities, with their new values) are what running it did.
     """
 
     sets: tuple[tuple[str, Any], ...] = ()
@@ -75,6 +78,7 @@ class Step:
     taken: tuple[str, ...] = ()
     active: tuple[str, ...] = ()
     outputs: tuple[tuple[str, Any], ...] = ()
+    entered: tuple[str, ...] = ()  #: the leaf states it entered, in order
 
 
 @dataclass
@@ -86,6 +90,7 @@ class Sim:
     chart: TickChart = field(init=False)
     log: StateLog = field(init=False)
     taken: list[str] = field(init=False, default_factory=list)
+    _log_start: int = field(init=False, default=0)
 
     def __post_init__(self) -> None:
         self.log = StateLog()
@@ -114,36 +119,52 @@ class Sim:
         for event in step.events:
             self.chart.post(event)
 
-    def run(self, step: Step, max_ticks: int, clock: float) -> Step | None:
-        """Run a new step: tick until a transition is taken; None if none is within ``max_ticks``
-        (or the chart stands still past ``clock`` ticks, when its temporal operators change no more)."""
-        before = self.chart.snapshot(("output",))
+    def run(self, step: Step, max_ticks: int, clock: float, watch: Sequence[str] = ()) -> Step | None:
+        """Run a new step: tick until a transition is taken; None if none is within ``max_ticks``.
+
+        Past ``clock`` ticks (when the temporal operators of the active states change no more) a step
+        also ends without a transition once the data its guards read (``watch``; all data if empty)
+        stood still for :data:`STILL_TICKS` chart steps: waiting longer would change nothing they see.
+        """
+        before = self.chart.snapshot(("output", "local"))
         self._start(step)
         start = len(self.taken)
-        previous = None
+        self._log_start = len(self.log.entries[self.cls.__name__])
+        data = self.chart.data_mapping()
+        names = tuple(watch) or tuple(data)
+        previous: tuple[Any, ...] | None = None
+        still_since = 0
         for n in range(1, max_ticks + 1):
             self.chart.tick()
             if len(self.taken) > start:
                 return self._done(step, n, start, before)
-            if n > clock and n % 64 == 0:  # the clock decides nothing more: the same data again means never
-                now = _comparable(self.chart.snapshot())
-                if now == previous:
+            if n > clock and n % 64 == 0:
+                now = tuple("nan" if isinstance(v, float) and math.isnan(v) else v for v in map(data.__getitem__, names))
+                if now != previous:
+                    previous, still_since = now, n
+                elif n - still_since >= STILL_TICKS:
                     return None
-                previous = now
         return None
 
     def hold(self, step: Step) -> Step:
         """A step that only sets inputs: no chart step runs (what a later step needs may be more)."""
+        before = self.chart.snapshot(("output", "local"))
+        self._log_start = len(self.log.entries[self.cls.__name__])
         self._start(step)
-        return self._done(step, 0, len(self.taken), self.chart.snapshot(("output",)))
+        return self._done(step, 0, len(self.taken), before)
 
     def _done(self, step: Step, ticks: int, start: int, before: dict[str, Any]) -> Step:
         kinds = chart_states(self.cls)
-        after = self.chart.snapshot(("output",))
-        changed = tuple((k, v) for k, v in after.items() if not _same(v, before.get(k)))
+        outputs = {d.name for d in self.cls.declarations() if d.kind == "output"}
+        after = self.chart.snapshot(("output", "local"))
+        # what a step is checked by: the outputs it changed, and the counters and flags of its own data
+        changed = tuple((k, v) for k, v in after.items() if not _same(v, before.get(k))
+                        and (k in outputs or not isinstance(v, float)))
         leaves = tuple(s for s in self.chart.configuration_values if kinds.get(s) == "leaf")
+        entered = tuple(e.state for e in self.log.entries[self.cls.__name__][self._log_start:]
+                        if kinds.get(e.state) == "leaf")
         return Step(step.sets, step.events, ticks, step.why, tuple(dict.fromkeys(self.taken[start:])),
-                    leaves, changed)
+                    leaves, changed, entered)
 
     def leaf_sequence(self) -> list[str]:
         """The leaf states entered since power-on, as ``expect_states`` with ``match: exact`` sees them."""
@@ -155,11 +176,6 @@ def has_clock_spec(spec: Any) -> bool:
     """Whether a guard spec is a temporal operator or a ``duration``."""
     func = getattr(spec, "func", None)
     return temporal_of(func) is not None or duration_of(func) is not None
-
-
-def _comparable(data: dict[str, Any]) -> dict[str, Any]:
-    """Data with NaN as text: NaN is not equal to itself, and "not yet set" is the same each tick."""
-    return {k: "nan" if isinstance(v, float) and math.isnan(v) else v for k, v in data.items()}
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -194,7 +210,8 @@ class Explorer:
         self.first: dict[str, tuple[Step, ...]] = {}  #: transition label -> the first path that took it
         self.nodes = 0
         self.complete = True  #: the search ended by exhausting the nodes, not a bound
-        self.seen_states: set[str] = set()
+        self.seen_states: set[str] = set()  #: states active on some explored path (of every search)
+        self._states_here: set[str] = set()  # ... of the current search
 
     # -- candidates ---------------------------------------------------------------------
 
@@ -272,7 +289,7 @@ class Explorer:
                 continue
             if truths[ts.index(first)] is not True or first.label not in covered:
                 return False
-            if first.target is not None and first.target not in self.seen_states:
+            if first.target is not None and first.target not in self._states_here:
                 return False
         return True
 
@@ -400,24 +417,29 @@ class Explorer:
         return limit
 
     def search(self, prefix: tuple[Step, ...] = (), wanted: set[str] | None = None,
-               stop_at_first: bool = False) -> dict[str, tuple[Step, ...]]:
+               stop_at_first: bool = False, bounds: Bounds | None = None) -> dict[str, tuple[Step, ...]]:
         """Breadth-first from the end of ``prefix``: for each transition (of ``wanted``, default all)
-        the first path found that takes it.  ``stop_at_first``: return at the first one."""
+        the first path found that takes it.  ``stop_at_first``: return at the first one; ``bounds``:
+        other than the explorer's."""
         t0 = time.perf_counter()
+        bounds = bounds or self.bounds
+        start_nodes = self.nodes
         labels = {t.label for t in self.structure.transitions}
         wanted = set(labels if wanted is None else wanted)
         found: dict[str, tuple[Step, ...]] = {}
         root = Sim(self.cls, self.dt).replay(prefix)
-        self.seen_states |= set(root.chart.configuration_values)
+        self._states_here = set(root.chart.configuration_values)
+        self.seen_states |= self._states_here
+        taken_here: set[str] = set()  # the transitions this search took: their children are in its queue
         seen = {self.key(root.chart)}
         queue: deque[tuple[tuple[Step, ...], Sim | None]] = deque([(prefix, root)])
         self.complete = True
         while queue and wanted - set(found):
             path, probe = queue.popleft()
-            if len(path) - len(prefix) >= self.bounds.max_depth:
+            if len(path) - len(prefix) >= bounds.max_depth:
                 self.complete = False
                 continue
-            if self.nodes >= self.bounds.max_nodes or time.perf_counter() - t0 > self.bounds.time_s:
+            if self.nodes - start_nodes >= bounds.max_nodes or time.perf_counter() - t0 > bounds.time_s:
                 self.complete = False
                 break
             self.nodes += 1
@@ -425,12 +447,13 @@ class Explorer:
                 probe = Sim(self.cls, self.dt).replay(path)
             active = tuple(probe.chart.configuration_values)
             clock = self.clock(active)
-            covered = set(found) | (labels - wanted)
+            watch = sorted(set().union(*(self.region.get(s, set()) for s in active)))
+            covered = set(taken_here)
             for cand in self.candidates(probe.chart, covered):
                 # the first candidate runs on the node's own chart, the others on replays of its path
                 sim = probe if probe is not None else Sim(self.cls, self.dt).replay(path)
                 probe = None
-                step = sim.run(Step(cand.sets, cand.events, why=cand.why), self.bounds.max_ticks, clock)
+                step = sim.run(Step(cand.sets, cand.events, why=cand.why), bounds.max_ticks, clock, watch)
                 if step is None and cand.sets and not cand.events:
                     # nothing happens with these inputs alone, but they may be half of what a later step needs
                     sim = Sim(self.cls, self.dt).replay(path)
@@ -441,7 +464,9 @@ class Explorer:
                 child = (*path, step)
                 for label in new:
                     found[label] = child
-                self.seen_states |= set(sim.chart.configuration_values)
+                taken_here.update(step.taken)
+                self._states_here |= set(sim.chart.configuration_values)
+                self.seen_states |= self._states_here
                 key = self.key(sim.chart)
                 if key not in seen:
                     seen.add(key)

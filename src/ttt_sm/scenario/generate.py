@@ -39,6 +39,9 @@ from .explore import Bounds, Explorer, Sim, Step
 from .guard_reader import atoms, kleene, refs, show, show_value
 
 STRATEGIES = ("shortest", "tour")
+#: How long the greedy tours may search, s of wall-clock time; and each extension of a tour.
+TOUR_TIME_S = 5.0
+TOUR_BOUNDS = Bounds(max_nodes=40, time_s=1.0)
 #: The longest condition a generated ``expect`` writes (the language allows 2000 characters).
 MAX_EXPECT_CHARS = 400
 
@@ -120,33 +123,38 @@ def _shortest(found: dict[str, tuple[Step, ...]]) -> list[tuple[Step, ...]]:
 
 
 def _tour(explorer: Explorer, found: dict[str, tuple[Step, ...]]) -> list[tuple[Step, ...]]:
-    """Greedy tours: extend the current path to the nearest transition not yet taken."""
+    """Greedy tours: extend the current path to the nearest transition not yet taken (a small search
+    from its end); once :data:`TOUR_TIME_S` is spent, the transitions left get their first paths."""
     left = set(found)
     paths: list[tuple[Step, ...]] = []
-    while left:
+    deadline = time.perf_counter() + TOUR_TIME_S
+    while left and time.perf_counter() < deadline:
         path: tuple[Step, ...] = ()
-        while left:
-            nearest = explorer.search(path, wanted=left, stop_at_first=True)
-            if not nearest:
+        while left and time.perf_counter() < deadline:
+            nearest = explorer.search(path, wanted=left, stop_at_first=True, bounds=TOUR_BOUNDS)
+            if nearest:
+                path = next(iter(nearest.values()))
+            elif not path:  # far from power-on: start with the shortest first path of those left
+                path = min((found[label] for label in left), key=len)
+            else:
                 break
-            path = next(iter(nearest.values()))
             left -= {label for step in path for label in step.taken}
-        if not path:  # from power-on the search did not find them again: their first paths
-            paths.extend(dict.fromkeys(found[label] for label in sorted(left)))
-            break
         paths.append(path)
+    # what the tours did not reach in time, or from power-on within their small searches: first paths
+    paths.extend(dict.fromkeys(found[label] for label in sorted(left)
+                               if not any(label in step.taken for p in paths for step in p)))
     return paths
 
 
 def _scenario(cls: type[TickChart], dt: float, path: tuple[Step, ...], labels: Sequence[str],
               strategy: str) -> GeneratedScenario:
-    sim = Sim(cls, dt).replay(path)
+    leaves = [*Sim(cls, dt).leaf_sequence(), *(state for step in path for state in step.entered)]
     taken = {label for step in path for label in step.taken}
     if strategy == "shortest":
         takes = tuple(label for label in labels if label in path[-1].taken)
     else:
         takes = tuple(label for label in labels if label in taken)
-    return GeneratedScenario(cls.__name__, path, takes, tuple(sim.leaf_sequence()), strategy)
+    return GeneratedScenario(cls.__name__, path, takes, tuple(leaves), strategy)
 
 
 # -- why a transition was not taken ---------------------------------------------------------
@@ -282,7 +290,8 @@ def to_yaml(scenario: GeneratedScenario, command: str) -> str:
         "steps:",
     ]
     for k, step in enumerate(scenario.path, 1):
-        out.append(f"  # step {k}:" + (" " + "; ".join(step.why) if step.why else " wait"))
+        doing = "; ".join(step.why) or (f"posts {', '.join(step.events)}" if step.events else "waits")
+        out.append(f"  # step {k}: {doing}")
         if step.taken:
             out.append(f"  # takes {'; '.join(step.taken)} (after {step.ticks} chart step"
                        f"{'s' if step.ticks != 1 else ''})")

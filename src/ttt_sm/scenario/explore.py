@@ -207,11 +207,32 @@ class Explorer:
         # comparisons of the chart's own data alone: what its actions will make of them is not known
         self.free = {a for g in self.guards.values() for a in atoms(g) if not refs(a) & self.reader.inputs}
         self._actions: dict[str, list[Node]] = {}
-        self.first: dict[str, tuple[Step, ...]] = {}  #: transition label -> the first path that took it
         self.nodes = 0
         self.complete = True  #: the search ended by exhausting the nodes, not a bound
+        self.start = self._start_step()
         self.seen_states: set[str] = set()  #: states active on some explored path (of every search)
         self._states_here: set[str] = set()  # ... of the current search
+
+    def _start_step(self) -> Step | None:
+        """Every path's first step: the inputs that only actions read (no guard, no comparison of an
+        action) get values other than their defaults, so that what the actions do with them shows in
+        the outputs the steps check (a dropped ``set_home`` with ``index_pos`` 0 would change nothing)."""
+        decided = set().union(*(refs(g) for g in self.guards.values()))
+        for state in self.structure.states:
+            decided |= set().union(*(refs(a) for a in self._action_atoms(state.id)))
+        values: dict[str, Any] = {}
+        for d in self.cls.declarations():
+            if d.kind != "input" or d.name in decided or isinstance(d.default, bool):
+                continue
+            if isinstance(d.default, float):
+                values[d.name] = d.default * 1.25 if d.default else 0.125
+            elif isinstance(d.default, int):
+                values[d.name] = d.default + 1
+        if not values:
+            return None
+        why = ("inputs that only actions read get values other than their defaults: what the actions"
+               " do with them shows in the outputs",)
+        return Sim(self.cls, self.dt).hold(Step(tuple(sorted(values.items())), why=why))
 
     # -- candidates ---------------------------------------------------------------------
 
@@ -423,6 +444,8 @@ class Explorer:
         other than the explorer's."""
         t0 = time.perf_counter()
         bounds = bounds or self.bounds
+        if not prefix and self.start is not None:
+            prefix = (self.start,)
         start_nodes = self.nodes
         labels = {t.label for t in self.structure.transitions}
         wanted = set(labels if wanted is None else wanted)

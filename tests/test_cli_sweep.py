@@ -108,6 +108,15 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
         in_files(["scenario", action], None)
     cases.append((["scenario", "run", str(Path(__file__).parent / "scenarios"), "--trace", p["read_only"]],
                   p["read_only"]))
+    generated_scenarios = str(Path(__file__).parent / "scenarios" / "drive_3_leaves_its_switch_when_it_starts_on_it.yaml")
+    cases.append((["scenario", "run", generated_scenarios, "--coverage", "--suggest", p["read_only"]],
+                  p["read_only"]))
+    cases.append((["scenario", "run", generated_scenarios, "--suggest", str(tmp / "suggested")], "--coverage"))
+    for action in ("generate", "mutate"):
+        cases.append((["scenario", action, "NoSuchChart", str(Path(__file__).parent / "scenarios")], "NoSuchChart"))
+    out_dirs(["scenario", "generate", "DriveInit3"])
+    cases.append((["scenario", "generate", "DriveInit3", "--strategy", "random"], "--strategy"))
+    in_files(["scenario", "mutate", "DriveInit3"], None)
     numbers(["gui"], "--port", ("abc", "1.5", "-1", "70000"))
     numbers(["gui"], "--speed", ("abc", "nan", "inf", "0", "11"))
     numbers(["gui"], "--seed", ("abc", "-1"))

@@ -204,6 +204,7 @@ class Explorer:
         self.reader = GuardReader(cls)
         self.guards: dict[str, Node] = {t.label: self.reader.guard(t.transition) for t in self.structure.transitions}
         self.region = self._region_refs()
+        self.junctions = {st.id for st in self.structure.states if st.junction}
         # comparisons of the chart's own data alone: what its actions will make of them is not known
         self.free = {a for g in self.guards.values() for a in atoms(g) if not refs(a) & self.reader.inputs}
         self._actions: dict[str, list[Node]] = {}
@@ -237,12 +238,28 @@ class Explorer:
     # -- candidates ---------------------------------------------------------------------
 
     def outgoing(self, active: Iterable[str]) -> dict[tuple[str, str], list[TransitionInfo]]:
-        """The transitions that may leave the active states, by (source, trigger), in priority order."""
+        """The transitions that may leave the active states, by (source, trigger), in priority order.
+
+        A transition to a connective junction brings the junction's segments in, as a decision of their
+        own under the trigger that leads there (docs/runtime.md, "Junctions").
+        """
         active = set(active)
         groups: dict[tuple[str, str], list[TransitionInfo]] = {}
+        reach: list[tuple[str, str]] = []
         for t in self.structure.transitions:
             if t.source in active:
                 groups.setdefault((t.source, t.trigger), []).append(t)
+                if t.target in self.junctions:
+                    reach.append((t.target, t.trigger))
+        while reach:
+            junction, trigger = reach.pop()
+            if (junction, trigger) in groups:
+                continue
+            for t in self.structure.transitions:
+                if t.source == junction:
+                    groups.setdefault((junction, trigger), []).append(t)
+                    if t.target in self.junctions:
+                        reach.append((t.target, trigger))
         for ts in groups.values():
             ts.sort(key=lambda t: ({"outer": 0, "inner": 1, "segment": 2, "action": 3}[t.scope], t.priority))
         return groups

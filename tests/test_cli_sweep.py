@@ -108,10 +108,9 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
         in_files(["scenario", action], None)
     cases.append((["scenario", "run", str(Path(__file__).parent / "scenarios"), "--trace", p["read_only"]],
                   p["read_only"]))
-    generated_scenarios = str(Path(__file__).parent / "scenarios" / "drive_3_leaves_its_switch_when_it_starts_on_it.yaml")
-    cases.append((["scenario", "run", generated_scenarios, "--coverage", "--suggest", p["read_only"]],
-                  p["read_only"]))
-    cases.append((["scenario", "run", generated_scenarios, "--suggest", str(tmp / "suggested")], "--coverage"))
+    one = str(Path(__file__).parent / "scenarios" / "drive_3_leaves_its_switch_when_it_starts_on_it.yaml")
+    cases.append((["scenario", "run", one, "--coverage", "--suggest", p["read_only"]], p["read_only"]))
+    cases.append((["scenario", "run", one, "--suggest", str(tmp / "suggested")], "--coverage"))
     for action in ("generate", "mutate"):
         cases.append((["scenario", action, "NoSuchChart", str(Path(__file__).parent / "scenarios")], "NoSuchChart"))
     out_dirs(["scenario", "generate", "DriveInit3"])

@@ -40,7 +40,7 @@ from typing import Any
 from ..runtime import TickChart
 from ..runtime.structure import TransitionInfo
 from ..runtime.temporal import duration_of, temporal_of
-from .guard_reader import GuardReader, Node, Setting, atoms, has_clock, kleene, refs, settings_for, show
+from .guard_reader import GuardReader, Node, Setting, atoms, has_clock, kleene, refs, settings_for
 from .model import chart_states
 from .runner import StateLog
 
@@ -139,7 +139,8 @@ class Sim:
             if len(self.taken) > start:
                 return self._done(step, n, start, before)
             if n > clock and n % 64 == 0:
-                now = tuple("nan" if isinstance(v, float) and math.isnan(v) else v for v in map(data.__getitem__, names))
+                now = tuple("nan" if isinstance(v, float) and math.isnan(v) else v
+                            for v in map(data.__getitem__, names))
                 if now != previous:
                     previous, still_since = now, n
                 elif n - still_since >= STILL_TICKS:
@@ -289,7 +290,7 @@ class Explorer:
             found[key] = Candidate(sets, events, tuple(dict.fromkeys(why)))
 
         add({}, (), ())
-        for (source, trigger), ts in groups.items():
+        for (_source, trigger), ts in groups.items():
             events = () if trigger == "tick" else (trigger.split()[0],)
             if events:
                 add({}, events, ())

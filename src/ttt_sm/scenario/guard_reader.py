@@ -46,6 +46,7 @@ _CMP_AST = {ast.Eq: "==", ast.NotEq: "!=", ast.Lt: "<", ast.LtE: "<=", ast.Gt: "
 _ARITH_AST = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/"}
 _CMP = {"==": operator.eq, "!=": operator.ne, "<": operator.lt, "<=": operator.le,
         ">": operator.gt, ">=": operator.ge}
+_FUNCTIONS: dict[str, Callable[..., Any]] = {"abs": abs, "min": min, "max": max}
 _ARITH = {"+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv}
 
 
@@ -330,7 +331,11 @@ def value(node: Node, data: Mapping[str, Any]) -> Any:
         except TypeError:
             raise Unknown(node[1][0]) from None
     if kind == "call":
-        return {"abs": abs, "min": min, "max": max}[node[1]](*(value(n, data) for n in node[2]))
+        func: Callable[..., Any] = _FUNCTIONS[node[1]]
+        try:
+            return func(*(value(n, data) for n in node[2]))
+        except (TypeError, ValueError):
+            raise Unknown(node[1]) from None
     if kind == "ifexp":
         return value(node[2], data) if value(node[1], data) else value(node[3], data)
     raise Unknown(kind)
@@ -426,9 +431,10 @@ def _candidates(atom: Node, x: str, datum: Any, data: Mapping[str, Any]) -> list
         return []
     found: list[Any] = []
     for b in _invert(side, target, x, data):
+        near: list[Any]
         if isinstance(default, int):
-            b = round(b)
-            near = [b, b - 1, b + 1]
+            whole = round(b)
+            near = [whole, whole - 1, whole + 1]
         else:
             eps = max(abs(b), 1.0) * 1e-6
             near = [b, b - eps, b + eps]

@@ -145,7 +145,7 @@ def _text_flips(tree: ast.ClassDef, text: ast.Constant, line: int) -> list[Mutan
     """A guard written as text: each comparison negated, or a bare name negated."""
     import re
 
-    value: str = text.value
+    value = str(text.value)
     where = _path_to(tree, text)
     out = []
     ops = list(re.finditer(r"==|!=|<=|>=|<|>", value))
@@ -213,11 +213,16 @@ def runs_chart(scenario: Scenario, chart: str) -> bool:
     return scenario.bare is not None and any(c.__name__ == chart for c in scenario.bare.charts.values())
 
 
+def _bare(scenario: Scenario, params: ArmParams, listeners: Sequence[object]) -> ChartsOnly:
+    assert scenario.bare is not None  # only bare-chart scenarios are run against mutants
+    return ChartsOnly(scenario.bare, params, listeners)
+
+
 def first_failure(scenarios: Sequence[Scenario], chart: str, cls: type[TickChart], params: ArmParams) -> str | None:
     """The first failure of the scenarios with ``chart`` replaced by ``cls`` (None: they all pass)."""
     for scenario in scenarios:
         s = _with_chart(scenario, chart, cls)
-        result = run_scenario(s, params, robot_factory=lambda sc, p, lst: ChartsOnly(sc.bare, p, lst))
+        result = run_scenario(s, params, robot_factory=_bare)
         if not result.passed:
             return f"{scenario.file}: {result.failures[0].message}"
     return None

@@ -111,8 +111,8 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     one = str(Path(__file__).parent / "scenarios" / "drive_3_leaves_its_switch_when_it_starts_on_it.yaml")
     cases.append((["scenario", "run", one, "--coverage", "--suggest", p["read_only"]], p["read_only"]))
     cases.append((["scenario", "run", one, "--suggest", str(tmp / "suggested")], "--coverage"))
-    for action in ("generate", "mutate"):
-        cases.append((["scenario", action, "NoSuchChart", str(Path(__file__).parent / "scenarios")], "NoSuchChart"))
+    cases.append((["scenario", "generate", "NoSuchChart"], "NoSuchChart"))
+    cases.append((["scenario", "mutate", "NoSuchChart", str(Path(__file__).parent / "scenarios")], "NoSuchChart"))
     out_dirs(["scenario", "generate", "DriveInit3"])
     cases.append((["scenario", "generate", "DriveInit3", "--strategy", "random"], "--strategy"))
     in_files(["scenario", "mutate", "DriveInit3"], None)

@@ -55,6 +55,7 @@ class GeneratedScenario:
     takes: tuple[str, ...]
     leaves: tuple[str, ...]  #: the leaf states entered since power-on (``expect_states``)
     strategy: str
+    initial: tuple[str, ...] = ()  #: the leaf states active at power-on
 
     @property
     def chart_steps(self) -> int:
@@ -148,13 +149,14 @@ def _tour(explorer: Explorer, found: dict[str, tuple[Step, ...]]) -> list[tuple[
 
 def _scenario(cls: type[TickChart], dt: float, path: tuple[Step, ...], labels: Sequence[str],
               strategy: str) -> GeneratedScenario:
-    leaves = [*Sim(cls, dt).leaf_sequence(), *(state for step in path for state in step.entered)]
+    initial = Sim(cls, dt).leaf_sequence()
+    leaves = [*initial, *(state for step in path for state in step.entered)]
     taken = {label for step in path for label in step.taken}
     if strategy == "shortest":
         takes = tuple(label for label in labels if label in path[-1].taken)
     else:
         takes = tuple(label for label in labels if label in taken)
-    return GeneratedScenario(cls.__name__, path, takes, tuple(leaves), strategy)
+    return GeneratedScenario(cls.__name__, path, takes, tuple(leaves), strategy, tuple(initial))
 
 
 # -- why a transition was not taken ---------------------------------------------------------
@@ -289,6 +291,7 @@ def to_yaml(scenario: GeneratedScenario, command: str) -> str:
         f"chart: {chart}",
         "steps:",
     ]
+    before = scenario.initial
     for k, step in enumerate(scenario.path, 1):
         doing = "; ".join(step.why) or (f"posts {', '.join(step.events)}" if step.events else "waits")
         out.append(f"  # step {k}: {doing}")
@@ -302,10 +305,15 @@ def to_yaml(scenario: GeneratedScenario, command: str) -> str:
             out.append(f"  - set: {{{values}}}")
         for event in step.events:
             out.append(f"  - post: {{chart: {chart}, event: {event}}}")
-        if step.ticks:
+        if step.ticks > 1:  # the transition comes at the last chart step, not one sooner
+            out.append(f"  - run: {{chart_steps: {step.ticks - 1}}}")
+            out.append(f"  - expect: {json.dumps(' and '.join(f'{chart}.{leaf}' for leaf in before))}")
+            out.append("  - run: {chart_steps: 1}")
+        elif step.ticks:
             out.append(f"  - run: {{chart_steps: {step.ticks}}}")
         for condition in _expect(chart, step):
             out.append(f"  - expect: {json.dumps(condition)}")
+        before = step.active
     out.append(f"  - expect_states: {{chart: {chart}, sequence: [{', '.join(scenario.leaves)}], match: exact}}")
     return "\n".join(out) + "\n"
 

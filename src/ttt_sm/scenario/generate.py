@@ -39,9 +39,10 @@ from .explore import Bounds, Explorer, Sim, Step
 from .guard_reader import atoms, kleene, refs, show, show_value
 
 STRATEGIES = ("shortest", "tour")
-#: How long the greedy tours may search, s of wall-clock time; and each extension of a tour.
-TOUR_TIME_S = 5.0
-TOUR_BOUNDS = Bounds(max_nodes=40, time_s=1.0)
+#: How many nodes the greedy tours may search in all, and each extension of a tour (nodes, not seconds:
+#: the same files on a busy machine).
+TOUR_NODES = 300
+TOUR_BOUNDS = Bounds(max_nodes=40)
 #: The longest condition a generated ``expect`` writes (the language allows 2000 characters).
 MAX_EXPECT_CHARS = 400
 
@@ -71,7 +72,8 @@ class Generated:
     transitions: tuple[str, ...]
     scenarios: list[GeneratedScenario] = field(default_factory=list)
     unreachable: dict[str, str] = field(default_factory=dict)
-    seconds: float = 0.0
+    seconds: float = 0.0  #: wall-clock time of the search and the paths
+    cpu_seconds: float = 0.0  #: processor time of this process meanwhile (a busy machine changes it less)
     nodes: int = 0
     files: list[str] = field(default_factory=list)
 
@@ -94,6 +96,7 @@ class Generated:
             "tour_lower_bound": len(self.transitions) - len(self.unreachable),
             "search_nodes": self.nodes,
             "seconds": round(self.seconds, 3),
+            "cpu_seconds": round(self.cpu_seconds, 3),
             "files": list(self.files),
         }
 
@@ -103,7 +106,7 @@ def generate(cls: type[TickChart], dt: float, strategy: str = "shortest",
     """Search ``cls`` and make its scenarios (nothing written: see :func:`write`)."""
     if strategy not in STRATEGIES:
         raise ValueError(f"strategy {strategy!r}; strategies: {', '.join(STRATEGIES)}")
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     explorer = Explorer(cls, dt, bounds)
     found = explorer.search()
     labels = tuple(t.label for t in cls.structure().transitions)
@@ -114,6 +117,7 @@ def generate(cls: type[TickChart], dt: float, strategy: str = "shortest",
     for path in paths:
         out.scenarios.append(_scenario(cls, dt, path, labels, strategy))
     out.seconds = time.perf_counter() - t0
+    out.cpu_seconds = time.process_time() - cpu0
     out.nodes = explorer.nodes
     return out
 
@@ -125,13 +129,13 @@ def _shortest(found: dict[str, tuple[Step, ...]]) -> list[tuple[Step, ...]]:
 
 def _tour(explorer: Explorer, found: dict[str, tuple[Step, ...]]) -> list[tuple[Step, ...]]:
     """Greedy tours: extend the current path to the nearest transition not yet taken (a small search
-    from its end); once :data:`TOUR_TIME_S` is spent, the transitions left get their first paths."""
+    from its end); once :data:`TOUR_NODES` are searched, the transitions left get their first paths."""
     left = set(found)
     paths: list[tuple[Step, ...]] = []
-    deadline = time.perf_counter() + TOUR_TIME_S
-    while left and time.perf_counter() < deadline:
+    budget = explorer.nodes + TOUR_NODES
+    while left and explorer.nodes < budget:
         path: tuple[Step, ...] = ()
-        while left and time.perf_counter() < deadline:
+        while left and explorer.nodes < budget:
             nearest = explorer.search(path, wanted=left, stop_at_first=True, bounds=TOUR_BOUNDS)
             if nearest:
                 path = next(iter(nearest.values()))

@@ -3,7 +3,15 @@
 ``ttt-sm scenario run FILES... [--json] [--coverage] [--trace DIR] [--out FILE]``
 runs the scenarios (a folder means its ``*.yaml`` files) and exits with status
 0 if all passed, 1 if one failed, 2 if a file could not be loaded (nothing
-runs then).  ``ttt-sm scenario check FILES...`` only loads and checks them.
+runs then); ``--suggest DIR`` (with ``--coverage``) writes there, for each
+transition the scenarios never took, the shortest generated scenario that takes
+it.  ``ttt-sm scenario check FILES...`` only loads and checks them.
+
+``ttt-sm scenario generate CHART [--out DIR] [--strategy shortest|tour]
+[--json]`` writes scenarios that together take every transition of the chart
+the search reaches (:mod:`ttt_sm.scenario.generate`); ``ttt-sm scenario
+mutate CHART FILES...`` runs scenarios against mutants of the chart
+(:mod:`ttt_sm.scenario.mutate`).  docs/scenarios.md, "Generated scenarios".
 
 What is streamed and what is one document: ``--out FILE`` and ``--trace DIR``
 are JSON Lines written as the run goes, each line flushed, the last one
@@ -19,11 +27,12 @@ import sys
 from typing import Any
 
 from ..scenario.errors import ScenarioError
+from ..scenario.generate import STRATEGIES
 from ..scenario.loader import load_scenario, scenario_files
 from ..scenario.model import Scenario, Step
 from ..scenario.runner import ScenarioResult
 from ..scenario.suite import RunReport, run_scenarios
-from .common import out_dir, print_json, trace_file
+from .common import CliError, out_dir, print_json, trace_file
 
 
 def register(sub: Any) -> None:
@@ -43,7 +52,31 @@ def register(sub: Any) -> None:
     run.add_argument("--out", metavar="FILE", default=None,
                      help="write the report to FILE as the run goes (JSON Lines: a line per scenario as it ends,"
                           " the coverage, the counts; the last line says how the run ended)")
+    run.add_argument("--suggest", metavar="DIR", default=None,
+                     help="with --coverage: write to DIR, for each transition the scenarios never took, the"
+                          " shortest generated scenario that takes it")
     run.set_defaults(func=cmd_scenario_run)
+
+    gen = actions.add_parser("generate", help="generate scenarios that take every transition of a chart",
+                             description="Write bare-chart scenarios that together take every transition of"
+                                         " CHART the search reaches; report the others with the reason.")
+    gen.add_argument("chart", metavar="CHART", help=f"a chart: {', '.join(_chart_names())}")
+    gen.add_argument("--out", metavar="DIR", default=None,
+                     help="folder to write the files to (default: generated/CHART)")
+    gen.add_argument("--strategy", default="shortest", choices=STRATEGIES,
+                     help="shortest: one scenario per transition, the shortest path found; tour: fewer,"
+                          " longer scenarios (default: shortest)")
+    gen.add_argument("--json", action="store_true", help="print one JSON document: what was generated")
+    gen.set_defaults(func=cmd_scenario_generate)
+
+    mut = actions.add_parser("mutate", help="run scenarios against mutants of a chart",
+                             description="Run the scenarios that run CHART bare against mutants of it (a guard"
+                                         " flipped, two transitions swapped, an action dropped); report how many"
+                                         " the scenarios kill.")
+    mut.add_argument("chart", metavar="CHART", help=f"a chart: {', '.join(_chart_names())}")
+    mut.add_argument("files", nargs="+", metavar="FILE", help="scenario files, or folders of them")
+    mut.add_argument("--json", action="store_true", help="print one JSON document")
+    mut.set_defaults(func=cmd_scenario_mutate)
 
     check = actions.add_parser("check", help="load and check scenario files without running them")
     check.add_argument("files", nargs="+", metavar="FILE", help="scenario files, or folders of them")
@@ -89,6 +122,10 @@ def cmd_scenario_run(args: argparse.Namespace) -> int:
         return _report_errors(errors, args.json)
     params = load_arm(args.params)
     # what will be written is checked before anything runs
+    if args.suggest is not None and not args.coverage:
+        raise CliError("--suggest writes scenarios for the transitions the coverage misses: add --coverage")
+    if args.suggest is not None:
+        out_dir(args.suggest, "--suggest")
     if args.trace is not None:
         out_dir(args.trace, "--trace")
     report_path = trace_file(args.out, "--out") if args.out is not None else None
@@ -126,8 +163,10 @@ def cmd_scenario_run(args: argparse.Namespace) -> int:
                         "ended": {"event": how, **data, "scenarios_done": len(done),
                                   "scenarios_total": len(scenarios)}})
         raise
+    suggested = _suggest(report, params, args.suggest) if args.suggest is not None else None
     if args.json:
-        print_json({**report.to_dict(), "complete": True})
+        extra = {"suggested": suggested} if suggested is not None else {}
+        print_json({**report.to_dict(), **extra, "complete": True})
     else:
         counts = report.to_dict()["counts"]
         sim = sum(r.sim_time_s for r in report.results)
@@ -136,7 +175,119 @@ def cmd_scenario_run(args: argparse.Namespace) -> int:
         if report.coverage is not None:
             print("coverage of all the scenarios together:")
             print(report.coverage.to_text(), end="")
+        for item in suggested or []:
+            where = item["file"] if item["file"] else f"none: {item['reason']}"
+            print(f"suggested for {item['chart']} {item['transition']}: {where}")
     return 0 if report.passed else 1
+
+
+def _chart_names() -> list[str]:
+    from ..charts import ALL_CHARTS
+
+    return [c.__name__ for c in ALL_CHARTS]
+
+
+def _chart(name: str) -> Any:
+    """The chart class named ``name``; one line naming the choices if there is none."""
+    from ..charts import ALL_CHARTS
+
+    for cls in ALL_CHARTS:
+        if cls.__name__ == name:
+            return cls
+    raise CliError(f"unknown chart {name[:80]!r}; charts: {', '.join(_chart_names())}")
+
+
+def _suggest(report: RunReport, params: Any, folder: str) -> list[dict[str, Any]]:
+    """For each transition no scenario took: the shortest generated scenario that takes it, written to
+    ``folder`` (or why there is none)."""
+    from pathlib import Path
+
+    from ..scenario.generate import file_name, generate, to_yaml
+
+    assert report.coverage is not None
+    out: list[dict[str, Any]] = []
+    for cov in report.coverage.charts:
+        missing = list(cov.missing_transitions)
+        if not missing:
+            continue
+        generated = generate(_chart(cov.chart), params.control.chart_dt, "shortest")
+        by_label = {label: s for s in generated.scenarios for label in s.takes}
+        written: dict[int, str] = {}
+        for label in missing:
+            scenario = by_label.get(label)
+            if scenario is None:
+                out.append({"chart": cov.chart, "transition": label, "file": None,
+                            "reason": generated.unreachable.get(label, "the search did not take it")})
+                continue
+            key = id(scenario)
+            if key not in written:
+                path = Path(folder) / file_name(scenario, len(written) + 1)
+                command = f"ttt-sm scenario run ... --coverage --suggest {folder}"
+                path.write_text(to_yaml(scenario, command), encoding="utf-8")
+                written[key] = str(path)
+            out.append({"chart": cov.chart, "transition": label, "file": written[key], "reason": None})
+    return out
+
+
+def cmd_scenario_generate(args: argparse.Namespace) -> int:
+    """Generate a chart's scenarios into a folder; exit 0 (2: a bad chart name or folder)."""
+    from pathlib import Path
+
+    from ..scenario.generate import generate, write
+    from ..twin.workspace import load_arm
+
+    cls = _chart(args.chart)
+    folder = out_dir(args.out if args.out is not None else str(Path("generated") / cls.__name__), "--out")
+    params = load_arm(args.params)
+    generated = generate(cls, params.control.chart_dt, args.strategy)
+    command = f"ttt-sm scenario generate {cls.__name__} --strategy {args.strategy}"
+    try:
+        write(generated, folder, command)
+    except OSError as exc:
+        raise CliError(f"--out {args.out}: cannot write there ({exc.strerror or exc})") from None
+    summary = generated.to_dict()
+    if args.json:
+        print_json({"charts": {cls.__name__: summary}})
+        return 0
+    for path in generated.files:
+        print(path)
+    print(f"{cls.__name__}: {summary['covered']} of {summary['transitions']} transitions taken by"
+          f" {summary['scenarios']} scenarios ({summary['steps']} steps, {summary['chart_steps']} chart steps;"
+          f" a tour takes at least {summary['tour_lower_bound']} transitions) in {summary['seconds']:.2f} s")
+    for item in summary["unreachable"]:
+        print(f"  not taken: {item['transition']}: {item['reason']}")
+    return 0
+
+
+def cmd_scenario_mutate(args: argparse.Namespace) -> int:
+    """Run scenarios against a chart's mutants; exit 0 (2: a bad chart name or a file that does not load)."""
+    from ..scenario.mutate import mutation_test, runs_chart, summary
+    from ..twin.workspace import load_arm
+
+    cls = _chart(args.chart)
+    scenarios, errors = _load_all(args.files)
+    if errors:
+        return _report_errors(errors, args.json)
+    runnable = [s for s in scenarios if runs_chart(s, cls.__name__)]
+    if not runnable:
+        raise CliError(f"no scenario of {', '.join(args.files)[:200]} runs {cls.__name__} bare ('chart:"
+                       f" {cls.__name__}'): mutants are run by bare-chart scenarios only")
+    params = load_arm(args.params)
+    results = mutation_test(cls, runnable, params)
+    counts = summary(results)
+    if args.json:
+        print_json({"chart": cls.__name__, "scenarios": len(runnable), "skipped": len(scenarios) - len(runnable),
+                    **counts, "mutants_found": [r.to_dict() for r in results]})
+        return 0
+    for r in results:
+        print(f"{r.status.upper():10s} {r.mutant.kind:4s} line {r.mutant.line}: {r.mutant.description}")
+        if r.status != "killed":
+            print(f"           {r.detail}")
+    print(f"{cls.__name__}: {counts['killed']} of {counts['killed'] + counts['survived']} mutants killed"
+          f" ({100 * counts['kill_ratio']:.0f} %); {counts['equivalent']} equivalent within the search bound,"
+          f" {counts['stillborn']} stillborn; {len(runnable)} scenarios"
+          + (f" ({len(scenarios) - len(runnable)} not bare, not run)" if len(scenarios) > len(runnable) else ""))
+    return 0
 
 
 def cmd_scenario_check(args: argparse.Namespace) -> int:

@@ -30,7 +30,7 @@ def add_global_options(parser: argparse.ArgumentParser) -> None:
     """Add ``--chart`` to the options that come before the subcommand."""
     from ..app.slots import SLOT_NAMES
 
-    parser.add_argument("--chart", action="append", default=[], metavar="SLOT=FILE.py:CLASS",
+    parser.add_argument("--chart", action="append", default=[], metavar="SLOT=FILE.py:CLASS", dest="chart_slots",
                         help=f"run your chart class in a slot ({', '.join(SLOT_NAMES)}); repeatable;"
                              f" taken by {', '.join(HONOURED)}")
 
@@ -38,7 +38,7 @@ def add_global_options(parser: argparse.ArgumentParser) -> None:
 @contextlib.contextmanager
 def chosen_charts(args: argparse.Namespace) -> Iterator[None]:
     """Run the command with the slots ``--chart`` chose (nothing to do without it)."""
-    choices = getattr(args, "chart", None) or []
+    choices = getattr(args, "chart_slots", None) or []
     if not choices:
         yield
         return

@@ -15,8 +15,8 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from statemachine import State
 from starlette.testclient import TestClient
+from statemachine import State
 
 from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params

@@ -8,6 +8,8 @@ shows with a debugger of its own run to the same point (same seed).
 from __future__ import annotations
 
 import json
+import os
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -325,3 +327,37 @@ def test_a_leaving_breakpoint_by_click_and_the_timeline_of_the_shown_chart(page:
     drawn = page.locator('[data-role="timeline"] [data-timeline-state="DriveInit1.run.initialise.turn_fwd"] .tl-bar')
     assert drawn.count() == len([iv for iv in window.intervals if iv.state == "turn_fwd"]) >= 1
     cockpit.session.call(lambda d: d.delete())
+
+
+def test_a_click_on_a_red_transition_shows_a_scenario_that_takes_it(page: Any, cockpit: Cockpit, tmp_path: Any) -> None:
+    open_cockpit(page, cockpit)
+    show(page, "DriveInit1")
+    # a report in which DriveInit1 took nothing: every edge red
+    path = tmp_path / "nothing.json"
+    path.write_text(json.dumps({"coverage": {"DriveInit1": {"entered": [], "taken": []}}}))
+    page.get_by_label("Coverage report").set_input_files(str(path))
+    page.wait_for_function("document.querySelector('[data-role=diagram]').dataset.coverage === 'on'")
+    edge = page.locator('[data-role="diagram"] [data-transition~="DriveInit1.turn_fwd->turn_back"]').first
+    assert edge.get_attribute("data-coverage") == "never"
+    index = int(edge.get_attribute("data-index").split()[0])
+    label = cockpit.session.chart_classes["DriveInit1"].structure().transitions[index].label
+    edge.locator("text").first.click()
+    page.get_by_role("menuitem", name=f"Suggest a scenario that takes {label}").click()
+    panel = page.get_by_role("region", name="Suggested scenario")
+    page.wait_for_function("document.querySelector('[data-role=suggestion-yaml]').textContent.includes('expect_states')",
+                           timeout=120_000)
+    yaml = page.locator('[data-role="suggestion-yaml"]').text_content()
+    assert "chart: DriveInit1" in yaml and "expect_states: {chart: DriveInit1" in yaml
+    assert label in yaml  # the header comment names the transition it takes
+    save = panel.get_by_role("link", name="Save")
+    assert save.get_attribute("download").startswith(f"DriveInit1_{index}_")
+    assert save.get_attribute("download").endswith(".yaml")
+    with page.expect_download() as download:
+        save.click()
+    assert download.value.suggested_filename == save.get_attribute("download")
+    assert panel.get_by_role("button", name="Copy").is_visible()
+    shots = Path(os.environ.get("TTT_SM_SCREENSHOTS", str(tmp_path)))
+    shots.mkdir(parents=True, exist_ok=True)
+    panel.screenshot(path=str(shots / "coverage_suggestion.png"))
+    page.get_by_role("button", name="Clear coverage").click()
+    page.wait_for_function("document.querySelector('[data-role=diagram]').dataset.coverage === 'off'")

@@ -211,13 +211,12 @@ def _suggest(report: RunReport, params: Any, folder: str) -> list[dict[str, Any]
         if not missing:
             continue
         generated = generate(_chart(cov.chart), params.control.chart_dt, "shortest")
-        by_label = {label: s for s in generated.scenarios for label in s.takes}
         written: dict[int, str] = {}
         for label in missing:
-            scenario = by_label.get(label)
+            scenario = generated.scenario_for(label)
             if scenario is None:
                 out.append({"chart": cov.chart, "transition": label, "file": None,
-                            "reason": generated.unreachable.get(label, "the search did not take it")})
+                            "reason": generated.reason(label)})
                 continue
             key = id(scenario)
             if key not in written:

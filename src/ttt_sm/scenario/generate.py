@@ -77,6 +77,15 @@ class Generated:
     nodes: int = 0
     files: list[str] = field(default_factory=list)
 
+    def scenario_for(self, label: str) -> GeneratedScenario | None:
+        """The scenario that takes transition ``label`` (the first made: for ``shortest``, the shortest
+        path found to it), or None (:meth:`reason` says why)."""
+        return next((s for s in self.scenarios if label in s.takes), None)
+
+    def reason(self, label: str) -> str:
+        """Why no scenario takes transition ``label``: the search's reason."""
+        return self.unreachable.get(label, "the search did not take it")
+
     @property
     def covered(self) -> list[str]:
         taken = {label for s in self.scenarios for step in s.path for label in step.taken}

@@ -11,12 +11,17 @@ have (a report of other charts, or of an older version of them).
 
 :class:`CoverageRuns` runs the scenarios a page asks for on a worker thread of
 its own, one run at a time, beside the simulation (a run takes seconds), and
-keeps the colouring the pages show.
+keeps the colouring the pages show.  On the same worker it answers a page that
+asks for a transition never taken (:meth:`CoverageRuns.suggest`): the shortest
+generated scenario that takes it, as ``ttt-sm scenario run --coverage
+--suggest`` writes it (:func:`~ttt_sm.scenario.generate.generate`, searched
+once per chart and kept), or the generator's reason why none does.
 """
 
 from __future__ import annotations
 
 import logging
+import re
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -25,6 +30,7 @@ from typing import Any
 from ..params import ArmParams
 from ..runtime import TickChart
 from ..scenario.errors import ScenarioError
+from ..scenario.generate import Generated, generate, to_yaml
 from ..scenario.loader import load_scenario, load_scenario_text
 from ..scenario.model import Scenario
 from ..scenario.runner import ScenarioResult
@@ -131,6 +137,23 @@ def run_for_coverage(scenarios: Sequence[Scenario], params: ArmParams, charts: M
     return result
 
 
+def suggestion(generated: Generated, chart: str, index: int) -> dict[str, Any]:
+    """A ``coverage_suggestion`` message: the generated scenario that takes transition ``index`` of ``chart``
+    (its YAML and the file name to save it as), or ``yaml`` None and the generator's ``reason``."""
+    cls_name = generated.chart
+    label = generated.transitions[index]
+    scenario = generated.scenario_for(label)
+    head = label.split(":")[0].replace("->", "to").replace("(none)", "none")
+    slug = re.sub(r"[^A-Za-z0-9]+", "_", head).strip("_")
+    out: dict[str, Any] = {"type": "coverage_suggestion", "chart": chart, "index": index, "transition": label,
+                           "file": f"{chart}_{index}_{slug}.yaml", "yaml": None, "reason": None}
+    if scenario is None:
+        out["reason"] = generated.reason(label)
+    else:
+        out["yaml"] = to_yaml(scenario, f"ttt-sm gui: suggested for {cls_name} {label}")
+    return out
+
+
 def scenario_dir_files(folder: Path | None) -> dict[str, Path]:
     """The ``*.yaml`` scenario files of a folder, by file name."""
     if folder is None or not folder.is_dir():
@@ -162,6 +185,7 @@ class CoverageRuns:
         self._send_to = send_to
         self._broadcast = broadcast
         self._busy = False
+        self._generated: dict[str, Generated] = {}  # by chart name; read and written on the worker only
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ttt-sm-coverage")
 
     def start(self, cid: int, cmd: str, job: Callable[[], dict[str, Any]]) -> dict[str, Any]:
@@ -187,6 +211,31 @@ class CoverageRuns:
 
         self._worker.submit(work)
         return {"text": "running the scenarios; the diagrams are coloured when they are done"}
+
+    def suggest(self, cid: int, chart: str, index: int) -> dict[str, Any]:
+        """Search chart ``chart`` on the worker (once: the search is kept) for the shortest scenario that takes
+        its transition ``index``; page ``cid`` gets it as a ``coverage_suggestion`` message.  The reply now."""
+        cls = self.charts.get(chart)
+        if cls is None:
+            raise CoverageError(f"no chart {chart!r} in this session; charts: {', '.join(self.charts)}")
+        transitions = cls.structure().transitions
+        if not 0 <= index < len(transitions):
+            raise CoverageError(f"{chart} has no transition {index}: its transitions are 0 to {len(transitions) - 1}")
+        dt = self.params.control.chart_dt
+
+        def work() -> None:
+            try:
+                generated = self._generated.get(chart)
+                if generated is None:
+                    generated = self._generated[chart] = generate(cls, dt, "shortest")
+                self._send_to(cid, suggestion(generated, chart, index))
+            except Exception as exc:  # a search that broke: say so, keep the session
+                log.exception("coverage suggestion failed")
+                self._send_to(cid, {"type": "error", "id": None, "command": "coverage_suggest",
+                                    "error": f"coverage_suggest: {type(exc).__name__}: {exc}"})
+
+        self._worker.submit(work)
+        return {"text": f"searching {chart} for the shortest scenario that takes {transitions[index].label}"}
 
     def show(self, colouring: dict[str, Any]) -> None:
         """Colour every page's diagrams (and those of a page that joins later)."""

@@ -11,7 +11,8 @@ concern:
 - :mod:`.breakpoints`: ``break``, ``break_delete``, ``break_enable``;
 - :mod:`.inputs`: ``set``, ``release``, ``post``;
 - :mod:`.history`: ``replay``, ``timeline``;
-- :mod:`.coverage`: ``coverage_run``, ``coverage_scenario``, ``coverage_load``, ``coverage_clear``;
+- :mod:`.coverage`: ``coverage_run``, ``coverage_scenario``, ``coverage_load``, ``coverage_clear``,
+  ``coverage_suggest``;
 - :mod:`.latency`: ``ack`` (a page has drawn a frame);
 - :mod:`.game`: the Tic-tac-toe page's ``game_symbol``, ``game_cell``, ``game_play``, ``game_stop``,
   ``game_engine``, ``game_new``;

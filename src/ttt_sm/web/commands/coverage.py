@@ -1,11 +1,12 @@
-"""Coverage on the chart cockpit's diagrams (:mod:`..coverage`): scenarios run, a report loaded, cleared."""
+"""Coverage on the chart cockpit's diagrams (:mod:`..coverage`): scenarios run, a report loaded, cleared;
+a scenario suggested for a transition never taken."""
 
 from __future__ import annotations
 
 from typing import Any
 
 from ..coverage import colouring, load_scenarios, run_for_coverage, scenario_from_text
-from ..fields import MAX_SCENARIO_BYTES, names_list, report, text
+from ..fields import MAX_SCENARIO_BYTES, identifier, integer, names_list, report, text
 from .spec import Cockpit, Reply, command
 
 
@@ -38,3 +39,10 @@ def clear(session: Cockpit, cid: int) -> Reply:
     """Colour no coverage."""
     session.coverage.clear()
     return {"text": "coverage cleared"}
+
+
+@command("coverage_suggest", chart=identifier, transition=integer(0, 10_000))
+def suggest(session: Cockpit, cid: int, chart: str, transition: int) -> Reply:
+    """The shortest generated scenario that takes transition ``transition`` (its index) of ``chart``, sent to
+    the page as a ``coverage_suggestion`` message when the search (on the coverage's worker) is done."""
+    return session.coverage.suggest(cid, chart, transition)

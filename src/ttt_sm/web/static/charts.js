@@ -28,7 +28,8 @@ function say(text, isError = false, kind = "") {
 
 const link = new SessionLink(onMessage, (text) => say(text, text.startsWith("disconnected")));
 const coverage = new CoverageView(link, say);
-const diagram = new DiagramView(link, say, () => coverage.draw());
+const diagram = new DiagramView(link, say, () => coverage.draw(),
+  (el, chart) => coverage.menuItems(el, chart, diagram.charts[chart]));
 const watch = new DataWatch(link, say);
 const signals = new Signals();
 const breakpoints = new Breakpoints(link);
@@ -48,6 +49,7 @@ function onMessage(m) {
     case "reply": return say(m.text || "ok");
     case "error": return say(m.error, true);
     case "coverage": return coverage.take(m);
+    case "coverage_suggestion": return coverage.takeSuggestion(m);
     case "timeline": return timeline.draw(m);
     default: return undefined;
   }

@@ -1,5 +1,8 @@
 // Coverage on the diagram: the states entered and the transitions taken by scenario runs (green),
 // and what they never reached (red), from scenario files run by the session or a report loaded.
+// A click on a red transition offers the shortest generated scenario that takes it: the session
+// searches (ttt_sm.web.coverage, the generator of `ttt-sm scenario generate`), this page shows the
+// YAML it sends, to copy or save.
 
 import { $$, fillSelect, role } from "../dom.js";
 
@@ -33,6 +36,69 @@ export class CoverageView {
       link.send({ type: "coverage_load", report });
     });
     role("coverage-clear").addEventListener("click", () => link.send({ type: "coverage_clear" }));
+    role("suggestion-copy").addEventListener("click", () => this.copy());
+    role("suggestion-close").addEventListener("click", () => this.closeSuggestion());
+    this.saveUrl = null;    // the object URL of the Save link, revoked when another replaces it
+  }
+
+  // The menu items of a click on transition edge `el` of chart `chart` (described as in the session's
+  // "session" message): one per transition it draws that the coverage shown never took.
+  menuItems(el, chart, description) {
+    const cov = this.coverage && this.coverage.charts[chart];
+    if (!cov || !el.dataset.index) return [];
+    return el.dataset.index.split(" ").map(Number)
+      .filter((i) => cov.missing_transitions.includes(i))
+      .map((i) => {
+        const t = description && description.transitions.find((d) => d.index === i);
+        const label = t ? t.label : `transition ${i}`;
+        return [`Suggest a scenario that takes ${label}`,
+          () => this.link.send({ type: "coverage_suggest", chart, transition: i })];
+      });
+  }
+
+  // The session's "coverage_suggestion" message: a scenario's YAML, or why there is none.
+  takeSuggestion(m) {
+    const panel = role("suggestion");
+    const save = role("suggestion-save");
+    if (this.saveUrl) URL.revokeObjectURL(this.saveUrl);
+    this.saveUrl = null;
+    panel.dataset.chart = m.chart;
+    panel.dataset.index = String(m.index);
+    role("suggestion-yaml").textContent = m.yaml || "";
+    role("suggestion-copy").hidden = !m.yaml;
+    save.hidden = !m.yaml;
+    if (m.yaml) {
+      role("suggestion-about").textContent = `The shortest generated scenario that takes ${m.chart}: ${m.transition}`
+        + ` (run it with ttt-sm scenario run ${m.file}).`;
+      this.saveUrl = URL.createObjectURL(new Blob([m.yaml], { type: "application/yaml" }));
+      save.href = this.saveUrl;
+      save.download = m.file;
+    } else {
+      role("suggestion-about").textContent = `No generated scenario takes ${m.chart}: ${m.transition}: ${m.reason}`;
+      save.removeAttribute("href");
+      save.download = "";
+    }
+    panel.hidden = false;
+    this.say(m.yaml ? `scenario suggested for ${m.chart}: ${m.transition}` : `${m.chart}: ${m.transition}: ${m.reason}`);
+  }
+
+  async copy() {
+    const text = role("suggestion-yaml").textContent;
+    try {
+      await navigator.clipboard.writeText(text);
+      this.say("scenario copied");
+    } catch {
+      // no clipboard (a page not served as localhost or https): select the text for Ctrl+C
+      const range = document.createRange();
+      range.selectNodeContents(role("suggestion-yaml"));
+      getSelection().removeAllRanges();
+      getSelection().addRange(range);
+      this.say("the clipboard is not available here: the YAML is selected, press Ctrl+C");
+    }
+  }
+
+  closeSuggestion() {
+    role("suggestion").hidden = true;
   }
 
   // The scenario files the session may run (its "session" message).

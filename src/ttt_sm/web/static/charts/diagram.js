@@ -11,11 +11,13 @@ import { openMenu } from "./menu.js";
 
 export class DiagramView {
   // link: the SessionLink; say(text, isError): the page's status line;
-  // onLoaded(): called when a picture is in place (the coverage colours it).
-  constructor(link, say, onLoaded) {
+  // onLoaded(): called when a picture is in place (the coverage colours it);
+  // moreItems(el, chart): menu items others add to a click on `el` (the coverage's suggestions).
+  constructor(link, say, onLoaded, moreItems = () => []) {
     this.link = link;
     this.say = say;
     this.onLoaded = onLoaded;
+    this.moreItems = moreItems;
     this.charts = {};     // name -> chart description (states, transitions, subcharts)
     this.chart = null;    // the chart shown
     this.view = "overview";
@@ -192,6 +194,7 @@ export class DiagramView {
         const arrow = name.slice(chart.length + 1);
         items.push([`Break when ${name} is taken`, () => addBreak(`transition ${chart} ${arrow}`)]);
       }
+      items.push(...this.moreItems(el, chart));
     }
     openMenu(items, event);
   }

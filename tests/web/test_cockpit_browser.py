@@ -336,8 +336,11 @@ def test_a_click_on_a_red_transition_shows_a_scenario_that_takes_it(page: Any, c
     path = tmp_path / "nothing.json"
     path.write_text(json.dumps({"coverage": {"DriveInit1": {"entered": [], "taken": []}}}))
     page.get_by_label("Coverage report").set_input_files(str(path))
-    page.wait_for_function("document.querySelector('[data-role=diagram]').dataset.coverage === 'on'")
+    # (a report an earlier test loaded may still be drawn: wait for this one's colours, not just 'on')
     edge = page.locator('[data-role="diagram"] [data-transition~="DriveInit1.turn_fwd->turn_back"]').first
+    page.wait_for_function("document.querySelector('[data-role=diagram]').dataset.coverage === 'on' &&"
+                           " document.querySelector('[data-role=diagram] [data-transition~=\"DriveInit1.turn_fwd"
+                           "->turn_back\"]').dataset.coverage === 'never'")
     assert edge.get_attribute("data-coverage") == "never"
     index = int(edge.get_attribute("data-index").split()[0])
     label = cockpit.session.chart_classes["DriveInit1"].structure().transitions[index].label

@@ -25,7 +25,6 @@ every one takes each at least once.
 from __future__ import annotations
 
 import itertools
-import json
 import re
 import time
 from collections.abc import Sequence
@@ -34,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from ..runtime import TickChart
+from ..runtime.jsonable import dumps
 from ..runtime.structure import TransitionInfo
 from .explore import Bounds, Explorer, Sim, Step
 from .guard_reader import atoms, kleene, refs, show, show_value
@@ -252,7 +252,7 @@ def yaml_value(v: Any) -> str:
             text = f"{mantissa}.0e{exponent}"
         return text
     if isinstance(v, str):
-        return json.dumps(v)
+        return dumps(v)
     return repr(v)
 
 
@@ -320,12 +320,12 @@ def to_yaml(scenario: GeneratedScenario, command: str) -> str:
             out.append(f"  - post: {{chart: {chart}, event: {event}}}")
         if step.ticks > 1:  # the transition comes at the last chart step, not one sooner
             out.append(f"  - run: {{chart_steps: {step.ticks - 1}}}")
-            out.append(f"  - expect: {json.dumps(' and '.join(f'{chart}.{leaf}' for leaf in before))}")
+            out.append(f"  - expect: {dumps(' and '.join(f'{chart}.{leaf}' for leaf in before))}")
             out.append("  - run: {chart_steps: 1}")
         elif step.ticks:
             out.append(f"  - run: {{chart_steps: {step.ticks}}}")
         for condition in _expect(chart, step):
-            out.append(f"  - expect: {json.dumps(condition)}")
+            out.append(f"  - expect: {dumps(condition)}")
         before = step.active
     out.append(f"  - expect_states: {{chart: {chart}, sequence: [{', '.join(scenario.leaves)}], match: exact}}")
     return "\n".join(out) + "\n"

@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import signal
 import time
+import weakref
 
 import pytest
 
@@ -52,5 +53,30 @@ def test_a_signal_in_plain_code_stops_at_once() -> None:
             for _ in range(1_000_000):  # the handler runs at the next bytecode
                 pass
             raise AssertionError("SIGTERM did not stop the loop")
+    finally:
+        restore()
+
+
+def test_a_signal_inside_a_weakref_callback_of_the_import_system_stops_once_it_returns() -> None:
+    """Seen in CI: SIGTERM landed in importlib's module-lock callback; raised there it was only printed
+    ('Exception ignored in: <function _get_module_lock.<locals>.cb>') and the command finished."""
+    namespace: dict = {"__name__": "importlib._bootstrap",
+                       "kill": lambda: os.kill(os.getpid(), signal.SIGTERM)}
+    source = "def cb(ref):\n    kill()\n    for _ in range(20_000):\n        sum(range(200))\n"
+    exec(compile(source, "<frozen importlib._bootstrap>", "exec"), namespace)  # noqa: S102
+
+    class ModuleLock:
+        pass
+
+    restore = terminate_interrupts()
+    try:
+        with pytest.raises(Interrupted):
+            lock = ModuleLock()
+            ref = weakref.ref(lock, namespace["cb"])
+            del lock  # the callback runs here, as the import system's does when a module lock is freed
+            assert ref() is None
+            deadline = time.monotonic() + 30.0
+            while time.monotonic() < deadline:
+                sum(range(200))
     finally:
         restore()

@@ -45,9 +45,10 @@ class Interrupted(KeyboardInterrupt):
         self.signal = signal_name
 
 
-#: Packages whose code calls back into Python from C (numba's compiler through llvmlite's ctypes
-#: callbacks): an exception raised there is printed and swallowed, so a signal waits until they return.
-_FOREIGN_PACKAGES = frozenset({"numba", "llvmlite", "ctypes"})
+#: Packages whose code runs where an exception is printed and swallowed, so a signal waits until they
+#: return: numba's compiler calls back into Python from C (llvmlite's ctypes callbacks), and the import
+#: system frees its module locks in weakref callbacks (``_get_module_lock.<locals>.cb``).
+_FOREIGN_PACKAGES = frozenset({"numba", "llvmlite", "ctypes", "importlib"})
 #: How often a signal that waits looks again whether the foreign code has returned, s.
 _RETRY_S = 0.05
 

@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from ..params import shown_path
-from ..runtime.jsonable import dumps
+from ..runtime.recordfile import RecordFile
 from .exercise import Exercise, LabError
 
 #: The file of results, one JSON line per student, that the reports are built from.
@@ -200,23 +200,19 @@ class ResultsFile:
             if header.get("exercise") != exercise:
                 raise GradeError(f"{shown_path(self.path)} holds results of exercise {header.get('exercise')!r},"
                                  f" not {exercise!r}: choose another --out, or --again to start anew")
-            self._file = self.path.open("a", encoding="utf-8")
+            self._record = RecordFile(self.path, append=True)
         else:
-            self._file = self.path.open("w", encoding="utf-8")
-            self._write({"event": "grade", "exercise": exercise})
+            self._record = RecordFile(self.path)
+            self._record.add({"event": "grade", "exercise": exercise})
         self._lock = threading.Lock()
-
-    def _write(self, line: dict[str, Any]) -> None:
-        self._file.write(dumps(line) + "\n")
-        self._file.flush()
 
     def add(self, result: dict[str, Any]) -> None:
         with self._lock:
-            self._write(result)
+            self._record.add(result)
             self.done[result["student"]] = result
 
     def close(self) -> None:
-        self._file.close()
+        self._record.close()
 
 
 def read_results(path: Path) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]:

@@ -40,10 +40,11 @@ class RecordFile:
     :class:`~.listeners.Trace`, which writes its records to it as they happen.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, append: bool = False) -> None:
+        """Start the file anew, or with ``append`` go on after the lines it holds."""
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._file: IO[str] | None = self.path.open("w", encoding="utf-8")
+        self._file: IO[str] | None = self.path.open("a" if append else "w", encoding="utf-8")
         self.lines = 0
         #: The ending written (``"finished"``, ``"interrupted"``, ``"error"``), once :meth:`end` ran.
         self.ended: str | None = None

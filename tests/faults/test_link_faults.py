@@ -97,13 +97,21 @@ def test_late_frames_wait_their_delay_in_order_and_a_cut_link_passes_nothing_unt
 
 def clean_cell(fault: str, cache, tries: int = 3, before=lambda: None):
     """One cell of `fault`; again (up to `tries` times) while the machine held an end up past half the
-    watchdog (``disturbed``): what such a cell saw may be the machine's doing.  `before` runs before each."""
+    watchdog (``disturbed``): what such a cell saw may be the machine's doing.  `before` runs before each.
+
+    A cell is real time: the firmware's watchdog and the PC's link timeout run
+    on the wall clock.  When the machine held this process up in every try,
+    the test cannot judge the fault and says so (a skip with the numbers).
+    """
     for _ in range(tries):
         before()
         cell = run_link_cell(P, fault, cache=cache)
         if not cell.disturbed:
-            break
-    return cell
+            return cell
+    pytest.skip(f"{fault}: the machine held this process up in each of {tries} tries (the last: PC loop "
+                f"{cell.pc_max_stall_ms} ms, emulator {cell.emulator_max_behind_ms} ms behind, a 1 ms sleep "
+                f"{cell.process_max_late_ms} ms late, the limit half the watchdog's 50 ms; {cell.late_outside_fault}"
+                f" setpoints late with no fault on)")
 
 
 REJECTING = {"frames_garbled": "crc", "frames_duplicated": "duplicate", "frames_out_of_order": "out_of_order"}
@@ -126,15 +134,15 @@ def test_bad_frames_are_counted_and_rejected_by_both_ends_and_never_acted_on(fau
     fw_lines = [m for m in lines if m.startswith("link (firmware): rejected") and m.split(": ")[2].startswith(reason)]
     assert len(pc_lines) == to_pc
     assert sum(int(line.split("rejected ")[1].split(" ")[0]) for line in fw_lines) == to_fw
-    # the drives ran on: neither end stopped (unless the machine held one up past the watchdog)
-    assert cell.disturbed or (not cell.firmware_stopped and not cell.pc_declared and cell.recovered)
+    # the drives ran on: neither end stopped
+    assert not cell.firmware_stopped and not cell.pc_declared and cell.recovered, (cell.pc_reason, cell.end_state)
 
 
 def test_lost_frames_are_counted_as_gaps_and_a_third_of_them_lost_does_not_stop_the_arm(firmware_cache):
     cell = clean_cell("frames_lost", firmware_cache)
     assert cell.lost_frames_firmware == cell.injected["pc_to_firmware"]["dropped"] > 0
     assert cell.lost_frames_pc == cell.injected["firmware_to_pc"]["dropped"] > 0
-    assert cell.disturbed or (not cell.firmware_stopped and not cell.pc_declared and cell.recovered)
+    assert not cell.firmware_stopped and not cell.pc_declared and cell.recovered, (cell.pc_reason, cell.end_state)
 
 
 def test_a_cut_link_stops_the_drives_after_50_ms_and_the_pc_declares_it_lost_then_rearms(firmware_cache):
@@ -146,7 +154,7 @@ def test_a_cut_link_stops_the_drives_after_50_ms_and_the_pc_declares_it_lost_the
     assert cell.pc_declared and cell.pc_silence_ms is not None and cell.pc_silence_ms > LINK_TIMEOUT_S * 1e3
     assert cell.pc_reason.startswith("no status from the firmware for 50 ms")
     # the cable back: START again, and the firmware takes setpoints
-    assert cell.rearmed and cell.recovered and cell.as_expected
+    assert cell.rearmed and cell.recovered and cell.as_expected, cell.end_state
 
 
 def test_late_setpoints_are_refused_and_their_absence_stops_the_drives(firmware_cache):
@@ -154,4 +162,4 @@ def test_late_setpoints_are_refused_and_their_absence_stops_the_drives(firmware_
     assert cell.rejected_by_firmware.get("late", 0) > 0 and cell.bad_frames_acted_on == 0
     assert cell.firmware_stopped and cell.watchdog_steps == WATCHDOG_STEPS + 1
     assert cell.pc_declared and "the firmware stopped the drives (safe_stop" in cell.pc_reason
-    assert cell.rearmed and cell.recovered
+    assert cell.rearmed and cell.recovered, cell.end_state

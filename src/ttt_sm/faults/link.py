@@ -57,6 +57,14 @@ LATE_S = 0.005
 """How late ``frames_late`` delivers the PC's frames, s (the firmware's limit: 2 control steps, 2 ms)."""
 OVERTAKE_S = 0.005
 """A frame held back to be overtaken goes on alone after this long, s, when no next frame came."""
+LATE_LIMIT = 10
+"""So many setpoints refused as late outside the fault, or more, and the cell is ``disturbed``.
+
+One hold-up of the PC makes one setpoint late (the next catches up); the
+watchdog needs 25 chart steps in a row without one.  A quiet machine makes
+0 to 4 in a cell; the machine's sustained slowness (the PC and the
+emulator's thread sharing two busy cores) makes a run of them without any
+single long hold-up."""
 #: Streaming before the fault, during it, and after it (before and after a re-arm), s of the wall clock.
 WARMUP_S = 0.3
 FAULT_S = 0.3
@@ -210,13 +218,20 @@ class LinkCell:
     rearmed: bool
     recovered: bool
     """After the fault (and the re-arm when the link was lost) the firmware runs and takes setpoints."""
+    end_state: str
+    """When not recovered: the link, the firmware's state and the setpoints it took at the end, and why."""
     pc_max_stall_ms: float
     """The longest chart step of the PC's loop that found the link sound, wall clock (one is 2 ms)."""
     emulator_max_behind_ms: float
     """The longest the emulator's thread fell behind the wall clock (it then runs the steps in a burst)."""
+    process_max_late_ms: float
+    """The longest a 1 ms sleep of the process overslept (:class:`PaceProbe`): the machine's hold-ups."""
+    late_outside_fault: int
+    """Setpoints the firmware refused as late before the fault and from the re-arm on: the PC answered a
+    status more than 2 ms after the firmware sent it, and no fault delayed them then (the machine did)."""
     disturbed: bool
-    """The machine held up the PC or the emulator for half the watchdog's 50 ms or more, or the link was lost
-    before the fault began: what the cell saw may be the machine's doing, not the fault's."""
+    """The machine held up the PC, the emulator or the process for half the watchdog's 50 ms or more, or the
+    link was lost before the fault began: what the cell saw may be the machine's doing, not the fault's."""
     onset_time: float
     """When the fault began, ``time.time()`` (the log's clock): the log lines it caused come after."""
     wall_s: float
@@ -233,21 +248,59 @@ class _Streamer:
         self.not_ok_at: float | None = None
         self.max_stall_s = 0.0
 
-    def run(self, seconds: float) -> None:
+    def run(self, seconds: float, losing: bool = False) -> None:
+        """Stream for `seconds`; `losing`: the fault may lose the link (a step then waits for it: not a stall)."""
         arm, divider = self.arm, self.arm.divider
         end = last = time.monotonic()
         end += seconds
         while time.monotonic() < end:
             t = time.monotonic() - self.t0
+            sound = arm.link_ok
             arm.set_setpoints([self.q0[0] + 0.2 * math.sin(2 * math.pi * 0.5 * t), self.q0[1], self.q0[2],
                                self.servo])
             arm.step(divider)
             now = time.monotonic()
-            if arm.link_ok:  # a step that found the link lost waited for it: the fault's doing
+            # a step that began on a sound link and took long was held up by the machine, even when the
+            # link was lost meanwhile (the firmware's watchdog ran out on it); one that a fault may have
+            # lost the link in waited for the link: the fault's doing
+            if sound and (arm.link_ok or not losing):
                 self.max_stall_s = max(self.max_stall_s, now - last)
-            elif self.not_ok_at is None:
+            if not arm.link_ok and self.not_ok_at is None:
                 self.not_ok_at = now
             last = now
+
+
+class PaceProbe:
+    """A thread that sleeps 1 ms at a time and keeps how late it woke at most: the machine's hold-ups.
+
+    The PC's loop and the emulator's thread measure their own delays, but not
+    all of them (a re-arm's settling, a step that lost the link while the
+    process was not scheduled).  This measures the process as a whole, with
+    a cost of a thousand short wake-ups a second: a cell the machine held up
+    past half the watchdog's limit is not the fault's evidence.
+    """
+
+    PERIOD_S = 0.001
+
+    def __init__(self) -> None:
+        self.max_late_s = 0.0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="ttt_sm-pace-probe", daemon=True)
+
+    def _run(self) -> None:
+        while True:
+            before = time.monotonic()
+            if self._stop.wait(self.PERIOD_S):
+                return
+            self.max_late_s = max(self.max_late_s, time.monotonic() - before - self.PERIOD_S)
+
+    def __enter__(self) -> PaceProbe:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        self._thread.join()
 
 
 def _reasons(counts: dict[int, int], before: dict[int, int]) -> dict[str, int]:
@@ -269,44 +322,53 @@ def run_link_cell(params: ArmParams, fault: str, seed: int = 0, gains: Gains | N
         fw = emu.firmware
         arm = SerialArm(emu.port, params, gains, servo_angle=REST_POSE[3])
         try:
-            pc = _Streamer(arm)
-            emu.max_behind_steps = 0  # (opening the link held the emulator's thread up: that is no fault)
-            pc.run(WARMUP_S)
-            if not arm.link_ok:
-                arm.rearm()
+            with PaceProbe() as probe:  # from here on, the machine's hold-ups count
+                pc = _Streamer(arm)
+                emu.max_behind_steps = 0  # (opening the link held the emulator's thread up: that is no fault)
+                late0 = fw.rejections()[L.Reason.LATE]
                 pc.run(WARMUP_S)
-            # the machine held an end up before the onset: the firmware stopped, or the PC lost the link
-            lost_before = fw.state != 1 or not arm.link_ok or bool(arm.losses) or any(
-                state == 2 for _, state, _ in emu.state_changes)
-            pc.not_ok_at = None
-            fw_rej, pc_rej = dict(fw.rejections()), dict(arm.rx.rejections)
-            fw_lost, pc_lost = fw.lost, arm.rx.seq.lost
-            losses = len(arm.losses)
-            changes = len(emu.state_changes)
-            onset_step, onset, onset_time = fw.steps, time.monotonic(), time.time()
-            tap.inject(fault)
-            pc.run(FAULT_S)
-            tap.clear()
-            pc.run(AFTER_S)
-            stops = [(step, at) for step, state, at in emu.state_changes[changes:] if state == 2]
-            fw_after = dict(fw.rejections())
-            pc_after = {int(r): n for r, n in arm.rx.rejections.items()}
-            counts = tap.counts
-            loss = arm.losses[losses] if len(arm.losses) > losses else None
-            not_ok_at = pc.not_ok_at
-            fault_text = arm.link_fault or ""
-            watchdog = None
-            if stops:
-                watchdog = stops[0][0] - fw.last_setpoint_step
-            rearmed = False
-            if not arm.link_ok:
-                rearmed = arm.rearm()
-            taken = fw.setpoints_ok
-            pc.run(AFTER_S)
-            recovered = arm.link_ok and fw.state == 1 and fw.setpoints_ok > taken
-            stall_ms, behind_ms = pc.max_stall_s * 1e3, emu.max_behind_steps * params.control.dt * 1e3
+                if not arm.link_ok:
+                    arm.rearm()
+                    pc.run(WARMUP_S)
+                # the machine held an end up before the onset: the firmware stopped, or the PC lost the link
+                lost_before = fw.state != 1 or not arm.link_ok or bool(arm.losses) or any(
+                    state == 2 for _, state, _ in emu.state_changes)
+                pc.not_ok_at = None
+                fw_rej, pc_rej = dict(fw.rejections()), dict(arm.rx.rejections)
+                late_outside = fw_rej[L.Reason.LATE] - late0
+                fw_lost, pc_lost = fw.lost, arm.rx.seq.lost
+                losses = len(arm.losses)
+                changes = len(emu.state_changes)
+                onset_step, onset, onset_time = fw.steps, time.monotonic(), time.time()
+                tap.inject(fault)
+                losing = fault in STOPPING_FAULTS
+                pc.run(FAULT_S, losing)
+                tap.clear()
+                pc.run(AFTER_S, losing)
+                stops = [(step, at) for step, state, at in emu.state_changes[changes:] if state == 2]
+                fw_after = dict(fw.rejections())
+                pc_after = {int(r): n for r, n in arm.rx.rejections.items()}
+                counts = tap.counts
+                loss = arm.losses[losses] if len(arm.losses) > losses else None
+                not_ok_at = pc.not_ok_at
+                fault_text = arm.link_fault or ""
+                watchdog = None
+                if stops:
+                    watchdog = stops[0][0] - fw.last_setpoint_step
+                late_rearm = fw.rejections()[L.Reason.LATE]  # (the fault's late frames are long through)
+                rearmed = False
+                if not arm.link_ok:
+                    rearmed = arm.rearm()
+                taken = fw.setpoints_ok
+                pc.run(AFTER_S)
+                late_outside += fw.rejections()[L.Reason.LATE] - late_rearm
+                recovered = arm.link_ok and fw.state == 1 and fw.setpoints_ok > taken
+                end_text = "" if recovered else (f"at the end: link_ok={arm.link_ok}, firmware state {fw.state}, "
+                                                 f"{fw.setpoints_ok - taken} setpoints taken; {arm.link_fault or ''}")
+                stall_ms, behind_ms = pc.max_stall_s * 1e3, emu.max_behind_steps * params.control.dt * 1e3
         finally:
             arm.close()
+        probe_ms = probe.max_late_s * 1e3
         # every bad frame is either rejected by its receiver or taken as valid; taken ones were acted on
         bad_reasons = {"frames_garbled": (L.Reason.CRC, "garbled"), "frames_duplicated": (L.Reason.DUPLICATE,
                        "duplicated"), "frames_out_of_order": (L.Reason.OUT_OF_ORDER, "overtaken")}
@@ -334,9 +396,11 @@ def run_link_cell(params: ArmParams, fault: str, seed: int = 0, gains: Gains | N
             pc_detect_ms=round((not_ok_at - onset) * 1e3, 1) if not_ok_at is not None else None,
             pc_silence_ms=round(loss.silence_s * 1e3, 1) if loss is not None else None,
             pc_reason=fault_text if pc_declared else "",
-            as_expected=as_expected, rearmed=rearmed, recovered=bool(recovered),
+            as_expected=as_expected, rearmed=rearmed, recovered=bool(recovered), end_state=end_text,
             pc_max_stall_ms=round(stall_ms, 1), emulator_max_behind_ms=round(behind_ms, 1),
-            disturbed=lost_before or max(stall_ms, behind_ms) >= LINK_LIMIT_S * 1e3 / 2,
+            process_max_late_ms=round(probe_ms, 1), late_outside_fault=late_outside,
+            disturbed=lost_before or max(stall_ms, behind_ms, probe_ms) >= LINK_LIMIT_S * 1e3 / 2
+            or late_outside >= LATE_LIMIT,
             onset_time=onset_time, wall_s=round(time.perf_counter() - wall0, 2),
         )
 

@@ -231,12 +231,13 @@ def first_failure(scenarios: Sequence[Scenario], chart: str, cls: type[TickChart
 def mutation_test(cls: type[TickChart], scenarios: Sequence[Scenario], params: ArmParams,
                   check_equivalence: bool = True) -> list[MutantResult]:
     """Run the scenarios that run ``cls`` bare against each of its mutants."""
-    from .generate import generate
+    from .generate import generate, to_yaml
     from .loader import load_scenario_text
 
     chart = cls.__name__
     runnable = [s for s in scenarios if runs_chart(s, chart)]
     results = []
+    originals: list[Scenario] = []  # the chart's own generated scenarios: the same for every mutant, made once
     for mutant in mutants(cls):
         try:
             built = build(cls, mutant)
@@ -252,15 +253,14 @@ def mutation_test(cls: type[TickChart], scenarios: Sequence[Scenario], params: A
             results.append(MutantResult(mutant, "survived", "no scenario failed"))
             continue
         # scenarios of the mutant itself: do they tell it from the original? (and the original's)
-        from .generate import to_yaml
-
         probes = [load_scenario_text(to_yaml(g, "mutate"), f"<generated from the mutant #{k}>")
                   for k, g in enumerate(generate(built, params.control.chart_dt).scenarios, 1)]
         apart = first_failure(probes, chart, cls, params)
         if apart is None:
-            probes = [load_scenario_text(to_yaml(g, "mutate"), f"<generated from {chart} #{k}>")
-                      for k, g in enumerate(generate(cls, params.control.chart_dt).scenarios, 1)]
-            apart = first_failure(probes, chart, built, params)
+            if not originals:
+                originals = [load_scenario_text(to_yaml(g, "mutate"), f"<generated from {chart} #{k}>")
+                             for k, g in enumerate(generate(cls, params.control.chart_dt).scenarios, 1)]
+            apart = first_failure(originals, chart, built, params)
         if apart is None:
             results.append(MutantResult(mutant, "equivalent", "the scenarios generated from the mutant and from"
                                         " the chart run alike on both: no difference within the search bound"))

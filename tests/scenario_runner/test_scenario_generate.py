@@ -146,6 +146,37 @@ def test_the_generated_scenarios_kill_the_mutants_of_drive_3(tmp_path) -> None:
     assert fewer["killed"] < counts["killed"]
 
 
+@pytest.mark.soak
+@pytest.mark.parametrize("cls", [c for c in ALL_CHARTS if c is not DriveInit3], ids=lambda c: c.__name__)
+def test_the_generated_scenarios_kill_the_mutants_of_every_chart(cls, tmp_path) -> None:
+    """The target on every chart of the robot (Control's 132 mutants take minutes: a soak test)."""
+    scenarios = [load_scenario(p) for p in write(generate(cls, DT), tmp_path, "test")]
+    results = mutation_test(cls, scenarios, PARAMS)
+    counts = summary(results)
+    assert counts["mutants"] >= 5 and counts["stillborn"] == 0
+    assert counts["kill_ratio"] >= 0.9, [r.to_dict() for r in results if r.status == "survived"]
+    assert all(r.detail for r in results if r.status == "equivalent")
+
+
+@pytest.mark.soak
+def test_generation_is_the_same_whatever_python_hashes_strings_with(tmp_path) -> None:
+    """Control's tour once chose among equally short paths in a set's order: with these three hash seeds it
+    wrote three different sets of files."""
+    import os
+    import subprocess
+    import sys
+
+    texts = []
+    for seed in ("0", "3", "11"):
+        out = tmp_path / seed
+        done = subprocess.run([sys.executable, "-m", "ttt_sm.cli", "scenario", "generate", "Control", "--strategy",
+                               "tour", "--out", str(out)], env={**os.environ, "PYTHONHASHSEED": seed},
+                              capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stderr
+        texts.append({f.name: f.read_text() for f in sorted(out.iterdir())})
+    assert texts[0] == texts[1] == texts[2] and len(texts[0]) >= 3
+
+
 # -- the command line -----------------------------------------------------------------------
 
 def _one_error_line(capsys) -> str:

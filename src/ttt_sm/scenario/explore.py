@@ -211,6 +211,7 @@ class Explorer:
         self._actions: dict[str, list[Node]] = {}
         self.nodes = 0
         self.complete = True  #: the search ended by exhausting the nodes, not a bound
+        self.last_sim: Sim | None = None  #: a search stopped at its first find: the chart at its path's end
         self.start = self._start_step()
         self.seen_states: set[str] = set()  #: states active on some explored path (of every search)
         self._states_here: set[str] = set()  # ... of the current search
@@ -456,10 +457,12 @@ class Explorer:
         return limit
 
     def search(self, prefix: tuple[Step, ...] = (), wanted: set[str] | None = None,
-               stop_at_first: bool = False, bounds: Bounds | None = None) -> dict[str, tuple[Step, ...]]:
+               stop_at_first: bool = False, bounds: Bounds | None = None,
+               root: Sim | None = None) -> dict[str, tuple[Step, ...]]:
         """Breadth-first from the end of ``prefix``: for each transition (of ``wanted``, default all)
-        the first path found that takes it.  ``stop_at_first``: return at the first one; ``bounds``:
-        other than the explorer's."""
+        the first path found that takes it.  ``stop_at_first``: return at the first one (its chart, run
+        to the path's end, is then :attr:`last_sim`); ``bounds``: other than the explorer's; ``root``:
+        the chart already run through ``prefix`` (it is run on; without it, ``prefix`` is replayed)."""
         t0 = time.perf_counter()
         bounds = bounds or self.bounds
         if not prefix and self.start is not None:
@@ -468,7 +471,9 @@ class Explorer:
         labels = {t.label for t in self.structure.transitions}
         wanted = set(labels if wanted is None else wanted)
         found: dict[str, tuple[Step, ...]] = {}
-        root = Sim(self.cls, self.dt).replay(prefix)
+        if root is None:
+            root = Sim(self.cls, self.dt).replay(prefix)
+        self.last_sim = None
         self._states_here = set(root.chart.configuration_values)
         self.seen_states |= self._states_here
         taken_here: set[str] = set()  # the transitions this search took: their children are in its queue
@@ -513,5 +518,6 @@ class Explorer:
                     seen.add(key)
                     queue.append((child, sim))
                 if new and stop_at_first:
+                    self.last_sim = sim
                     return found
         return found

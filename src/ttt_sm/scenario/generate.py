@@ -144,12 +144,13 @@ def _tour(explorer: Explorer, found: dict[str, tuple[Step, ...]]) -> list[tuple[
     budget = explorer.nodes + TOUR_NODES
     while left and explorer.nodes < budget:
         path: tuple[Step, ...] = ()
+        here: Sim | None = None  # the chart run through `path`, when the last search left it there
         while left and explorer.nodes < budget:
-            nearest = explorer.search(path, wanted=left, stop_at_first=True, bounds=TOUR_BOUNDS)
+            nearest = explorer.search(path, wanted=left, stop_at_first=True, bounds=TOUR_BOUNDS, root=here)
             if nearest:
-                path = next(iter(nearest.values()))
+                path, here = next(iter(nearest.values())), explorer.last_sim
             elif not path:  # far from power-on: start with the shortest first path of those left
-                path = min((found[label] for label in left), key=len)
+                path, here = min((found[label] for label in sorted(left)), key=len), None
             else:
                 break
             left -= {label for step in path for label in step.taken}

@@ -149,9 +149,9 @@ def test_the_generated_scenarios_kill_the_mutants_of_drive_3(tmp_path) -> None:
 @pytest.mark.soak
 @pytest.mark.parametrize("cls", [c for c in ALL_CHARTS if c is not DriveInit3], ids=lambda c: c.__name__)
 def test_the_generated_scenarios_kill_the_mutants_of_every_chart(cls, tmp_path) -> None:
-    """The target on every chart of the robot (Control's 132 mutants take minutes: a soak test)."""
+    """The target on every chart of the robot; of Control's 132 mutants (4 minutes) every fourth."""
     scenarios = [load_scenario(p) for p in write(generate(cls, DT), tmp_path, "test")]
-    results = mutation_test(cls, scenarios, PARAMS)
+    results = mutation_test(cls, scenarios, PARAMS, stride=4 if cls.__name__ == "Control" else 1)
     counts = summary(results)
     assert counts["mutants"] >= 5 and counts["stillborn"] == 0
     assert counts["kill_ratio"] >= 0.9, [r.to_dict() for r in results if r.status == "survived"]

@@ -218,19 +218,30 @@ def _bare(scenario: Scenario, params: ArmParams, listeners: Sequence[object]) ->
     return ChartsOnly(scenario.bare, params, listeners)
 
 
-def first_failure(scenarios: Sequence[Scenario], chart: str, cls: type[TickChart], params: ArmParams) -> str | None:
-    """The first failure of the scenarios with ``chart`` replaced by ``cls`` (None: they all pass)."""
-    for scenario in scenarios:
+def first_failure(scenarios: Sequence[Scenario], chart: str, cls: type[TickChart], params: ArmParams,
+                  killers: list[Scenario] | None = None) -> str | None:
+    """The first failure of the scenarios with ``chart`` replaced by ``cls`` (None: they all pass).
+
+    ``killers``: the scenarios that failed before, most recent first; they run
+    first (a mutant next to the last one in the source is most often caught by
+    the same scenario), and the one that fails now moves to their front.
+    """
+    first = list(killers or ())
+    order = first + [s for s in scenarios if not any(s is k for k in first)]
+    for scenario in order:
         s = _with_chart(scenario, chart, cls)
         result = run_scenario(s, params, robot_factory=_bare)
         if not result.passed:
+            if killers is not None:
+                killers[:] = [scenario, *(k for k in killers if k is not scenario)]
             return f"{scenario.file}: {result.failures[0].message}"
     return None
 
 
 def mutation_test(cls: type[TickChart], scenarios: Sequence[Scenario], params: ArmParams,
-                  check_equivalence: bool = True) -> list[MutantResult]:
-    """Run the scenarios that run ``cls`` bare against each of its mutants."""
+                  check_equivalence: bool = True, stride: int = 1) -> list[MutantResult]:
+    """Run the scenarios that run ``cls`` bare against each of its mutants (``stride``: every so many, a
+    sample of them in the order of the source)."""
     from .generate import generate, to_yaml
     from .loader import load_scenario_text
 
@@ -238,14 +249,15 @@ def mutation_test(cls: type[TickChart], scenarios: Sequence[Scenario], params: A
     runnable = [s for s in scenarios if runs_chart(s, chart)]
     results = []
     originals: list[Scenario] = []  # the chart's own generated scenarios: the same for every mutant, made once
-    for mutant in mutants(cls):
+    killers: list[Scenario] = []  # the scenarios that killed mutants, the latest first: tried first
+    for mutant in mutants(cls)[::stride]:
         try:
             built = build(cls, mutant)
             built(tick_period_s=params.control.chart_dt, chart_name=chart)
         except Exception as exc:  # the change makes no chart at all: nothing to test
             results.append(MutantResult(mutant, "stillborn", f"{type(exc).__name__}: {exc}"))
             continue
-        failure = first_failure(runnable, chart, built, params)
+        failure = first_failure(runnable, chart, built, params, killers)
         if failure is not None:
             results.append(MutantResult(mutant, "killed", failure))
             continue

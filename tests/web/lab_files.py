@@ -40,8 +40,15 @@ def broken_line() -> int:
 
 
 def fixed() -> str:
-    """The solution with state ``approach`` renamed (it still passes: the checks judge what it does)."""
-    return re.sub(rf"\b{RENAMED[0]}\b", RENAMED[1], reference_solution())
+    """The solution with state ``approach`` renamed (it still passes: the checks judge what it does).
+
+    The state's callbacks are renamed with it (``during_approach``): the runtime
+    refuses a ``during_`` method of a state that does not exist.  (``\\b`` alone
+    would not reach them: ``_`` is a word character.)
+    """
+    text = re.sub(rf"(?<![A-Za-z0-9]){RENAMED[0]}\b", RENAMED[1], reference_solution())
+    assert f"during_{RENAMED[1]}" in text, "the tutorial's solution no longer has a during_ action to rename"
+    return text
 
 
 def lab_folder(folder: Path) -> Exercise:

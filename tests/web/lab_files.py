@@ -18,6 +18,8 @@ LAB_DOC = Path(__file__).resolve().parents[2] / "docs" / "lab.md"
 BROKEN_CLASS = ("class MyDriveInit3(TickChart):", "class MyDriveInit3(TickChart:")
 #: The fix renames a state: the redrawn diagram shows it.
 RENAMED = ("approach", "seek_switch")
+#: The line of :func:`raising` that raises (ZeroDivisionError: the increment is 0.0 until the search starts).
+RAISING = "self.inc = 1.0 / self.inc"
 
 
 def reference_solution() -> str:
@@ -49,6 +51,21 @@ def fixed() -> str:
     text = re.sub(rf"(?<![A-Za-z0-9]){RENAMED[0]}\b", RENAMED[1], reference_solution())
     assert f"during_{RENAMED[1]}" in text, "the tutorial's solution no longer has a during_ action to rename"
     return text
+
+
+def raising() -> str:
+    """The solution with an action that raises on the first chart tick: it divides by the increment, still 0.0.
+
+    It loads and fits the slot; it fails only when the robot runs it.
+    """
+    text = reference_solution()
+    anchor = "    def start_search(self):\n"
+    assert anchor in text, "the tutorial's solution no longer has start_search"
+    return text.replace(anchor, f"    def during_wait_ini1(self):\n        {RAISING}\n\n{anchor}")
+
+
+def raising_line() -> int:
+    return next(n for n, line in enumerate(raising().splitlines(), 1) if line.strip() == RAISING)
 
 
 def lab_folder(folder: Path) -> Exercise:

@@ -4,7 +4,9 @@ The student's folder starts with the tutorial's solution: it runs in its slot
 and its checks pass.  A save with a syntax error reaches every page as one
 line with file:line, and the chart that loaded last keeps running; a save
 that fixes it rebuilds the robot with it (a renamed state in the diagram) and
-runs the checks again.
+runs the checks again.  A chart that raises while the robot runs it is shown
+at its file:line; the arm holds where it stands, the session stays, and the
+next good save runs on.
 
 Every wait is for a message and bounded twice: by a number of messages (a
 paused session sends a few per save) and by a generous overall time, so a
@@ -33,7 +35,7 @@ from ttt_sm.web.lab_watch import LabTask, LabWatch
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
 
-from .lab_files import RENAMED, broken, broken_line, fixed, lab_folder, save
+from .lab_files import RENAMED, broken, broken_line, fixed, lab_folder, raising, raising_line, save
 
 #: The longest any one wait may take, s: only there so that a message that never comes fails instead of
 #: hanging.  Generous: the longest wait, for the checks (a twin and three scenarios in a process at low
@@ -201,6 +203,61 @@ def test_a_class_that_does_not_fit_the_slot_is_one_line_and_the_robot_runs_on(la
     assert "does not fit the DriveInit3 slot: missing input ini2" in m["error"]
     assert m["error"].startswith(f"{lab.watch.task.chart_file}:")
     assert m["loads"] == 1
+
+
+def test_a_chart_that_raises_while_it_runs_holds_the_arm_keeps_the_session_and_a_fix_runs_on(lab: Lab) -> None:
+    chart_file = lab.watch.task.chart_file
+    save(chart_file, raising())
+    lab.wait_for_lab("the raising chart loaded (loads 2, no error)", lambda m: m["loads"] == 2 and m["error"] is None)
+    held: list[list[float]] = []
+
+    def spy_on_setpoints(dbg: Debugger) -> None:  # the arm's setpoints from now on, as they are set
+        arm = dbg.robot.arm
+        set_setpoints = arm.set_setpoints
+
+        def recorded(q: Any, fr_sw: bool = False) -> None:
+            held.append([float(v) for v in q])
+            set_setpoints(q, fr_sw)
+        arm.set_setpoints = recorded  # type: ignore[method-assign]
+
+    lab.session.call(spy_on_setpoints)
+    lab.socket.send({"type": "run", "id": 1})
+
+    # the error, at its file:line, to the page; the run paused, the robot where the exception left it
+    m = lab.wait_for_lab("the chart's exception on the page", lambda m: m["error"] is not None)
+    assert m["error"].startswith(f"{chart_file}:{raising_line()}: ZeroDivisionError: float division by zero"), m
+    assert "the arm holds where it stands" in m["error"] and m["loads"] == 2
+    frame = lab.socket.wait_for("a frame that says why the run stopped",
+                                lambda m: m["type"] == "frame" and bool(m.get("stop")))
+    assert frame["mode"] == "paused" and frame["error"] is None
+    assert frame["stop"]["kind"] == "error" and "ZeroDivisionError" in frame["stop"]["text"], frame["stop"]
+    session = lab.session
+    assert session.mode == "paused" and session.fault is not None and session.error is None
+
+    # the arm held: the one setpoint set since is where the drives and the servo stand
+    def where_the_arm_stands(dbg: Debugger) -> tuple[int, list[float]]:
+        arm = dbg.robot.arm
+        return dbg.robot.steps, [*arm.encoder_angles(), arm.servo_setpoint]
+
+    steps, pose = session.call(where_the_arm_stands)  # the session answers: it is alive
+    assert held == [pose]
+    # and that robot runs no more: run and step are refused with why, nothing moves
+    lab.socket.send({"type": "step", "n": 5, "id": 2})
+    refused = lab.socket.wait_for("the refusal of step", lambda m: m["type"] == "error" and m["id"] == 2)
+    assert refused["error"].startswith("step: the robot stopped at t = 0.0000 s") and "ZeroDivisionError" in \
+        refused["error"]
+    lab.socket.send({"type": "run", "id": 3})
+    refused = lab.socket.wait_for("the refusal of run", lambda m: m["type"] == "error" and m["id"] == 3)
+    assert refused["error"].startswith("run: the robot stopped")
+    assert session.call(where_the_arm_stands) == (steps, pose) and held == [pose]
+
+    # the fix: built again from power-on, and it runs on as it did before the exception
+    save(chart_file, fixed())
+    m = lab.wait_for_lab("the fixed save loaded (loads 3, no error)", lambda m: m["loads"] == 3 and m["error"] is None)
+    assert session.fault is None
+    frame = lab.socket.wait_for("a frame of the fixed chart running",
+                                lambda m: m["type"] == "frame" and m["mode"] == "running" and m["steps"] > 0)
+    assert frame.get("stop") is None and frame["error"] is None
 
 
 def test_the_lab_routes_say_when_there_is_no_lab() -> None:

@@ -10,6 +10,10 @@
     checks process:  python -m ttt_sm.lab.live DIR  (one JSON line per check, as each is decided)
         | each line to every page as it comes; the next good save ends a run still going
 
+    simulation thread:  the chart raises while the robot runs it (Session.robot_raised)
+        | the arm holds where it stands, the session pauses and stays; the error (file:line) to every page
+        | the next good save builds the robot again and runs on if it was running
+
 The checks run as a process of their own, at a lower priority: they take
 seconds of CPU, and the simulation thread (and the pages) must not wait on
 them.  Nothing here knows the lab's exercises: the command line reads the
@@ -117,6 +121,7 @@ class LabWatch:
     def attach(self, session: Session, diagrams: Diagrams) -> None:
         """Reload into `session`, whose pages draw the charts with `diagrams` (``create_app`` calls it)."""
         self.session, self.diagrams = session, diagrams
+        session.fault_listeners.append(self._robot_raised)
 
     # -- life -------------------------------------------------------------------------------
 
@@ -186,6 +191,21 @@ class LabWatch:
         self.running = (cls.__name__, where)
         self._start_checks()  # publishes
 
+    def _robot_raised(self, exc: BaseException) -> None:
+        """The chart raised while the robot ran it (the simulation thread): where in the file, to every page."""
+        file = shown_path(self.task.chart_file)
+        line = _line_in(self.task.chart_file, exc)
+        what = f"{type(exc).__name__}: {' '.join(str(exc).split()) or type(exc).__name__}"
+        robot = self.session.debugger.robot if self.session is not None else None
+        when = f" at t = {robot.t:.4f} s" if robot is not None else ""
+        if line is None:  # not in the student's file: the cockpit's own error, said as such
+            self.error = (f"{file}: the robot stopped{when}, not in your file: {what}; the arm holds where it"
+                          f" stands: save to start again")
+        else:
+            self.error = (f"{file}:{line}: {what} (raised while the robot ran your chart{when}); the arm holds"
+                          f" where it stands: save a fix to start again")
+        self._publish()
+
     def _load(self) -> tuple[type[TickChart], str, ChartSlots]:
         t = self.task
         cls, where = load_chart(t.chart_file, t.class_name)
@@ -204,6 +224,7 @@ class LabWatch:
             return
 
         def swap(dbg: Debugger) -> None:
+            run_on = session.fault is not None and session.fault_while_running  # the fault paused the run
             old = dbg.recipe
             if not isinstance(old, (RobotRecipe, GameRecipe)):
                 raise ReloadError(f"{where}: this session's robot cannot be built again (not the twin)")
@@ -212,10 +233,12 @@ class LabWatch:
                     dbg.start_over(dataclasses.replace(old, slots=slots))
             except Exception as exc:  # the student's class raised while the robot was built
                 dbg.recipe = old
-                line = _line_in(self.task.chart_file, exc)
+                line = _line_in(self.task.chart_file, exc) or 1
                 raise ReloadError(f"{shown_path(self.task.chart_file)}:{line}: the robot could not be built with"
                                   f" {cls.__name__}: {type(exc).__name__}: {' '.join(str(exc).split())}") from None
             session.last_stop = None
+            if run_on:
+                session.mode = "running"
             session.chart_classes[slot] = cls
             session.info.update(describe_session(dbg))
             diagrams.replace(slot, cls)
@@ -275,10 +298,10 @@ class LabWatch:
         self._publish()
 
 
-def _line_in(path: Path, exc: BaseException) -> int:
-    """The line of `path` deepest in `exc`'s traceback (1 if none of its frames is in that file)."""
+def _line_in(path: Path, exc: BaseException) -> int | None:
+    """The line of `path` deepest in `exc`'s traceback (None if none of its frames is in that file)."""
     resolved = path.resolve()
-    line = 1
+    line = None
     for frame in traceback.extract_tb(exc.__traceback__):
         if frame.filename and Path(frame.filename).resolve() == resolved:
             line = frame.lineno or line

@@ -22,6 +22,7 @@ import uvicorn
 from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params
 from ttt_sm.web.coverage import scenario_dir_files
+from ttt_sm.web.lab_watch import LabWatch
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
 
@@ -51,9 +52,12 @@ def text_of(page: Any, role: str) -> str:
 
 
 @contextmanager
-def served(session: Session) -> Iterator[Cockpit]:
-    """``session`` served on a free loopback port while the block runs (the session with the app); stopped after."""
-    server, thread, url = serve(session)
+def served(session: Session, lab: LabWatch | None = None) -> Iterator[Cockpit]:
+    """``session`` served on a free loopback port while the block runs (the session with the app); stopped after.
+
+    ``lab``: a student's chart watched and reloaded into it (``ttt-sm gui --lab``).
+    """
+    server, thread, url = serve(session, lab=lab)
     try:
         yield Cockpit(url, session, server)
     finally:
@@ -61,12 +65,13 @@ def served(session: Session) -> Iterator[Cockpit]:
         thread.join(30)
 
 
-def serve(session: Session, token: str | None = None) -> tuple[uvicorn.Server, threading.Thread, str]:
+def serve(session: Session, token: str | None = None,
+          lab: LabWatch | None = None) -> tuple[uvicorn.Server, threading.Thread, str]:
     sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
     sock.bind(("127.0.0.1", 0))
     port = sock.getsockname()[1]
     hosts = [f"127.0.0.1:{port}", f"localhost:{port}"]
-    app = create_app(session, token=token, hosts=hosts)
+    app = create_app(session, token=token, hosts=hosts, lab=lab)
     server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
     thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
     thread.start()

@@ -52,6 +52,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
                     help="a camera outside the simulation, shown in the /game page: an OpenCV capture device"
                          " index (0), a folder of pictures (shown in name order) or the serial smart camera"
                          " (serial:PORT)")
+    sp.add_argument("--lab", metavar="DIR", default=None,
+                    help="live while writing: watch the chart of the exercise folder DIR (made by ttt-sm lab start);"
+                         " each save rebuilds the robot with it, redraws it and reruns the checks in the /lab page")
     sp.add_argument("--trace", metavar="FILE", default="out/gui/trace.jsonl",
                     help="the trace of transitions, written as they happen (JSON Lines, flushed line by line;"
                          " the last line says how the cockpit stopped; default out/gui/trace.jsonl)")
@@ -111,6 +114,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
     record_root = out_dir(args.out, "--out") if args.game else None
     trace = trace_file(args.trace)  # refused now if it cannot be written, not when the cockpit stops
     params = load_arm(getattr(args, "params", None))
+    lab = lab_watch(args) if args.lab is not None else None
     token = secrets.token_urlsafe(24) if needs_token(args.host) else None
     try:
         sock = socket.socket(socket.AF_INET6 if ":" in args.host else socket.AF_INET, socket.SOCK_STREAM)
@@ -122,15 +126,19 @@ def cmd_gui(args: argparse.Namespace) -> int:
     print(f"ttt-sm gui: building the robot (seed {args.seed}) ...", file=sys.stderr, flush=True)
     conn = open_arm(args, params)
     dbg = Debugger.build(params, seed=args.seed, game=args.game, person=args.person, trace_path=trace,
-                         record_root=record_root, arm=conn.arm if conn else None, truth=conn.truth if conn else None)
+                         record_root=record_root, arm=conn.arm if conn else None, truth=conn.truth if conn else None,
+                         slots=lab.first_slots() if lab is not None else None)
     try:
         session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
                           camera_feed=feed)
         shown = f"[{args.host}]" if ":" in args.host else args.host
         hosts = [f"{h}:{port}" for h in ("127.0.0.1", "localhost", "[::1]", shown)]
-        app = create_app(session, token=token, hosts=hosts)
+        app = create_app(session, token=token, hosts=hosts, lab=lab)
         url = f"http://{shown}:{port}/charts" + (f"?token={token}" if token else "")
         print(f"ttt-sm gui: the chart cockpit is at {url}", flush=True)
+        if lab is not None:
+            print(f"ttt-sm gui: your chart, live while you write it, is at {url.replace('/charts', '/lab', 1)}"
+                  + (f" (it does not load yet: {lab.error})" if lab.error else ""), flush=True)
         if args.game and args.person == "page":
             print(f"ttt-sm gui: play at {url.replace('/charts', '/game', 1)}", flush=True)
         if record_root is not None:
@@ -141,8 +149,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
             print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
                   flush=True)
         print("ttt-sm gui: Ctrl-C stops it (the trace is written to " + args.trace + " as it happens)", flush=True)
-        if args.open:  # the game's page when you play there, else the chart cockpit
-            shown_url = url.replace("/charts", "/game", 1) if args.game and args.person == "page" else url
+        if args.open:  # the game's page when you play there, the lab's with --lab, else the chart cockpit
+            shown_url = (url.replace("/charts", "/game", 1) if args.game and args.person == "page" else
+                         url.replace("/charts", "/lab", 1) if lab is not None else url)
             threading.Timer(1.0, webbrowser.open, args=(shown_url,)).start()
         config = uvicorn.Config(app, log_level="warning", ws_max_size=1 << 20, lifespan="on")
         server = uvicorn.Server(config)
@@ -168,3 +177,23 @@ def cmd_gui(args: argparse.Namespace) -> int:
     dbg.end_trace("finished")  # nothing if the session ended it already
     print("ttt-sm gui: stopped", flush=True)
     return 0
+
+
+def lab_watch(args: argparse.Namespace) -> Any:
+    """``--lab DIR``: the watcher of the exercise folder's chart (web/lab_watch.py); one line if DIR is none."""
+    from ..lab.exercise import LabError, read_exercise
+    from ..web.lab_watch import LabTask, LabWatch
+
+    folder = Path(args.lab)
+    if not folder.is_dir():
+        raise CliError(f"--lab: {args.lab} is not a folder: make one with ttt-sm lab start EXERCISE {args.lab}")
+    if args.arm != "sim":
+        raise CliError("--lab runs your chart on the twin: leave out --arm")
+    try:
+        ex = read_exercise(folder)
+    except LabError as exc:
+        raise CliError(f"--lab: {exc}") from None
+    argv = [sys.executable, "-m", "ttt_sm.lab.live", str(folder), "--nice", "10"]
+    if getattr(args, "params", None):
+        argv += ["--params", str(args.params)]
+    return LabWatch(LabTask(ex.title, ex.slot, ex.chart_file, ex.class_name, tuple(argv)))

@@ -44,6 +44,7 @@ from typing import Any
 
 from ..app.game import GameSession
 from ..app.robot import Robot
+from ..app.slots import ChartSlots, chosen_slots
 from ..arm import Arm
 from ..params import ArmParams
 from ..runtime.listeners import Trace
@@ -161,7 +162,7 @@ class Debugger:
               settle_s: float = 0.0, *, game: bool = False, person: str = "simulated",
               max_run_s: float = DEFAULT_MAX_RUN_S, trace_path: str | Path | None = None,
               record_root: Path | None = None, arm: Arm | None = None,
-              truth: GroundTruth | None = None) -> Debugger:
+              truth: GroundTruth | None = None, slots: ChartSlots | None = None) -> Debugger:
         """A debugger on a new robot, with its recipe for :meth:`replay`.
 
         ``game``: the robot plays a game (:class:`~.replay.GameRecipe`: the Game
@@ -173,13 +174,16 @@ class Debugger:
         ``record_root/game-1/game.jsonl`` as it is played.
         ``arm`` (and the ``truth`` it offers): another arm than the twin
         (``--arm serial:PORT``); the robot is built on it once (no replay).
+        ``slots``: the class in each replaceable chart's place, kept in the recipe
+        (default: the command's, :func:`~ttt_sm.app.slots.chosen_slots`).
         """
         if arm is not None:
             arm_recipe = ArmRecipe(params, arm, truth, seed, game=game, person=person, record_root=record_root)
             return cls(arm_recipe.build(), arm_recipe, max_run_s=max_run_s, trace_path=trace_path)
         pose = None if q_start is None else tuple(float(v) for v in q_start)
-        recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person, record_root=record_root) \
-            if game else RobotRecipe(params, seed, pose, settle_s)
+        chosen = slots if slots is not None else chosen_slots()
+        recipe: Recipe = GameRecipe(params, seed, pose, settle_s, person=person, record_root=record_root,
+                                    slots=chosen) if game else RobotRecipe(params, seed, pose, settle_s, slots=chosen)
         return cls(recipe.build(), recipe, max_run_s=max_run_s, trace_path=trace_path)
 
     def _attach(self, robot: Robot) -> None:

@@ -145,6 +145,13 @@ class Diagrams:
         self._cache: OrderedDict[tuple[str, str, tuple[str, ...]], str] = OrderedDict()
         self._lock = threading.Lock()
 
+    def replace(self, chart: str, cls: type[TickChart]) -> None:
+        """Chart `chart` is now drawn from `cls` (a student's chart reloaded): its cached pictures are dropped."""
+        with self._lock:
+            self.charts[chart] = cls
+            for key in [k for k in self._cache if k[0] == chart]:
+                del self._cache[key]
+
     def svg(self, chart: str, key: str = "overview", opened: tuple[str, ...] = ()) -> str:
         """One picture of a chart, annotated; :class:`DiagramError` names what does not exist."""
         cls = self.charts.get(chart)
@@ -160,6 +167,8 @@ class Diagrams:
                 return self._cache[cache_key]
         picture = annotate(svg_from_dot(to_dot(cls, view=view)), chart, cls.structure())
         with self._lock:
+            if self.charts.get(chart) is not cls:  # replaced while it was drawn: not kept
+                return picture
             self._cache[cache_key] = picture
             while len(self._cache) > CACHE_SIZE:
                 self._cache.popitem(last=False)

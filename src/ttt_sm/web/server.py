@@ -11,6 +11,7 @@ Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
 ``/api/arm/ink.png`` (the whiteboard's ink under the arm's top view, :mod:`.arm_view`),
 ``/api/camera/frame.png`` (the newest picture of ``--camera``, :mod:`.camera_feed`),
 ``/operate`` (the Operational page, :mod:`.operate`),
+``/lab`` and ``/api/lab`` (with ``ttt-sm gui --lab``: the student's chart live while they write it, :mod:`.lab_watch`),
 ``/static/...`` (the pages' scripts and styles, from the package: nothing from
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
 SVG, :mod:`.diagrams`), ``/api/trace.jsonl`` (the trace so far), ``/ws``.
@@ -39,7 +40,7 @@ from urllib.parse import urlsplit
 
 from starlette.applications import Starlette
 from starlette.requests import HTTPConnection, Request
-from starlette.responses import HTMLResponse, PlainTextResponse, Response
+from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Receive, Scope, Send
@@ -50,6 +51,7 @@ from .arm_view import ink_picture, png
 from .camera_feed import feed_png
 from .diagrams import DiagramError, Diagrams
 from .game import photo_png
+from .lab_watch import LabWatch
 from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
 from .session import Session
 
@@ -118,15 +120,19 @@ def origin_ok(origin: str | None, host: str) -> bool:
 
 
 def create_app(session: Session, *, token: str | None = None, hosts: Iterable[str] = (),
-               manage_session: bool = True) -> Starlette:
+               manage_session: bool = True, lab: LabWatch | None = None) -> Starlette:
     """The cockpit's ASGI app over ``session``.
 
     ``token``: required on every request when given (``ttt-sm gui`` sets one
     for any host but 127.0.0.1).  ``hosts``: the ``host[:port]`` values the Host
     header may take (empty: any).  ``manage_session``: start the session with
     the app and stop it (saving the trace) when the app shuts down.
+    ``lab``: a student's chart watched and reloaded into the session (the
+    ``/lab`` page), started and stopped with the app.
     """
     diagrams = Diagrams(session.chart_classes)
+    if lab is not None:
+        lab.attach(session, diagrams)
     files = resources.files("ttt_sm.web") / "static"
 
     def page(name: str) -> Response:
@@ -145,6 +151,16 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
 
     async def operate(request: Request) -> Response:
         return page("operate.html")
+
+    async def lab_page(request: Request) -> Response:
+        if lab is None:
+            return PlainTextResponse("no lab here: start the cockpit with ttt-sm gui --lab DIR\n", status_code=404)
+        return page("lab.html")
+
+    async def lab_state(request: Request) -> Response:
+        if lab is None:
+            return JSONResponse({"error": "no lab here: start the cockpit with ttt-sm gui --lab DIR"}, status_code=404)
+        return JSONResponse(lab.state(), headers={"Cache-Control": "no-store"})
 
     async def game_photo(request: Request) -> Response:
         png = await asyncio.to_thread(photo_png, session.debugger)
@@ -249,9 +265,13 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
         if manage_session:
             session.start()
+        if lab is not None:
+            lab.start()
         try:
             yield
         finally:
+            if lab is not None:
+                await asyncio.to_thread(lab.stop)
             if manage_session:
                 saved = await asyncio.to_thread(session.stop)
                 if saved is not None:
@@ -266,6 +286,8 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         Route("/api/arm/ink.png", arm_ink),
         Route("/api/camera/frame.png", camera_frame),
         Route("/operate", operate),
+        Route("/lab", lab_page),
+        Route("/api/lab", lab_state),
         Route("/api/diagram/{chart}", diagram),
         Route("/api/trace.jsonl", trace),
         WebSocketRoute("/ws", ws),

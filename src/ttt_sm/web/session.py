@@ -24,6 +24,13 @@ number of pending transitions, frame stamps and latency samples.  The whole
 trace is the debugger's trace file when it streams one (``ttt-sm gui
 --trace``: written as it happens, ended by :meth:`Session.stop` with how the
 cockpit stopped), else :meth:`Session.stop` saves the kept transitions.
+
+A chart that raises while the robot runs (a student's chart, with ``ttt-sm
+gui --lab``) does not end the session: :meth:`Session.robot_raised` holds the
+arm where it stands, pauses, and refuses to run that robot on (its charts may
+be half way through a step) until it is built again: a replay, a new game, the
+lab's next save.  Every page is told (the frames' ``stop``, and whoever
+listens in :attr:`Session.fault_listeners`).
 """
 
 from __future__ import annotations
@@ -146,6 +153,14 @@ class Session:
         self._resync = False
         self._thread: threading.Thread | None = None
         self.error: str | None = None
+        #: Why the robot may not run on (a chart raised while it ran: :meth:`robot_raised`), or None.
+        #: Cleared when the robot is built again (:meth:`robot_replaced`).
+        self.fault: str | None = None
+        #: Whether the session was running when the fault came (the lab's next good save runs on).
+        self.fault_while_running = False
+        #: ``tell(exc)``, in the simulation thread, when a chart raises while the robot runs (the lab
+        #: names the student's file and line).
+        self.fault_listeners: list[Callable[[BaseException], None]] = []
         #: How the session ends, for the trace file's last line: ``("interrupted", {"signal": "SIGTERM"})``
         #: when a signal stops the server (``ttt-sm gui`` sets it), else finished (or the error).
         self.ending: tuple[str, dict[str, Any]] | None = None
@@ -302,6 +317,37 @@ class Session:
             self.frames.forget_taken()
         self.frames.forget_pending()
         self._resync = True
+        self.fault = None  # the robot that raised is gone
+
+    def robot_raised(self, exc: BaseException) -> None:
+        """A chart raised while the robot ran (or a command broke off in the middle of a step).
+
+        The arm holds where it stands (its setpoints are where the drives and
+        the servo are now), the run pauses, and the robot runs no more: its
+        charts may be half way through a tick.  :attr:`fault` says why until
+        the robot is built again; the frames carry it as the ``stop``, and each
+        of :attr:`fault_listeners` is told.  The session itself goes on.
+        """
+        log.error("the robot stopped: a chart raised", exc_info=exc)
+        robot = self.debugger.robot
+        arm = robot.arm
+        try:
+            arm.set_setpoints([*arm.encoder_angles(), arm.servo_setpoint], False)
+        except Exception:  # an arm that cannot take them now (a link down): its own safety holds it
+            log.exception("the arm could not be told to hold where it stands")
+        self.fault_while_running = self.mode == "running"
+        self.mode = "paused"
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        self.fault = (f"the robot stopped at t = {robot.t:.4f} s, chart tick {robot.chart_ticks}:"
+                      f" {type(exc).__name__}: {message}; the arm holds where it stands until the robot is"
+                      f" built again")
+        self.last_stop = {"kind": "error", "text": self.fault, "tick": robot.chart_ticks, "hits": []}
+        self._dirty = True
+        for tell in list(self.fault_listeners):
+            try:
+                tell(exc)
+            except Exception:  # a listener's bug must not end the session either
+                log.exception("a listener of the robot's fault failed")
 
     def send_to(self, cid: int, message: dict[str, Any]) -> None:
         """Send one page a message."""
@@ -364,9 +410,15 @@ class Session:
     def _run_slice(self) -> None:
         dbg = self.debugger
         self._next_frame_at = max(self._last_frame_at + self.frame_period, time.perf_counter())
+        if self.fault is not None:  # the robot that raised runs no more
+            self.mode = "paused"
+            return
         self._running_slice = True
         try:
             reason = dbg.run(min(RUN_CHUNK_S, dbg.max_run_s))
+        except Exception as exc:  # a chart raised: the arm holds, the session goes on without running it
+            self.robot_raised(exc)
+            return
         finally:
             self._running_slice = False
         self._dirty = True
@@ -401,6 +453,9 @@ class Session:
             result = spec.handler(self, cid, **cmd.args)
         except (DebugError, CoverageError, ValueError) as exc:
             self.reply_error(cid, f"{cmd.type}: {exc}" if not str(exc).startswith(cmd.type) else str(exc), cmd)
+        except Exception as exc:  # broke off in the middle (a replay through a chart that raises, say)
+            self.robot_raised(exc)
+            self.reply_error(cid, f"{cmd.type}: {self.fault}", cmd)
         else:
             if result is not None:
                 self.send_to(cid, {"type": "reply", "id": cmd.id, "command": cmd.type, "ok": True, **result})

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ...debug.errors import DebugError
 from ...debug.records import StopReason
 from ..fields import MAX_COUNT, integer, number, optional, speed
 from .spec import Cockpit, Reply, command
@@ -12,6 +13,7 @@ from .spec import Cockpit, Reply, command
 @command("run")
 def run(session: Cockpit, cid: int) -> Reply:
     """Run until a breakpoint or a pause."""
+    _refuse_after_fault(session)
     session.mode = "running"
     session.last_stop = None
     session.clock.restart()
@@ -29,9 +31,21 @@ def pause(session: Cockpit, cid: int) -> Reply:
     return {"text": "paused"}
 
 
+def _refuse_after_fault(session: Cockpit) -> None:
+    if session.fault is not None:
+        raise ValueError(f"{session.fault} (a replay to an earlier tick, or with --lab the next save, builds it again)")
+
+
 def _stepping(session: Cockpit, go: Callable[[], StopReason]) -> Reply:
+    _refuse_after_fault(session)
     session.mode = "paused"
-    reason = go()
+    try:
+        reason = go()
+    except DebugError:
+        raise  # refused before a step was taken
+    except Exception as exc:  # a chart raised (a ValueError too, which would read as a refusal): the arm holds
+        session.robot_raised(exc)
+        raise ValueError(str(session.fault)) from None
     session.note_stop(reason)
     return {"text": reason.describe()}
 

@@ -55,6 +55,8 @@ class Cockpit(Protocol):
     speed: float | None
     #: Why the run stopped last (a frame's ``stop``), or None while it runs.
     last_stop: dict[str, Any] | None
+    #: Why the robot may not run on (a chart raised while it ran), or None.
+    fault: str | None
     clock: PacedClock
     frames: Frames
     operate: Operate
@@ -71,6 +73,9 @@ class Cockpit(Protocol):
 
     def note_stop(self, reason: StopReason) -> None:
         """Keep why the run stopped, for the frames."""
+
+    def robot_raised(self, exc: BaseException) -> None:
+        """A chart raised while the robot ran: hold the arm where it stands, run that robot no more."""
 
     def robot_replaced(self, *, replaying: bool) -> AbstractContextManager[None]:
         """Around a call that gives the debugger a new robot (a replay, a new game)."""

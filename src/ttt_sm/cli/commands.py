@@ -20,6 +20,7 @@ from .common import (
     CliError,
     add_arm_option,
     add_command,
+    add_runner_options,
     clear_status,
     emit,
     out_dir,
@@ -31,6 +32,7 @@ from .common import (
 if TYPE_CHECKING:
     from ..app.arms import ArmConnection
     from ..app.game import GameSession
+    from ..runner import Runner
     from ..runtime.export import ExtraDiagram
 
 
@@ -278,12 +280,30 @@ def cmd_ik(args: argparse.Namespace) -> int:
     return 0
 
 
-#: Most power-on poses one ``init`` runs (each takes a few seconds of computing).
-MAX_STARTS = 1000
+#: Most power-on poses one ``init`` runs (each takes about half a second of computing: 10000 is a long sweep,
+#: best on a pool or a cluster, ``--workers``/``--dask``).
+MAX_STARTS = 10000
+
+
+def sweep_runner(args: argparse.Namespace, preload: tuple[str, ...] = ()) -> Runner:
+    """The runner of a sweep's ``--workers N`` / ``--dask ADDRESS`` (:mod:`ttt_sm.runner`)."""
+    from ..runner import Runner, dask_client
+
+    if args.dask is not None:
+        if args.workers != 1:
+            raise CliError(f"--workers {args.workers} and --dask: the cluster's workers run the tasks; give one")
+        return Runner(client=dask_client(args.dask))
+    return Runner(workers=args.workers, preload=preload)
+
+
+def _closing(runner: Runner) -> None:
+    if runner.client is not None:
+        runner.client.close()
 
 
 def cmd_init(args: argparse.Namespace) -> int:
-    from ..app.init_wiring import init_report
+    from ..app.init_wiring import INIT_PRELOAD, init_report
+    from ..runner import SweepInterrupted
 
     if not 1 <= args.starts <= MAX_STARTS:
         raise CliError(f"--starts must lie in 1..{MAX_STARTS}, got {args.starts}")
@@ -293,18 +313,34 @@ def cmd_init(args: argparse.Namespace) -> int:
     if args.arm != "sim" and args.starts != 1:
         raise CliError(f"--starts {args.starts}: an arm behind a serial link initialises once, from where it stands;"
                        " give --starts 1")
+    if args.arm != "sim" and (args.workers != 1 or args.dask is not None):
+        option = f"--workers {args.workers}" if args.dask is None else "--dask"
+        raise CliError(f"{option}: an arm behind a serial link initialises once, in this process; drop {option}")
+    runner = sweep_runner(args, INIT_PRELOAD)
     conn = open_arm(args, params)
     try:
         report = init_report(params, args.starts, seed=args.seed, timeout_s=args.time_limit, status=status_line(),
-                             arm=conn.arm if conn else None, truth=conn.truth if conn else None)
+                             arm=conn.arm if conn else None, truth=conn.truth if conn else None, runner=runner)
+    except SweepInterrupted as stopped:
+        clear_status()
+        _emit_init(stopped.report, args)  # what was done before the Ctrl-C; the interrupt then exits with 130
+        raise
     except ValueError as exc:
         raise CliError(f"--arm {args.arm}: {exc}") from exc
     finally:
         clear_status()
         if conn is not None:
             conn.close()
+        _closing(runner)
+    return _emit_init(report, args)
+
+
+def _emit_init(report: dict[str, Any], args: argparse.Namespace) -> int:
+    """Print `report` (JSON or text); the exit status it earns: 0 when every run initialised within the limits."""
     text = "\n".join(f"  {k}: {v}" for k, v in report.items())
-    emit(report, args.json, f"init from {args.starts} random power-on poses:\n{text}")
+    title = f"init from {args.starts} random power-on poses" + (
+        f" (interrupted after {report['runs']})" if report["interrupted"] else "")
+    emit(report, args.json, f"{title}:\n{text}")
     ok = report["successes"] == report["runs"] and not report["limit_violations"] \
         and not report["board_zone_entries"]
     return 0 if ok else 1
@@ -506,6 +542,7 @@ def register(sub: Any) -> None:
                     help=f"number of random power-on poses, 1..{MAX_STARTS} (default 20)")
     sp.add_argument("--time-limit", type=float, default=40.0, metavar="SECONDS",
                     help="longest one initialisation may run, simulated seconds (default 40; one takes 6-12)")
+    add_runner_options(sp, "initialisations")
     add_arm_option(sp)
     sp = add_command(sub, "faults", cmd_faults,
                      "inject each fault of the arm (twin or emulator) in each phase and measure what the Safety chart"

@@ -75,17 +75,18 @@ def _ignore_interrupts() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _stop_processes(pool: ProcessPoolExecutor) -> None:
-    """Terminate the pool's worker processes: their tasks are pure computation, nothing to tidy up."""
-    # Python 3.14 has ProcessPoolExecutor.terminate_workers(); before it, the pool's own table of processes
-    terminate = getattr(pool, "terminate_workers", None)
-    if terminate is not None:
-        terminate()
-        return
-    for process in list((getattr(pool, "_processes", None) or {}).values()):
+def _pool_processes(pool: Executor) -> list[Any]:
+    """The worker processes of a process pool (none for threads), taken before a shutdown forgets them."""
+    # the pool's own table (Python 3.14's terminate_workers() reads it too); the pool drops it on shutdown
+    return list((getattr(pool, "_processes", None) or {}).values())
+
+
+def _terminate(processes: list[Any]) -> None:
+    """Terminate a pool's worker processes: their tasks are pure computation, nothing to tidy up."""
+    for process in processes:
         try:
             process.terminate()
-        except (OSError, AttributeError):
+        except (OSError, AttributeError, ValueError):  # gone already, or closed
             pass
 
 
@@ -185,11 +186,11 @@ class Runner:
             if finished_all:
                 pool.shutdown(wait=True)
             else:
+                processes = _pool_processes(pool)
                 pool.shutdown(wait=False, cancel_futures=True)
                 if stop is not None:
                     stop()
-                if isinstance(pool, ProcessPoolExecutor):
-                    _stop_processes(pool)
+                _terminate(processes)
                 pool.shutdown(wait=True)
 
     def _on_dask(self, fn: Callable[..., R], tasks: Sequence[tuple[Any, ...]],

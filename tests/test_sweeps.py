@@ -160,3 +160,17 @@ def test_ctrl_c_prints_the_starts_done_so_far_and_exits_130(tmp_path) -> None:
     assert report["successes"] == report["runs"] and report["workers"] == 2
     _, alive = psutil.wait_procs(children, timeout=15)
     assert alive == [], [p.cmdline() for p in alive]
+
+
+def test_the_init_sweep_bench_times_each_runner_on_the_same_starts(params, monkeypatch) -> None:
+    from ttt_sm.bench import OPT_IN, bench_init_sweep
+
+    assert "init_sweep" in OPT_IN  # minutes long at its default: run only when named
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # the LocalCluster part is the Dask test's above
+    result = bench_init_sweep(params, starts=2, seed=4)
+    assert result["init_sweep_successes"] == [2, 2] and result["init_sweep_same_report"] is True
+    for name in ("1_worker", "2_workers"):
+        wall = result[f"init_sweep_{name}_wall_s"]
+        workers = 1 if name == "1_worker" else 2
+        assert result[f"init_sweep_{name}_starts_per_s_per_worker"] == pytest.approx(2 / wall / workers, rel=0.05)
+    assert "init_sweep_dask_2_workers_wall_s" not in result

@@ -27,6 +27,7 @@ from .common import (
     print_json,
     progress,
     status_line,
+    whole_number,
 )
 
 if TYPE_CHECKING:
@@ -244,7 +245,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         try:
             result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
                                progress=progress(True), gui_soak_min=args.gui_soak or 0.0, on_section=on_section,
-                               link_minutes=args.link_minutes)
+                               link_minutes=args.link_minutes, sweep_starts=args.sweep_starts)
         except ValueError as exc:
             raise CliError(str(exc)) from exc
     except BaseException as exc:  # the record and the --json document say what was measured and where it stopped
@@ -423,8 +424,10 @@ def _emit_faults(report: dict[str, Any], args: argparse.Namespace) -> int:
     summary = report["summary"]
     lines.append(f"{summary['detected']} of {summary['cells']} detected, {summary['detected_within_100_ms']} within"
                  f" 100 ms; {summary['limit_violations']} limit violations; {summary['records_lost']} records lost;"
-                 f" {summary['recovered']} recovered ({report['wall_time_s']:.0f} s, {report['workers']} worker"
-                 f"{'s' if report['workers'] != 1 else ''}, {report['runner']})")
+                 f" {summary['recovered']} recovered ({report['wall_time_s']:.0f} s)")
+    if report["workers"] != 1 or report["runner"] != "local":
+        lines.append(f"on {report['workers']} {report['runner']} workers:"
+                     f" {report['throughput_per_worker']:g} cells/s per worker")
     lines += [f"error: {e}" for e in report.get("errors", [])]
     if report["interrupted"]:
         lines.append(f"interrupted: {summary['cells']} cells done")
@@ -547,12 +550,15 @@ def register(sub: Any) -> None:
     sp = add_command(sub, "bench", cmd_bench, "measure the speed and quality targets")
     sp.add_argument("--only", default=None,
                     help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui,link;"
-                         " lab_grade (grading a class of 30, minutes long) runs only when named here")
+                         " lab_grade (grading a class of 30, minutes long) and init_sweep (init starts on 1 and 2"
+                         " local workers and a 2-worker Dask LocalCluster) run only when named here")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
     sp.add_argument("--gui-soak", metavar="MIN", type=float, default=None,
                     help="gui section: also run MIN minutes at x10 and report the memory after 1 and after MIN")
     sp.add_argument("--link-minutes", metavar="MIN", type=float, default=None,
                     help="link section: stream setpoints to the emulator for MIN minutes (default 10; --quick: 5 s)")
+    sp.add_argument("--sweep-starts", metavar="N", type=whole_number, default=None,
+                    help="init_sweep section: starts on each runner (default 40; --quick: 6; 10000 for the long sweep)")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
     sp = add_command(sub, "ik", cmd_ik, "solve inverse kinematics for one tool pose")
     sp.add_argument("x", type=float, help="mm")

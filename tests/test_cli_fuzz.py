@@ -52,7 +52,7 @@ ARGS = [
     (["draw", "X", "--column"], [], _in(1, 5, whole=True)),
     (["draw", "X", "--speed"], [], _in(1, 100)),
     (["draw", "X", "--size"], [], _in(4, 30)),
-    (["init", "--starts"], [], _in(1, 1000, whole=True)),
+    (["init", "--starts"], [], _in(1, 10000, whole=True)),
     (["init", "--seed"], [], _in(0, 2**63 - 1, whole=True)),
     (["demo", "--seed"], [], _in(0, 2**63 - 1, whole=True)),
     (["bench", "--seed"], [], _in(0, 2**63 - 1, whole=True)),
@@ -176,7 +176,7 @@ test_an_unusable_arm_is_refused_in_one_line, test_an_unusable_arm_is_refused_in_
 @pytest.mark.parametrize("argv, message", [
     (["draw", "X", "--seed", "-1"], "argument --seed: expected a whole number 0 .. 2**63 - 1, got -1"),
     (["vision", "bench", "--photos", "1", "--seed", "-5"], "argument --seed: expected a whole number 0 .. 2**63 - 1"),
-    (["init", "--starts", "7656"], "--starts must lie in 1..1000, got 7656"),
+    (["init", "--starts", "76560"], "--starts must lie in 1..10000, got 76560"),
     (["tune", "--out", "/proc/nope/x"], "--out /proc/nope/x: cannot write there (No such file or directory)"),
     (["charts", "export", "--out", "/proc/version"], "--out /proc/version: cannot write there"),
     (["debug", "--max-run", "0.001", "--commands", "/dev/zero"],

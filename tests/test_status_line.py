@@ -52,11 +52,12 @@ def _status_lines(terminal: str) -> list[str]:
 
 
 @needs_script
-def test_init_shows_its_power_on_pose_on_a_terminal_not_in_its_json(tmp_path):
+def test_init_shows_its_runs_done_on_a_terminal_not_in_its_json(tmp_path):
     status, out, terminal = _run_with_stderr_on_a_terminal(["init", "--starts", "2", "--json"], tmp_path)
     assert status == 0, terminal
-    assert [s for s in _status_lines(terminal) if s] == [f"init: power-on pose {k + 1} of 2, {k} initialised so far"
-                                                         for k in range(2)]
+    assert [s for s in _status_lines(terminal) if s] == ["0/2 init: starting in this process",
+                                                         "1/2 init: 1 initialised so far",
+                                                         "2/2 init: 2 initialised so far"]
     assert terminal.endswith("\r\x1b[K")  # the status line taken off at the end
     report = json.loads(out)  # the document alone on standard output
     assert report["runs"] == 2 and "power-on pose" not in out

@@ -185,6 +185,48 @@ def bench_lab_grade_section(quick: bool = False) -> dict[str, Any]:
     return bench_lab_grade(6 if quick else 30)
 
 
+#: What the init_sweep section compares between its runners: the report without wall times and the runner's keys.
+_RUNNER_KEYS = ("wall_time_s", "workers", "backend", "throughput_per_worker")
+
+
+def bench_init_sweep(params: ArmParams, starts: int = 40, seed: int = 0) -> dict[str, Any]:
+    """``ttt-sm init --starts N`` on the runner (ttt_sm/runner.py): in this process, on a local pool of 2
+    processes, and on a 2-worker Dask LocalCluster (when Dask is installed), side by side.
+
+    Reports each one's wall time and starts per second per worker (the pool's
+    and the cluster's include their workers' start-up: importing ttt_sm and
+    loading numba's cached kernels), and whether the three reports agree on
+    everything the runs measured (they must: the runner changes the wall time only).
+    """
+    from .app.init_wiring import INIT_PRELOAD, init_report
+    from .runner import Runner
+    from .twin.tuning import design_gains
+
+    def measured(report: dict[str, Any]) -> dict[str, Any]:
+        return {k: v for k, v in report.items() if k not in _RUNNER_KEYS}
+
+    result: dict[str, Any] = {"init_sweep_starts": starts, "init_sweep_cpus": os.cpu_count()}
+    design_gains(params)  # designed once per process whatever the runner: not in the first runner's time
+    reports = {}
+    for name, runner in (("1_worker", Runner(1)), ("2_workers", Runner(2, preload=INIT_PRELOAD))):
+        reports[name] = init_report(params, starts, seed=seed, runner=runner)
+    try:
+        from dask.distributed import Client, LocalCluster
+    except ImportError:
+        pass
+    else:
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster, \
+                Client(cluster) as client:
+            reports["dask_2_workers"] = init_report(params, starts, seed=seed, runner=Runner(client=client))
+    for name, report in reports.items():
+        result[f"init_sweep_{name}_wall_s"] = report["wall_time_s"]
+        result[f"init_sweep_{name}_starts_per_s_per_worker"] = report["throughput_per_worker"]
+    result["init_sweep_successes"] = [r["successes"] for r in reports.values()]
+    first = measured(reports["1_worker"])
+    result["init_sweep_same_report"] = all(measured(r) == first for r in reports.values())
+    return result
+
+
 def bench_link_section(params: ArmParams, seconds: float, seed: int = 0) -> dict[str, Any]:
     """The serial link at the chart rate against the emulator in real time (ttt_sm/hardware/linkbench.py)."""
     from .hardware.linkbench import bench_link
@@ -206,16 +248,17 @@ SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "gui": lambda p, a: bench_gui_section(p, a["seed"], a["quick"], a["gui_soak_min"]),
     "link": lambda p, a: bench_link_section(p, a["link_seconds"], a["seed"]),
     "lab_grade": lambda p, a: bench_lab_grade_section(a["quick"]),
+    "init_sweep": lambda p, a: bench_init_sweep(p, a["sweep_starts"], a["seed"]),
 }
 #: Sections run only when ``--only`` names them (minutes long, and not a target of the robot's speed).
-OPT_IN = ("lab_grade",)
+OPT_IN = ("lab_grade", "init_sweep")
 
 
 def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, quick: bool = False,
               out: Path = Path("out/bench"), progress: Callable[[str], None] | None = None,
               gui_soak_min: float = 0.0,
               on_section: Callable[[str, dict[str, Any] | None], None] | None = None,
-              link_minutes: float | None = None) -> dict[str, Any]:
+              link_minutes: float | None = None, sweep_starts: int | None = None) -> dict[str, Any]:
     """Run the chosen sections (all by default) and return one flat result dict.
 
     `quick` shortens the timed runs (for tests of the command, not for the
@@ -223,7 +266,8 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
     section starting, ``on_section(name, values)`` of its results (the
     command line writes them to ``bench.jsonl`` as they come).
     `link_minutes`: how long the link section streams (default 10 minutes,
-    as issue 13 asks; 5 s when `quick`).
+    as issue 13 asks; 5 s when `quick`).  `sweep_starts`: the init_sweep
+    section's starts on each runner (default 40; 6 when `quick`).
     """
     names = only or [n for n in SECTIONS if n not in OPT_IN]
     unknown = [n for n in names if n not in SECTIONS]
@@ -232,7 +276,8 @@ def run_bench(params: ArmParams, only: list[str] | None = None, seed: int = 0, q
     args = {"seed": seed, "out": out, "loop_seconds": 2.0 if quick else 20.0,
             "pacing_seconds": 1.0 if quick else 10.0, "init_starts": 5 if quick else 200,
             "games": 1 if quick else 3, "quick": quick, "gui_soak_min": gui_soak_min,
-            "link_seconds": 60.0 * link_minutes if link_minutes is not None else 5.0 if quick else 600.0}
+            "link_seconds": 60.0 * link_minutes if link_minutes is not None else 5.0 if quick else 600.0,
+            "sweep_starts": sweep_starts if sweep_starts is not None else 6 if quick else 40}
     result: dict[str, Any] = {
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
                     "load_avg_before": [round(x, 2) for x in os.getloadavg()],

@@ -27,10 +27,13 @@ import numpy as np
 from ..arm import Arm, Sensors
 from ..charts.drive_init import DriveInit1, DriveInit2, DriveInit3
 from ..params import ArmParams
+from ..runner import Runner, SweepInterrupted, one_line, throughput
 from ..sched.scheduler import Scheduler, Signals
+from ..twin.gains import Gains
 from ..twin.kinematics import link_points
 from ..twin.sim import ArmSim
 from ..twin.truth import GroundTruth
+from ..twin.tuning import design_gains
 from .slots import THESIS_SLOTS, ChartSlots
 from .wires import BLOCKS, INIT_WIRES
 from .wiring import Wiring, not_wired, wire_stages
@@ -241,6 +244,8 @@ class InitRun:
     board_zone_ticks: int
     offset_error_rad: tuple[float, float, float]
     max_overtravel_rad: float
+    #: Why the run has no result ("": it ran): it raised, or the pool or cluster lost it.
+    error: str = ""
 
 
 def random_power_on(params: ArmParams, rng: np.random.Generator) -> np.ndarray:
@@ -250,9 +255,10 @@ def random_power_on(params: ArmParams, rng: np.random.Generator) -> np.ndarray:
     return np.append(rng.uniform(lo, hi), servo_init_angle(params))
 
 
-def settled_pose(params: ArmParams, q_start: np.ndarray | None, seconds: float, seed: int) -> np.ndarray:
+def settled_pose(params: ArmParams, q_start: np.ndarray | None, seconds: float, seed: int,
+                 gains: Gains | None = None) -> np.ndarray:
     """Where the unpowered arm comes to rest from `q_start` under gravity and friction."""
-    sim = ArmSim(params, seed=seed, q0=q_start)
+    sim = ArmSim(params, gains=gains, seed=seed, q0=q_start)
     sim.settle_unpowered(seconds)
     return sim.truth.q
 
@@ -262,7 +268,7 @@ DEFAULT_INIT_TIMEOUT_S = 40.0
 
 
 def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None,
-             settle_s: float = 2.0, timeout_s: float = DEFAULT_INIT_TIMEOUT_S) -> InitRun:
+             settle_s: float = 2.0, timeout_s: float = DEFAULT_INIT_TIMEOUT_S, gains: Gains | None = None) -> InitRun:
     """Initialise the twin once.
 
     The arm is placed at `q_start` (default: its rest pose) and left unpowered
@@ -271,9 +277,12 @@ def run_init(params: ArmParams, seed: int = 0, q_start: np.ndarray | None = None
     arm is powered: the encoders start counting from zero there, the
     controllers hold where the arm stands, and the init charts take over, for
     at most `timeout_s` of simulated time (a run that reaches it is a failure).
+    `gains`: the controllers' (default: designed from `params`, which takes a
+    few seconds the first time in a process; a sweep designs them once and
+    hands them to every worker).
     """
-    q_power_on = settled_pose(params, q_start, settle_s, seed) if settle_s > 0 else q_start
-    sim = ArmSim(params, seed=seed, q0=q_power_on)
+    q_power_on = settled_pose(params, q_start, settle_s, seed, gains) if settle_s > 0 else q_start
+    sim = ArmSim(params, gains=gains, seed=seed, q0=q_power_on)
     return init_once(params, sim, sim.truth, timeout_s)
 
 
@@ -305,40 +314,96 @@ def init_once(params: ArmParams, arm: Arm, truth: GroundTruth, timeout_s: float 
     )
 
 
+def _init_task(params: ArmParams, seed: int, q_start: np.ndarray, timeout_s: float, gains: Gains) -> InitRun:
+    """One start of a sweep, as a worker runs it (a module-level function: a pool or Dask pickles it by name)."""
+    return run_init(params, seed=seed, q_start=q_start, timeout_s=timeout_s, gains=gains)
+
+
+def _failed_run(q_start: np.ndarray, exc: BaseException) -> InitRun:
+    """A start whose run raised or was lost by the pool or cluster: a failure, from its power-on pose."""
+    return InitRun(q_power_on=tuple(float(v) for v in q_start), success=False,  # type: ignore[arg-type]
+                   time_s=math.nan, limit_violations=0, board_zone_ticks=0,
+                   offset_error_rad=(math.nan, math.nan, math.nan), max_overtravel_rad=0.0,
+                   error=one_line(exc))
+
+
+#: What a pool's fork server imports once for the init sweep's workers.
+INIT_PRELOAD = ("ttt_sm.app.init_wiring",)
+
+
 def init_report(params: ArmParams, starts: int, seed: int = 0, timeout_s: float = DEFAULT_INIT_TIMEOUT_S,
                 status: Callable[[str], None] | None = None, arm: Arm | None = None,
-                truth: GroundTruth | None = None) -> dict[str, Any]:
+                truth: GroundTruth | None = None, runner: Runner | None = None) -> dict[str, Any]:
     """Initialise from `starts` random power-on poses: what `ttt-sm init --json` prints.
 
-    Each run is bounded by `timeout_s` of simulated time; `status` hears where the runs are.
+    Each run is bounded by `timeout_s` of simulated time; `status` hears ``k/N``
+    as the runs complete.  The runs share nothing: start k is seed + k from the
+    k-th pose drawn from one generator seeded with `seed`, all drawn before any
+    runs, so `runner` (:class:`~ttt_sm.runner.Runner`: this process by default,
+    a local pool or a Dask cluster) changes the wall time, never the report.
+    A Ctrl-C raises :class:`~ttt_sm.runner.SweepInterrupted` holding the report
+    of the runs done so far (``"interrupted": true``).
     With `arm` (and its `truth`), one run on that arm from where it stands (`starts` must be 1).
     """
-    rng = np.random.default_rng(seed)
+    runner = runner or Runner()
     wall0 = time.perf_counter()
-    runs: list[InitRun] = []
     if arm is not None:
         if truth is None or starts != 1:
             raise ValueError("an arm behind a serial link initialises once, from where it stands, and is watched"
                              " against its emulator's ground truth" + ("" if truth else ": this one sends none"))
-        runs.append(init_once(params, arm, truth, timeout_s))
-    for k in range(starts if arm is None else 0):
-        if status is not None:
-            status(f"init: power-on pose {k + 1} of {starts}, {sum(r.success for r in runs)} initialised so far")
-        runs.append(run_init(params, seed=seed + k, q_start=random_power_on(params, rng), timeout_s=timeout_s))
-    times = [r.time_s for r in runs]
+        if runner.backend != "local" or runner.workers != 1:
+            raise ValueError("an arm behind a serial link initialises once, in this process: no --workers, no --dask")
+        run = init_once(params, arm, truth, timeout_s)
+        return _init_summary(params, [run], wall0, runner, interrupted=False)
+    rng = np.random.default_rng(seed)
+    poses = [random_power_on(params, rng) for _ in range(starts)]
+    gains = design_gains(params)
+    tasks = [(params, seed + k, q, timeout_s, gains) for k, q in enumerate(poses)]
+    done: dict[int, InitRun] = {}
+    if status is not None:
+        status(f"0/{starts} init: starting {runner.describe()}")
+    stream = runner.run(_init_task, tasks, lambda k, exc: _failed_run(poses[k], exc), name="ttt-sm-init")
+    try:
+        for k, result in stream:
+            done[k] = result
+            if status is not None:
+                status(f"{len(done)}/{starts} init: {sum(r.success for r in done.values())} initialised so far")
+    except KeyboardInterrupt as exc:
+        stream.close()
+        raise SweepInterrupted(_init_summary(params, [done[k] for k in sorted(done)], wall0, runner,
+                                             interrupted=True), exc) from None
+    finally:
+        stream.close()
+    return _init_summary(params, [done[k] for k in sorted(done)], wall0, runner, interrupted=False)
+
+
+def _init_summary(params: ArmParams, runs: list[InitRun], wall0: float, runner: Runner,
+                  interrupted: bool) -> dict[str, Any]:
+    """The report of `runs` (in the order of their starts), begun at `wall0` on `runner`."""
+    times = [r.time_s for r in runs if not math.isnan(r.time_s)]
     offset_errors = [abs(e) for r in runs if r.success for e in r.offset_error_rad]
     count = min(d.rad_per_count for d in params.drives)
-    return {
+    wall_s = time.perf_counter() - wall0
+    workers = runner.workers
+    report: dict[str, Any] = {
         "runs": len(runs),
         "successes": sum(r.success for r in runs),
         "limit_violations": sum(r.limit_violations for r in runs),
         "board_zone_entries": sum(r.board_zone_ticks > 0 for r in runs),
-        "max_time_s": round(max(times), 3),
-        "mean_time_s": round(float(np.mean(times)), 3),
+        "max_time_s": round(max(times), 3) if times else math.nan,
+        "mean_time_s": round(float(np.mean(times)), 3) if times else math.nan,
         "max_offset_error_rad": float(max(offset_errors)) if offset_errors else math.nan,
         "one_count_rad": count,
-        "max_overtravel_rad": max(r.max_overtravel_rad for r in runs),
-        "wall_time_s": round(time.perf_counter() - wall0, 2),
+        "max_overtravel_rad": max((r.max_overtravel_rad for r in runs), default=0.0),
+        "wall_time_s": round(wall_s, 2),
         "failed_power_on_deg": [[round(math.degrees(v), 1) for v in r.q_power_on] for r in runs
                                 if not r.success],
+        "workers": workers,
+        "backend": runner.backend,
+        "throughput_per_worker": throughput(len(runs), wall_s, workers),
+        "interrupted": interrupted,
     }
+    errors = [f"start at {[round(math.degrees(v), 1) for v in r.q_power_on]} deg: {r.error}" for r in runs if r.error]
+    if errors:
+        report["errors"] = errors
+    return report

@@ -20,17 +20,20 @@ from .common import (
     CliError,
     add_arm_option,
     add_command,
+    add_runner_options,
     clear_status,
     emit,
     out_dir,
     print_json,
     progress,
     status_line,
+    whole_number,
 )
 
 if TYPE_CHECKING:
     from ..app.arms import ArmConnection
     from ..app.game import GameSession
+    from ..runner import Runner
     from ..runtime.export import ExtraDiagram
 
 
@@ -242,7 +245,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         try:
             result = run_bench(params, only=only, seed=args.seed, quick=args.quick, out=out,
                                progress=progress(True), gui_soak_min=args.gui_soak or 0.0, on_section=on_section,
-                               link_minutes=args.link_minutes)
+                               link_minutes=args.link_minutes, sweep_starts=args.sweep_starts)
         except ValueError as exc:
             raise CliError(str(exc)) from exc
     except BaseException as exc:  # the record and the --json document say what was measured and where it stopped
@@ -278,12 +281,30 @@ def cmd_ik(args: argparse.Namespace) -> int:
     return 0
 
 
-#: Most power-on poses one ``init`` runs (each takes a few seconds of computing).
-MAX_STARTS = 1000
+#: Most power-on poses one ``init`` runs (each takes about half a second of computing: 10000 is a long sweep,
+#: best on a pool or a cluster, ``--workers``/``--dask``).
+MAX_STARTS = 10000
+
+
+def sweep_runner(args: argparse.Namespace, preload: tuple[str, ...] = ()) -> Runner:
+    """The runner of a sweep's ``--workers N`` / ``--dask ADDRESS`` (:mod:`ttt_sm.runner`)."""
+    from ..runner import Runner, dask_client
+
+    if args.dask is not None:
+        if args.workers != 1:
+            raise CliError(f"--workers {args.workers} and --dask: the cluster's workers run the tasks; give one")
+        return Runner(client=dask_client(args.dask))
+    return Runner(workers=args.workers, preload=preload)
+
+
+def _closing(runner: Runner) -> None:
+    if runner.client is not None:
+        runner.client.close()
 
 
 def cmd_init(args: argparse.Namespace) -> int:
-    from ..app.init_wiring import init_report
+    from ..app.init_wiring import INIT_PRELOAD, init_report
+    from ..runner import SweepInterrupted
 
     if not 1 <= args.starts <= MAX_STARTS:
         raise CliError(f"--starts must lie in 1..{MAX_STARTS}, got {args.starts}")
@@ -293,18 +314,34 @@ def cmd_init(args: argparse.Namespace) -> int:
     if args.arm != "sim" and args.starts != 1:
         raise CliError(f"--starts {args.starts}: an arm behind a serial link initialises once, from where it stands;"
                        " give --starts 1")
+    if args.arm != "sim" and (args.workers != 1 or args.dask is not None):
+        option = f"--workers {args.workers}" if args.dask is None else "--dask"
+        raise CliError(f"{option}: an arm behind a serial link initialises once, in this process; drop {option}")
+    runner = sweep_runner(args, INIT_PRELOAD)
     conn = open_arm(args, params)
     try:
         report = init_report(params, args.starts, seed=args.seed, timeout_s=args.time_limit, status=status_line(),
-                             arm=conn.arm if conn else None, truth=conn.truth if conn else None)
+                             arm=conn.arm if conn else None, truth=conn.truth if conn else None, runner=runner)
+    except SweepInterrupted as stopped:
+        clear_status()
+        _emit_init(stopped.report, args)  # what was done before the Ctrl-C; the interrupt then exits with 130
+        raise
     except ValueError as exc:
         raise CliError(f"--arm {args.arm}: {exc}") from exc
     finally:
         clear_status()
         if conn is not None:
             conn.close()
+        _closing(runner)
+    return _emit_init(report, args)
+
+
+def _emit_init(report: dict[str, Any], args: argparse.Namespace) -> int:
+    """Print `report` (JSON or text); the exit status it earns: 0 when every run initialised within the limits."""
     text = "\n".join(f"  {k}: {v}" for k, v in report.items())
-    emit(report, args.json, f"init from {args.starts} random power-on poses:\n{text}")
+    title = f"init from {args.starts} random power-on poses" + (
+        f" (interrupted after {report['runs']})" if report["interrupted"] else "")
+    emit(report, args.json, f"{title}:\n{text}")
     ok = report["successes"] == report["runs"] and not report["limit_violations"] \
         and not report["board_zone_entries"]
     return 0 if ok else 1
@@ -337,29 +374,47 @@ def fault_arm(text: str) -> str:
 
 
 def cmd_faults(args: argparse.Namespace) -> int:
-    from ..faults.matrix import fault_matrix
+    from ..faults.matrix import FAULTS_PRELOAD, fault_matrix
     from ..faults.twin import TWIN_FAULTS
     from ..hardware.firmware import FirmwareError
+    from ..runner import SweepInterrupted
 
     if args.link:
         if args.arm is not None:
             raise CliError(f"--arm {args.arm}: the link's faults always run against the firmware emulator in real"
                            " time; drop --arm or --link")
+        if args.workers != 1 or args.dask is not None:
+            option = f"--workers {args.workers}" if args.dask is None else "--dask"
+            raise CliError(f"{option}: the link's faults run in real time, one after another in this process (two at"
+                           " once would share the processor and change the timing they measure); drop"
+                           f" {option} or --link")
         return _link_faults(args)
     arm = args.arm or "sim"
     faults = _choices(args.only, TWIN_FAULTS, "--only") if args.only else list(TWIN_FAULTS)
     phases = [FAULT_PHASES[p] for p in _choices(args.phases, FAULT_PHASES, "--phases")] if args.phases \
         else list(FAULT_PHASES.values())
     params = load_arm(args.params)
+    runner = sweep_runner(args, FAULTS_PRELOAD)
     try:
-        report = fault_matrix(params, faults, phases, seed=args.seed, status=status_line(), arm=arm)
+        report = fault_matrix(params, faults, phases, seed=args.seed, status=status_line(), arm=arm, runner=runner)
+    except SweepInterrupted as stopped:
+        clear_status()
+        _emit_faults(stopped.report, args)  # the cells done before the Ctrl-C; the interrupt then exits with 130
+        raise
     except (FirmwareError, OSError) as exc:
         raise CliError(f"the firmware emulator cannot run: {exc}") from None
     finally:
         clear_status()
-    lines = [f"arm: {report['backend']}"] if arm != "sim" else []
+        _closing(runner)
+    return _emit_faults(report, args)
+
+
+def _emit_faults(report: dict[str, Any], args: argparse.Namespace) -> int:
+    """Print the fault matrix's `report` (JSON or a table); the exit status it earns: 0 when every cell was
+    detected within 100 ms, no limit violated and no record lost."""
+    lines = [f"arm: {report['backend']}"] if report["arm"] != "sim" else []
     lines += [f"{'fault':15} {'phase':18} {'detected':>9} {'safe':>8} {'limits':>6} {'zone':>4} {'ink':>7}"
-             f" {'record':>6} {'recovered':>9}"]
+              f" {'record':>6} {'recovered':>9}"]
     for c in report["cells"]:
         detect = f"{c['detect_ms']:.0f} ms" if c["detected"] else "no"
         safe = f"{c['time_to_safe_ms']:.0f} ms" if c["time_to_safe_ms"] is not None else "-"
@@ -370,6 +425,12 @@ def cmd_faults(args: argparse.Namespace) -> int:
     lines.append(f"{summary['detected']} of {summary['cells']} detected, {summary['detected_within_100_ms']} within"
                  f" 100 ms; {summary['limit_violations']} limit violations; {summary['records_lost']} records lost;"
                  f" {summary['recovered']} recovered ({report['wall_time_s']:.0f} s)")
+    if report["workers"] != 1 or report["runner"] != "local":
+        lines.append(f"on {report['workers']} {report['runner']} workers:"
+                     f" {report['throughput_per_worker']:g} cells/s per worker")
+    lines += [f"error: {e}" for e in report.get("errors", [])]
+    if report["interrupted"]:
+        lines.append(f"interrupted: {summary['cells']} cells done")
     emit(report, args.json, "\n".join(lines))
     ok = summary["detected_within_100_ms"] == summary["cells"] and not summary["limit_violations"] \
         and not summary["records_lost"]
@@ -489,12 +550,15 @@ def register(sub: Any) -> None:
     sp = add_command(sub, "bench", cmd_bench, "measure the speed and quality targets")
     sp.add_argument("--only", default=None,
                     help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui,link;"
-                         " lab_grade (grading a class of 30, minutes long) runs only when named here")
+                         " lab_grade (grading a class of 30, minutes long) and init_sweep (init starts on 1 and 2"
+                         " local workers and a 2-worker Dask LocalCluster) run only when named here")
     sp.add_argument("--quick", action="store_true", help="short timed runs (to test the command)")
     sp.add_argument("--gui-soak", metavar="MIN", type=float, default=None,
                     help="gui section: also run MIN minutes at x10 and report the memory after 1 and after MIN")
     sp.add_argument("--link-minutes", metavar="MIN", type=float, default=None,
                     help="link section: stream setpoints to the emulator for MIN minutes (default 10; --quick: 5 s)")
+    sp.add_argument("--sweep-starts", metavar="N", type=whole_number, default=None,
+                    help="init_sweep section: starts on each runner (default 40; --quick: 6; 10000 for the long sweep)")
     sp.add_argument("--out", default="out/bench", help="folder for plots the bench writes")
     sp = add_command(sub, "ik", cmd_ik, "solve inverse kinematics for one tool pose")
     sp.add_argument("x", type=float, help="mm")
@@ -506,6 +570,7 @@ def register(sub: Any) -> None:
                     help=f"number of random power-on poses, 1..{MAX_STARTS} (default 20)")
     sp.add_argument("--time-limit", type=float, default=40.0, metavar="SECONDS",
                     help="longest one initialisation may run, simulated seconds (default 40; one takes 6-12)")
+    add_runner_options(sp, "initialisations")
     add_arm_option(sp)
     sp = add_command(sub, "faults", cmd_faults,
                      "inject each fault of the arm (twin or emulator) in each phase and measure what the Safety chart"
@@ -520,7 +585,9 @@ def register(sub: Any) -> None:
                          " twin's plant (gated), over a pseudo-terminal, as ttt-sm arm serve runs it")
     sp.add_argument("--link", action="store_true",
                     help="the faults of the serial link instead (frames_lost,frames_garbled,frames_duplicated,"
-                         "frames_late,frames_out_of_order,link_cut), against the firmware emulator in real time")
+                         "frames_late,frames_out_of_order,link_cut), against the firmware emulator in real time,"
+                         " one after another in this process (no --workers, no --dask: they measure timing)")
+    add_runner_options(sp, "cells (fault x phase; not the --link faults)")
     sp = add_command(sub, "charts", cmd_charts, "export the chart diagrams, or check that charts/ is up to date")
     sp.add_argument("action", choices=["export", "check"])
     sp.add_argument("--format", default=None,

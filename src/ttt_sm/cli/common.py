@@ -188,6 +188,26 @@ def add_arm_option(sp: argparse.ArgumentParser) -> None:
                          " (a board, or ttt-sm arm serve's link)")
 
 
+def whole_number(text: str) -> int:
+    """A count or a size: a whole number 1 .. 10**6."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text[:40]!r}") from None
+    if not 1 <= value <= 10**6:
+        raise argparse.ArgumentTypeError(f"expected a whole number 1 .. 1000000, got {text[:40]}")
+    return value
+
+
+def add_runner_options(sp: argparse.ArgumentParser, what: str) -> None:
+    """``--workers`` and ``--dask`` of a sweep (``ttt-sm init``, ``ttt-sm faults``): where its `what` run."""
+    sp.add_argument("--workers", type=whole_number, default=1, metavar="N",
+                    help=f"{what} run at once on this machine, each in a process of its own (default 1: one after"
+                         " another in this process); the report is the same whatever N")
+    sp.add_argument("--dask", metavar="ADDRESS", default=None,
+                    help=f"run the {what} on the Dask cluster whose scheduler is at ADDRESS (needs ttt_sm[cluster])")
+
+
 def board_cells(text: str) -> str:
     """The ``type`` of a board given as text: rows may be split by '/', '|' or spaces, as ``ttt-sm camera serve``
     and ``ttt-sm ai move`` take them; the 25 cells are checked by the command that reads them."""

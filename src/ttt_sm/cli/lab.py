@@ -20,7 +20,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from .common import CliError, print_json
+from .common import CliError, print_json, whole_number
 
 #: The commands that build a robot from the chosen slots.
 HONOURED = ("play", "draw", "demo", "debug", "scenario")
@@ -85,17 +85,6 @@ def register(sub: Any) -> None:
     gr.set_defaults(func=cmd_lab_grade)
 
 
-def whole_number(text: str) -> int:
-    """A count or a size: a whole number 1 .. 10**6."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text[:40]!r}") from None
-    if not 1 <= value <= 10**6:
-        raise argparse.ArgumentTypeError(f"expected a whole number 1 .. 1000000, got {text[:40]}")
-    return value
-
-
 def seconds(text: str) -> float:
     """A time limit: a number of seconds in (0, 86400]."""
     try:
@@ -147,9 +136,10 @@ def cmd_lab_grade(args: argparse.Namespace) -> int:
     import os
 
     from ..lab.exercise import exercise
-    from ..lab.grade import Limits, ResultsFile, dask_client, grade_class, submissions
+    from ..lab.grade import Limits, ResultsFile, grade_class, submissions
     from ..lab.grade_report import build_reports
     from ..params import shown_path
+    from ..runner import dask_client
     from ..twin.workspace import load_arm
     from .common import out_dir, progress
 

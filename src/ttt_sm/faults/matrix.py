@@ -68,8 +68,10 @@ from ..app.init_wiring import servo_init_angle
 from ..app.robot import Robot
 from ..arm import Arm
 from ..hardware.emulator import ArmEmulator
+from ..hardware.firmware import build
 from ..hardware.serial_arm import LinkTruth, SerialArm
 from ..params import ArmParams
+from ..runner import Runner, SweepInterrupted, one_line, throughput
 from ..sched.scheduler import Signals
 from ..twin.gains import Gains
 from ..twin.kinematics import arm_chain_py, link_points
@@ -360,24 +362,90 @@ def _record_intact(record: GameRecord, path: Path, tripped: bool) -> bool:
     return not tripped or (len(trips) >= 1 and bool(trips[0].get("reason")))
 
 
+def _cell_task(params: ArmParams, fault: str, phase: str, seed: int, gains: Gains, arm: str,
+               cache: Path | None) -> Cell:
+    """One cell, as a worker runs it (a module-level function: a pool or Dask pickles it by name)."""
+    return run_cell(params, fault, phase, seed, gains, arm, cache)
+
+
+def _lost_cell(fault: str, phase: str, exc: BaseException) -> Cell:
+    """A cell whose run raised, or that the pool or cluster lost: nothing detected, recovered or recorded;
+    the reason says what happened."""
+    return Cell(fault=fault, phase=phase, drive=0, detected=False, detect_ms=None,
+                reason=f"the cell did not run to its end: {one_line(exc)}", time_to_safe_ms=None,
+                limit_violations=0, board_zone_entries=0, board_zone_entries_reinit=0, ink_smear_mm=0.0,
+                record_intact=False, recovered=False, sim_s=0.0, wall_s=0.0)
+
+
+#: What a pool's fork server imports once for the fault matrix's workers.
+FAULTS_PRELOAD = ("ttt_sm.faults.matrix",)
+
+
 def fault_matrix(params: ArmParams, faults: Sequence[str] = TWIN_FAULTS, phases: Sequence[str] = PHASES,
                  seed: int = 0, status: Callable[[str], None] | None = None, arm: str = "sim",
-                 cache: Path | None = None) -> dict[str, Any]:
-    """Every fault in every phase on `arm` (:data:`ARMS`): what ``ttt-sm faults --json`` prints."""
+                 cache: Path | None = None, runner: Runner | None = None) -> dict[str, Any]:
+    """Every fault in every phase on `arm` (:data:`ARMS`): what ``ttt-sm faults --json`` prints.
+
+    The cells share nothing (each builds its own robot on its own arm), so
+    `runner` (:class:`~ttt_sm.runner.Runner`: this process by default, a local
+    pool or a Dask cluster) runs them where it runs tasks; the report lists
+    them in the order fault by phase whatever order they complete in, and
+    is the same on every runner but for the wall times.  `status` hears
+    ``k/N`` as the cells complete.  A cell that raises (or that the pool or
+    cluster loses) is reported undetected, with the reason, and in
+    ``errors``.  A Ctrl-C raises :class:`~ttt_sm.runner.SweepInterrupted`
+    holding the report of the cells done so far (``"interrupted": true``).
+    """
     if arm not in ARMS:
         raise FaultMatrixError(f"no arm {arm!r}; arms: {', '.join(ARMS)}")
+    runner = runner or Runner()
     wall0 = time.perf_counter()
     load0 = _load()
+    if arm == "emulator":
+        build(cache=cache)  # here, once: a compiler that fails is one error, not one per cell
     gains = design_gains(params)
-    cells: list[Cell] = []
-    for fault in faults:
-        for phase in phases:
+    pairs = [(fault, phase) for fault in faults for phase in phases]
+    tasks = [(params, fault, phase, seed, gains, arm, cache) for fault, phase in pairs]
+    done: dict[int, Cell] = {}
+    errors: dict[int, str] = {}
+
+    def lost(i: int, exc: BaseException) -> Cell:
+        errors[i] = f"{pairs[i][0]} while {pairs[i][1]}: {one_line(exc)}"
+        return _lost_cell(*pairs[i], exc)
+
+    if status is not None:
+        status(f"0/{len(pairs)} faults: starting {runner.describe()}")
+    stream = runner.run(_cell_task, tasks, lost, name="ttt-sm-faults")
+    try:
+        for i, cell in stream:
+            done[i] = cell
             if status is not None:
-                status(f"faults: {fault} while {phase} ({len(cells) + 1} of {len(faults) * len(phases)})")
-            cells.append(run_cell(params, fault, phase, seed, gains, arm, cache))
+                status(f"{len(done)}/{len(pairs)} faults: {cell.fault} while {cell.phase} done")
+    except KeyboardInterrupt as exc:
+        stream.close()
+        report = _matrix_report([done[i] for i in sorted(done)], arm, seed, wall0, load0, runner, interrupted=True)
+        raise SweepInterrupted(_with_errors(report, errors), exc) from None
+    finally:
+        stream.close()
+    report = _matrix_report([done[i] for i in sorted(done)], arm, seed, wall0, load0, runner, interrupted=False)
+    return _with_errors(report, errors)
+
+
+def _with_errors(report: dict[str, Any], errors: dict[int, str]) -> dict[str, Any]:
+    """`report` with ``errors``, the cells that did not run to their end, in the matrix's order (when any)."""
+    if errors:
+        report["errors"] = [errors[i] for i in sorted(errors)]
+    return report
+
+
+def _matrix_report(cells: list[Cell], arm: str, seed: int, wall0: float, load0: float | None, runner: Runner,
+                   interrupted: bool) -> dict[str, Any]:
+    """The report of `cells` (in the matrix's order), begun at `wall0` on `runner`."""
     detected = [c for c in cells if c.detected]
     late = [c for c in detected if c.detect_ms is not None and c.detect_ms > DETECT_TARGET_S * 1e3]
-    return {
+    wall_s = time.perf_counter() - wall0
+    workers = runner.workers
+    report: dict[str, Any] = {
         "arm": arm,
         "backend": BACKENDS[arm],
         "cells": [asdict(c) for c in cells],
@@ -394,9 +462,15 @@ def fault_matrix(params: ArmParams, faults: Sequence[str] = TWIN_FAULTS, phases:
             "recovered": sum(c.recovered for c in cells),
         },
         "seed": seed,
-        "wall_time_s": round(time.perf_counter() - wall0, 2),
+        "wall_time_s": round(wall_s, 2),
         "load_average": [load0, _load()],
+        # "backend" above is the arm's, as it was before the matrix had a runner: the runner's is "runner"
+        "workers": workers,
+        "runner": runner.backend,
+        "throughput_per_worker": throughput(len(cells), wall_s, workers),
+        "interrupted": interrupted,
     }
+    return report
 
 
 def _load() -> float | None:

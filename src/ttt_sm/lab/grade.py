@@ -12,7 +12,9 @@ student's result line, and the grader goes on.
 The jobs run on a local pool (:func:`grade_locally`, threads that each wait
 on a child process) or on a Dask cluster (:func:`grade_on_dask`, the same
 :func:`grade_one` as a task; the chart's text travels with the job, so the
-workers need no shared folder).  Each result is appended to
+workers need no shared folder), both through :class:`~ttt_sm.runner.Runner`,
+the runner of the long sweeps too; the children and their limits are the
+grader's own.  Each result is appended to
 ``results.jsonl`` as it arrives (:class:`ResultsFile`), and the reports are
 built from that file (:mod:`.grade_report`): what was graded before a Ctrl-C
 stays graded.
@@ -29,12 +31,12 @@ import tempfile
 import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ..params import shown_path
+from ..runner import Runner, one_line
 from ..runtime.recordfile import RecordFile
 from .exercise import Exercise, LabError
 
@@ -238,11 +240,20 @@ def read_results(path: Path) -> tuple[dict[str, Any], dict[str, dict[str, Any]]]
     return header, results
 
 
+def _lost(job: Job, exc: BaseException) -> dict[str, Any]:
+    """The result line of a student whose task raised or was lost (its worker died): crashed, saying why."""
+    return {"student": job.student, "exercise": job.exercise, "status": "crashed", "passed": False,
+            "score": 0, "total": 0, "checks": [], "transitions": [], "taken": [], "seconds": 0.0,
+            "error": f"the grader lost the task: {one_line(exc)}"}
+
+
 def grade_locally(jobs: list[Job], limits: Limits, workers: int) -> Iterator[dict[str, Any]]:
     """Grade `jobs` on `workers` children at a time; yield each result as it arrives.
 
-    Closing the generator (a Ctrl-C in the loop that reads it) cancels the jobs
-    not yet started and kills the children that run.
+    The pool (:class:`~ttt_sm.runner.Runner`) is of threads: each waits on the
+    child that grades its submission.  Closing the generator (a Ctrl-C in the
+    loop that reads it) cancels the jobs not yet started and kills the
+    children that run.
     """
     children: set[subprocess.Popen[bytes]] = set()
     lock = threading.Lock()
@@ -262,34 +273,19 @@ def grade_locally(jobs: list[Job], limits: Limits, workers: int) -> Iterator[dic
                         _kill(process)
         return grade_one(job, limits, track)
 
-    pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="ttt-sm-grade")
-    try:
-        pending: set[Future[dict[str, Any]]] = {pool.submit(run, job) for job in jobs}
-        while pending:
-            finished, pending = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
-            for future in finished:
-                yield future.result()
-    finally:
+    def stop() -> None:
         stopping.set()
-        pool.shutdown(wait=False, cancel_futures=True)
         with lock:
             for process in list(children):
                 _kill(process)
-        pool.shutdown(wait=True)
 
-
-def dask_client(address: str) -> Any:
-    """A Dask client connected to the scheduler at `address`; a :class:`GradeError` when Dask is missing
-    or the scheduler cannot be reached."""
+    stream = Runner(workers, pool="thread").run(run, [(job,) for job in jobs], lambda i, exc: _lost(jobs[i], exc),
+                                                stop=stop)
     try:
-        from dask.distributed import Client
-    except ImportError:
-        raise GradeError("--dask needs Dask: pip install 'ttt_sm[cluster]' (or 'dask[distributed]')") from None
-    try:
-        return Client(address, timeout="5s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise GradeError(f"--dask {address}: cannot reach a Dask scheduler there ({' '.join(str(exc).split())})"
-                         ) from None
+        for _, result in stream:
+            yield result
+    finally:
+        stream.close()
 
 
 def grade_on_dask(jobs: list[Job], limits: Limits, client: Any) -> Iterator[dict[str, Any]]:
@@ -300,22 +296,13 @@ def grade_on_dask(jobs: list[Job], limits: Limits, client: Any) -> Iterator[dict
     (its worker died) is that student's ``crashed`` line.  Closing the generator
     cancels the tasks not yet done.
     """
-    from dask.distributed import as_completed
-
-    futures = [client.submit(grade_one, job, limits, key=f"ttt-sm-grade-{job.student}-{os.getpid()}-{time.time_ns()}",
-                             pure=False, retries=0) for job in jobs]
-    by_key = {f.key: job for f, job in zip(futures, jobs, strict=True)}
+    stream = Runner(client=client).run(grade_one, [(job, limits) for job in jobs],
+                                       lambda i, exc: _lost(jobs[i], exc), name="ttt-sm-grade")
     try:
-        for future in as_completed(futures):
-            try:
-                yield future.result()
-            except Exception as exc:  # the cluster lost the task: the student still gets a line
-                job = by_key[future.key]
-                yield {"student": job.student, "exercise": job.exercise, "status": "crashed", "passed": False,
-                       "score": 0, "total": 0, "checks": [], "transitions": [], "taken": [], "seconds": 0.0,
-                       "error": f"the cluster lost the task: {type(exc).__name__}: {' '.join(str(exc).split())}"}
+        for _, result in stream:
+            yield result
     finally:
-        client.cancel([f for f in futures if not f.done()])
+        stream.close()
 
 
 def summary_line(result: dict[str, Any]) -> str:

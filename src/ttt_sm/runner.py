@@ -146,6 +146,32 @@ class Runner:
             return self._here(fn, tasks, lost)
         return self._on_pool(fn, tasks, lost, stop)
 
+    def sweep(self, fn: Callable[..., R], tasks: Sequence[tuple[Any, ...]], lost: Callable[[int, BaseException], R],
+              report: Callable[[list[R], bool], dict[str, Any]], name: str,
+              status: Callable[[str], None] | None = None,
+              said: Callable[[R, list[R]], str] = lambda result, done: "done") -> dict[str, Any]:
+        """:meth:`run` the tasks, and the `report` of their results in the tasks' order (False: not interrupted).
+
+        `status` hears ``k/N name: said(result, results so far)`` as each
+        completes.  A Ctrl-C (or SIGTERM) stops what runs and raises
+        :class:`SweepInterrupted` holding the report of those done (True).
+        """
+        done: dict[int, R] = {}
+        if status is not None:
+            status(f"0/{len(tasks)} {name}: starting {self.describe()}")
+        stream = self.run(fn, tasks, lost, name=f"ttt-sm-{name}")
+        try:
+            for i, result in stream:
+                done[i] = result
+                if status is not None:
+                    status(f"{len(done)}/{len(tasks)} {name}: {said(result, list(done.values()))}")
+        except KeyboardInterrupt as exc:
+            stream.close()
+            raise SweepInterrupted(report([done[i] for i in sorted(done)], True), exc) from None
+        finally:
+            stream.close()
+        return report([done[i] for i in sorted(done)], False)
+
     @staticmethod
     def _here(fn: Callable[..., R], tasks: Sequence[tuple[Any, ...]],
               lost: Callable[[int, BaseException], R]) -> Generator[tuple[int, R], None, None]:

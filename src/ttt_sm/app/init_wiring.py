@@ -27,7 +27,7 @@ import numpy as np
 from ..arm import Arm, Sensors
 from ..charts.drive_init import DriveInit1, DriveInit2, DriveInit3
 from ..params import ArmParams
-from ..runner import Runner, SweepInterrupted, one_line, throughput
+from ..runner import Runner, one_line, throughput
 from ..sched.scheduler import Scheduler, Signals
 from ..twin.gains import Gains
 from ..twin.kinematics import link_points
@@ -359,22 +359,9 @@ def init_report(params: ArmParams, starts: int, seed: int = 0, timeout_s: float 
     poses = [random_power_on(params, rng) for _ in range(starts)]
     gains = design_gains(params)
     tasks = [(params, seed + k, q, timeout_s, gains) for k, q in enumerate(poses)]
-    done: dict[int, InitRun] = {}
-    if status is not None:
-        status(f"0/{starts} init: starting {runner.describe()}")
-    stream = runner.run(_init_task, tasks, lambda k, exc: _failed_run(poses[k], exc), name="ttt-sm-init")
-    try:
-        for k, result in stream:
-            done[k] = result
-            if status is not None:
-                status(f"{len(done)}/{starts} init: {sum(r.success for r in done.values())} initialised so far")
-    except KeyboardInterrupt as exc:
-        stream.close()
-        raise SweepInterrupted(_init_summary(params, [done[k] for k in sorted(done)], wall0, runner,
-                                             interrupted=True), exc) from None
-    finally:
-        stream.close()
-    return _init_summary(params, [done[k] for k in sorted(done)], wall0, runner, interrupted=False)
+    return runner.sweep(_init_task, tasks, lambda k, exc: _failed_run(poses[k], exc),
+                        lambda runs, cut: _init_summary(params, runs, wall0, runner, interrupted=cut), "init",
+                        status, lambda run, runs: f"{sum(r.success for r in runs)} initialised so far")
 
 
 def _init_summary(params: ArmParams, runs: list[InitRun], wall0: float, runner: Runner,

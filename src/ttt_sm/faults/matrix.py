@@ -71,7 +71,7 @@ from ..hardware.emulator import ArmEmulator
 from ..hardware.firmware import build
 from ..hardware.serial_arm import LinkTruth, SerialArm
 from ..params import ArmParams
-from ..runner import Runner, SweepInterrupted, one_line, throughput
+from ..runner import Runner, one_line, throughput
 from ..sched.scheduler import Signals
 from ..twin.gains import Gains
 from ..twin.kinematics import arm_chain_py, link_points
@@ -406,29 +406,17 @@ def fault_matrix(params: ArmParams, faults: Sequence[str] = TWIN_FAULTS, phases:
     gains = design_gains(params)
     pairs = [(fault, phase) for fault in faults for phase in phases]
     tasks = [(params, fault, phase, seed, gains, arm, cache) for fault, phase in pairs]
-    done: dict[int, Cell] = {}
     errors: dict[int, str] = {}
 
     def lost(i: int, exc: BaseException) -> Cell:
         errors[i] = f"{pairs[i][0]} while {pairs[i][1]}: {one_line(exc)}"
         return _lost_cell(*pairs[i], exc)
 
-    if status is not None:
-        status(f"0/{len(pairs)} faults: starting {runner.describe()}")
-    stream = runner.run(_cell_task, tasks, lost, name="ttt-sm-faults")
-    try:
-        for i, cell in stream:
-            done[i] = cell
-            if status is not None:
-                status(f"{len(done)}/{len(pairs)} faults: {cell.fault} while {cell.phase} done")
-    except KeyboardInterrupt as exc:
-        stream.close()
-        report = _matrix_report([done[i] for i in sorted(done)], arm, seed, wall0, load0, runner, interrupted=True)
-        raise SweepInterrupted(_with_errors(report, errors), exc) from None
-    finally:
-        stream.close()
-    report = _matrix_report([done[i] for i in sorted(done)], arm, seed, wall0, load0, runner, interrupted=False)
-    return _with_errors(report, errors)
+    def report(cells: list[Cell], cut: bool) -> dict[str, Any]:
+        return _with_errors(_matrix_report(cells, arm, seed, wall0, load0, runner, interrupted=cut), errors)
+
+    return runner.sweep(_cell_task, tasks, lost, report, "faults", status,
+                        lambda cell, cells: f"{cell.fault} while {cell.phase} done")
 
 
 def _with_errors(report: dict[str, Any], errors: dict[int, str]) -> dict[str, Any]:

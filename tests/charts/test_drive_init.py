@@ -137,4 +137,4 @@ def test_init_runs_are_bounded_in_simulated_time_and_say_where_they_are():
     report = init_report(P, 2, seed=3, timeout_s=1.0, status=heard.append)
     # one simulated second is too short to find the indexes: both runs stop there and count as failures
     assert report["successes"] == 0 and report["max_time_s"] == 1.0 and len(report["failed_power_on_deg"]) == 2
-    assert heard == [f"init: power-on pose {k} of 2, 0 initialised so far" for k in (1, 2)]
+    assert heard == ["0/2 init: starting in this process"] + [f"{k}/2 init: 0 initialised so far" for k in (1, 2)]

@@ -21,7 +21,6 @@ the folder is no exercise) is one ``error`` line, and exit status 2.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from collections.abc import Iterator
@@ -31,6 +30,7 @@ from ..app.chart_file import ChartFileError, load_chart
 from ..app.slots import ChartSlots, SlotError, using_slots
 from ..params import ArmParams
 from ..runtime import TickChart
+from ..runtime.jsonable import dumps
 from ..runtime.listeners import Coverage
 from ..scenario.loader import load_scenario
 from ..scenario.runner import run_scenario
@@ -57,7 +57,7 @@ def iter_checks(ex: Exercise, cls: type[TickChart], where: str, params: ArmParam
 
 
 def _line(message: dict[str, object]) -> None:
-    print(json.dumps(message), flush=True)
+    print(dumps(message), flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:

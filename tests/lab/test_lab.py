@@ -214,3 +214,8 @@ def test_lab_list_names_every_exercise(capsys):
 def test_chart_is_refused_by_a_command_that_does_not_build_a_robot(tmp_path, capsys):
     status, _, err = _run(capsys, "--chart", "DriveInit3=x.py:A", "params")
     assert status == 2 and "--chart is not taken by params" in _one_error_line(err)
+
+
+def test_chart_and_a_lab_folder_together_are_refused_in_one_line(tmp_path, capsys):
+    status, _, err = _run(capsys, "--chart", "DriveInit3=x.py:A", "gui", "--lab", str(tmp_path))
+    assert status == 2 and "--chart and gui --lab" in _one_error_line(err)

@@ -23,7 +23,7 @@ from typing import Any
 from .common import CliError, print_json, whole_number
 
 #: The commands that build a robot from the chosen slots.
-HONOURED = ("play", "draw", "demo", "debug", "scenario")
+HONOURED = ("play", "gui", "draw", "demo", "debug", "scenario")
 
 
 def add_global_options(parser: argparse.ArgumentParser) -> None:
@@ -44,6 +44,8 @@ def chosen_charts(args: argparse.Namespace) -> Iterator[None]:
         return
     if args.command not in HONOURED:
         raise CliError(f"--chart is not taken by {args.command}; it is taken by {', '.join(HONOURED)}")
+    if getattr(args, "lab", None) is not None:
+        raise CliError("--chart and gui --lab: the lab's folder names the chart it runs (docs/lab.md); give one")
     from ..app.chart_file import slots_from
     from ..app.slots import using_slots
 

@@ -29,6 +29,7 @@ from pathlib import Path
 from ..app.chart_file import ChartFileError, load_chart
 from ..app.slots import ChartSlots, SlotError, using_slots
 from ..params import ArmParams
+from ..runner import one_line
 from ..runtime import TickChart
 from ..runtime.jsonable import dumps
 from ..runtime.listeners import Coverage
@@ -82,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
         _line({"type": "error", "error": str(exc)})
         return 2
     except Exception as exc:  # the student's chart raised while it ran: one line, the run is over
-        _line({"type": "error", "error": f"the checks stopped: {type(exc).__name__}: {' '.join(str(exc).split())}"})
+        _line({"type": "error", "error": f"the checks stopped: {one_line(exc)}"})
         return 2
     _line({"type": "done", "score": {"passed": passed, "total": total}, "passed": passed == total})
     return 0

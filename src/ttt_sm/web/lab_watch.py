@@ -42,6 +42,7 @@ from ..app.slots import THESIS_SLOTS, ChartSlots, SlotError
 from ..debug.debugger import Debugger
 from ..debug.replay import GameRecipe, RobotRecipe
 from ..params import shown_path
+from ..runner import one_line
 from ..runtime import TickChart
 from .catalogue import describe_session
 from .diagrams import Diagrams
@@ -214,7 +215,7 @@ class LabWatch:
         except SlotError:
             raise
         except Exception as exc:  # the library refused the class while its structure was read
-            raise ChartFileError(f"{where}: {type(exc).__name__}: {' '.join(str(exc).split())}") from None
+            raise ChartFileError(f"{where}: {one_line(exc)}") from None
         return cls, where, slots
 
     def _swap(self, cls: type[TickChart], where: str, slots: ChartSlots) -> None:
@@ -235,7 +236,7 @@ class LabWatch:
                 dbg.recipe = old
                 line = _line_in(self.task.chart_file, exc) or 1
                 raise ReloadError(f"{shown_path(self.task.chart_file)}:{line}: the robot could not be built with"
-                                  f" {cls.__name__}: {type(exc).__name__}: {' '.join(str(exc).split())}") from None
+                                  f" {cls.__name__}: {one_line(exc)}") from None
             session.last_stop = None
             if run_on:
                 session.mode = "running"

@@ -427,7 +427,9 @@ class SerialArm:
             self._poll(min(0.005, timeout))
             now = time.monotonic()
             if self._status is not status:
-                give_up = now + timeout
+                # measured from the frame's arrival, not from this look: a look that ends late
+                # (a busy machine) must not stretch the silence allowed past `timeout`
+                give_up = self.last_frame_at + timeout
             elif now > give_up:
                 self._declare_lost(f"no status from the firmware for {timeout * 1000:.0f} ms (waiting for step"
                                    f" {target}; {self.rx.rejected} frames rejected)", now, checked)

@@ -218,6 +218,7 @@ def _problem(argv: list[str], names: str, result: dict[str, object]) -> str | No
     return None
 
 
+@pytest.mark.soak  # some 600 command lines, 50 s; tests/test_cli_fuzz.py fuzzes single arguments in the default run
 def test_every_subcommand_refuses_bad_arguments_in_one_line_without_a_traceback(sweep):
     problems = []
     commands = set()

@@ -64,6 +64,7 @@ def test_init_on_two_workers_reports_what_one_does(serial_init: dict[str, Any],
     assert _measured(pooled) == _measured(serial_init)
 
 
+@pytest.mark.soak  # starts a LocalCluster
 def test_init_on_a_dask_cluster_reports_what_one_worker_does(serial_init: dict[str, Any],
                                                              capsys: pytest.CaptureFixture[str]) -> None:
     distributed = pytest.importorskip("dask.distributed", reason="Dask is not installed (the cluster extra)")

@@ -174,6 +174,7 @@ def test_an_interrupt_keeps_the_results_and_a_rerun_grades_only_the_rest(tmp_pat
     assert _by_student(out)["d1"]["status"] == "time limit"
 
 
+@pytest.mark.soak  # a LocalCluster of two workers grading the class again: 40-70 s
 def test_a_dask_cluster_gives_the_same_grades(graded, tmp_path, capsys):
     from dask.distributed import LocalCluster
 

@@ -15,6 +15,7 @@ from ttt_sm.params import load_params
 from ttt_sm.web.bench import bench_gui_game
 
 
+@pytest.mark.soak  # two whole games (30-80 s); test_game_page plays one by clicks in the default run
 def test_the_gui_game_bench_plays_the_same_whole_game_headless_and_in_the_page() -> None:
     # In a thread of its own: the bench starts Playwright's sync API, which refuses a thread where another
     # test's browser (the session's `browser` fixture) already runs its loop.

@@ -200,13 +200,13 @@ def bench_init_sweep(params: ArmParams, starts: int = 40, seed: int = 0) -> dict
     """
     from .app.init_wiring import INIT_PRELOAD, init_report
     from .runner import Runner
-    from .twin.tuning import design_gains
+    from .twin.gains_cache import kept_gains
 
     def measured(report: dict[str, Any]) -> dict[str, Any]:
         return {k: v for k, v in report.items() if k not in _RUNNER_KEYS}
 
     result: dict[str, Any] = {"init_sweep_starts": starts, "init_sweep_cpus": os.cpu_count()}
-    design_gains(params)  # designed once per process whatever the runner: not in the first runner's time
+    kept_gains(params)  # designed (or read) once per process whatever the runner: not in the first runner's time
     reports = {}
     for name, runner in (("1_worker", Runner(1)), ("2_workers", Runner(2, preload=INIT_PRELOAD))):
         reports[name] = init_report(params, starts, seed=seed, runner=runner)

@@ -10,6 +10,7 @@ file (keys with ``_deg`` in their name) are converted to radians here.
 from __future__ import annotations
 
 import math
+import os
 import re
 import reprlib
 import tomllib
@@ -88,6 +89,12 @@ class Sponge:
     offset: float
     width: float
     compliance: float
+
+
+def user_cache(kind: str) -> Path:
+    """Where ttt_sm keeps what it derives once per machine: ``$XDG_CACHE_HOME/ttt_sm/<kind>`` (``~/.cache``)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "ttt_sm" / kind
 
 
 def servo_duty(angle_rad: float, min_rad: float, max_rad: float, pulse_min_s: float, pulse_max_s: float,

@@ -30,10 +30,10 @@ from ..params import ArmParams
 from ..runner import Runner, one_line, throughput
 from ..sched.scheduler import Scheduler, Signals
 from ..twin.gains import Gains
+from ..twin.gains_cache import kept_gains
 from ..twin.kinematics import link_points
 from ..twin.sim import ArmSim
 from ..twin.truth import GroundTruth
-from ..twin.tuning import design_gains
 from .slots import THESIS_SLOTS, ChartSlots
 from .wires import BLOCKS, INIT_WIRES
 from .wiring import Wiring, not_wired, wire_stages
@@ -357,7 +357,7 @@ def init_report(params: ArmParams, starts: int, seed: int = 0, timeout_s: float 
         return _init_summary(params, [run], wall0, runner, interrupted=False)
     rng = np.random.default_rng(seed)
     poses = [random_power_on(params, rng) for _ in range(starts)]
-    gains = design_gains(params)
+    gains = kept_gains(params)
     tasks = [(params, seed + k, q, timeout_s, gains) for k, q in enumerate(poses)]
     return runner.sweep(_init_task, tasks, lambda k, exc: _failed_run(poses[k], exc),
                         lambda runs, cut: _init_summary(params, runs, wall0, runner, interrupted=cut), "init",

@@ -43,8 +43,8 @@ from ..hardware.emulator import ArmEmulator
 from ..hardware.serial_arm import SerialArm
 from ..params import ArmParams
 from ..twin.gains import Gains
+from ..twin.gains_cache import kept_gains
 from ..twin.plant import REST_POSE
-from ..twin.tuning import design_gains
 
 #: The link's faults, in the order the matrix lists them.
 LINK_FAULTS = ("frames_lost", "frames_garbled", "frames_duplicated", "frames_late", "frames_out_of_order",
@@ -409,7 +409,7 @@ def link_fault_matrix(params: ArmParams, faults: Sequence[str] = LINK_FAULTS, se
                       cache: Path | None = None, status: Callable[[str], None] | None = None) -> dict[str, Any]:
     """Every link fault against the emulator in real time: what ``ttt-sm faults --link --json`` prints."""
     wall0 = time.perf_counter()
-    gains = design_gains(params)
+    gains = kept_gains(params)
     cells: list[LinkCell] = []
     for fault in faults:
         if status is not None:

@@ -74,10 +74,10 @@ from ..params import ArmParams
 from ..runner import Runner, one_line, throughput
 from ..sched.scheduler import Signals
 from ..twin.gains import Gains
+from ..twin.gains_cache import kept_gains
 from ..twin.kinematics import arm_chain_py, link_points
 from ..twin.sim import ArmSim
 from ..twin.truth import ArmTruth
-from ..twin.tuning import design_gains
 from ..twin.whiteboard import Whiteboard
 from .plant import PlantFault
 from .twin import DRIVE_FAULTS, TWIN_FAULTS, FaultyArm
@@ -403,7 +403,7 @@ def fault_matrix(params: ArmParams, faults: Sequence[str] = TWIN_FAULTS, phases:
     load0 = _load()
     if arm == "emulator":
         build(cache=cache)  # here, once: a compiler that fails is one error, not one per cell
-    gains = design_gains(params)
+    gains = kept_gains(params)
     pairs = [(fault, phase) for fault in faults for phase in phases]
     tasks = [(params, fault, phase, seed, gains, arm, cache) for fault, phase in pairs]
     errors: dict[int, str] = {}

@@ -20,6 +20,8 @@ import subprocess
 from pathlib import Path
 from typing import Literal
 
+from ..params import user_cache
+
 Precision = Literal["float", "double"]
 PRECISIONS: tuple[Precision, ...] = ("float", "double")
 
@@ -83,8 +85,7 @@ def compile_command(precision: Precision, out: Path, root: Path | None = None) -
 
 def default_cache() -> Path:
     """Where builds are cached: ``$XDG_CACHE_HOME/ttt_sm/firmware`` (``~/.cache`` by default)."""
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "ttt_sm" / "firmware"
+    return user_cache("firmware")
 
 
 def build(precision: Precision = "float", cache: Path | None = None) -> Path:

@@ -44,7 +44,7 @@ import numpy as np
 
 from ..params import ArmParams
 from ..ptylink import realtime_priority
-from ..twin.tuning import design_gains
+from ..twin.gains_cache import kept_gains
 from .serial_arm import SerialArm
 
 #: A frame is late after this long (issue 13: 2 ms).
@@ -105,7 +105,7 @@ def bench_link(params: ArmParams, seconds: float = 600.0, seed: int = 0,
 def _measure(params: ArmParams, seconds: float, seed: int, say: Callable[[str], None], priority: bool,
              note: str | None) -> dict[str, Any]:
     dt, divider = params.control.dt, params.control.chart_divider
-    gains = design_gains(params)
+    gains = kept_gains(params)
     losses: list[str] = []
     sessions: list[list[tuple[int, float]]] = []
     sent = received = pc_rejected = 0

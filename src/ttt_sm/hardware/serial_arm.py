@@ -55,8 +55,8 @@ from ..params import ArmParams
 from ..twin import layout
 from ..twin.cascade import CascadeController
 from ..twin.gains import Gains, check_drive
+from ..twin.gains_cache import kept_gains
 from ..twin.kinematics import fk
-from ..twin.tuning import design_gains
 from . import link as L
 
 LINK_TIMEOUT_S = 0.050
@@ -171,7 +171,7 @@ class SerialArm:
         The parameter file: the encoder resolutions the handshake must match,
         the control rate, the chart divider.
     gains
-        The cascade's gains; None designs them (``design_gains(params)``).
+        The cascade's gains; None designs them (``kept_gains(params)``).
     servo_angle
         The servo's setpoint until the first ``set_setpoints`` (rad).
     link_timeout_s
@@ -183,7 +183,7 @@ class SerialArm:
         self.params = params
         self.dt = params.control.dt
         self.divider = params.control.chart_divider
-        self.gains = design_gains(params) if gains is None else gains
+        self.gains = kept_gains(params) if gains is None else gains
         self.link_timeout_s = link_timeout_s
         self._rpc = tuple(float(d.rad_per_count) for d in params.drives)
         self._servo = params.servo  # its feedback's calibration turns the STATUS's ADC counts into an angle

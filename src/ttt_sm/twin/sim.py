@@ -35,9 +35,9 @@ from . import layout
 from .cascade import CascadeController
 from .errors import SimError
 from .gains import Gains
+from .gains_cache import kept_gains
 from .plant import CURRENT_NOISE_A, REST_POSE, SUBSTEPS, Angles, Plant, check_pose, gravity_torques
 from .truth import ArmTruth
-from .tuning import design_gains
 
 
 @dataclass(frozen=True)
@@ -92,7 +92,7 @@ class ArmSim:
     params : ArmParams
         The parameter file.
     gains : Gains, optional
-        Controller gains; None designs them (``tuning.design_gains(params)``).
+        Controller gains; None designs them (``tuning.design_gains(params)``, kept: ``gains_cache.kept_gains``).
     seed : int
         Seeds the current-measurement noise; everything else is deterministic.
     q0 : sequence of 4 floats, optional
@@ -110,7 +110,7 @@ class ArmSim:
                  q0: Angles | None = None, substeps: int = SUBSTEPS,
                  current_noise_a: float = CURRENT_NOISE_A) -> None:
         if gains is None:
-            gains = design_gains(params)
+            gains = kept_gains(params)
         if substeps < 1:
             raise SimError(f"substeps must be >= 1, got {substeps}")
         q_start = check_pose(params, q0)

@@ -175,3 +175,16 @@ def test_the_init_sweep_bench_times_each_runner_on_the_same_starts(params, monke
         workers = 1 if name == "1_worker" else 2
         assert result[f"init_sweep_{name}_starts_per_s_per_worker"] == pytest.approx(2 / wall / workers, rel=0.05)
     assert "init_sweep_dask_2_workers_wall_s" not in result
+
+
+@pytest.mark.parametrize(("argv", "why"), [
+    (("faults", "--link", "--workers", "2"), "--workers 2: the link's faults run in real time"),
+    (("faults", "--link", "--dask", "tcp://127.0.0.1:1"), "--dask: the link's faults run in real time"),
+    (("init", "--starts", "1", "--arm", "serial:/dev/ttt-sm-no-such-port", "--workers", "2"),
+     "--workers 2: an arm behind a serial link initialises once, in this process; drop --workers 2"),
+])
+def test_runs_that_must_stay_in_this_process_refuse_a_pool_or_a_cluster(capsys: pytest.CaptureFixture[str],
+                                                                         argv: tuple[str, ...], why: str) -> None:
+    assert main(list(argv)) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and why in err[0], err

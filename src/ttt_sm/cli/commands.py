@@ -11,6 +11,8 @@ import argparse
 import dataclasses
 import logging
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -297,14 +299,34 @@ def sweep_runner(args: argparse.Namespace, preload: tuple[str, ...] = ()) -> Run
     return Runner(workers=args.workers, preload=preload)
 
 
-def _closing(runner: Runner) -> None:
-    if runner.client is not None:
-        runner.client.close()
+def in_this_process(args: argparse.Namespace, why: str, drop: str = "") -> None:
+    """Refuse ``--workers``/``--dask`` for a run that must stay in this process: `why`, then what to drop."""
+    if args.workers != 1 or args.dask is not None:
+        option = f"--workers {args.workers}" if args.dask is None else "--dask"
+        raise CliError(f"{option}: {why}; drop {option}{drop}")
+
+
+@contextmanager
+def sweeping(args: argparse.Namespace, preload: tuple[str, ...],
+             emit: Callable[[dict[str, Any], argparse.Namespace], int]) -> Iterator[Runner]:
+    """The runner of a sweep, closed after it; on Ctrl-C, what was done is printed with `emit`, then exit 130."""
+    from ..runner import SweepInterrupted
+
+    runner = sweep_runner(args, preload)
+    try:
+        yield runner
+    except SweepInterrupted as stopped:
+        clear_status()
+        emit(stopped.report, args)  # what was done before the Ctrl-C; the interrupt then exits with 130
+        raise
+    finally:
+        clear_status()
+        if runner.client is not None:
+            runner.client.close()
 
 
 def cmd_init(args: argparse.Namespace) -> int:
     from ..app.init_wiring import INIT_PRELOAD, init_report
-    from ..runner import SweepInterrupted
 
     if not 1 <= args.starts <= MAX_STARTS:
         raise CliError(f"--starts must lie in 1..{MAX_STARTS}, got {args.starts}")
@@ -314,25 +336,19 @@ def cmd_init(args: argparse.Namespace) -> int:
     if args.arm != "sim" and args.starts != 1:
         raise CliError(f"--starts {args.starts}: an arm behind a serial link initialises once, from where it stands;"
                        " give --starts 1")
-    if args.arm != "sim" and (args.workers != 1 or args.dask is not None):
-        option = f"--workers {args.workers}" if args.dask is None else "--dask"
-        raise CliError(f"{option}: an arm behind a serial link initialises once, in this process; drop {option}")
-    runner = sweep_runner(args, INIT_PRELOAD)
-    conn = open_arm(args, params)
-    try:
-        report = init_report(params, args.starts, seed=args.seed, timeout_s=args.time_limit, status=status_line(),
-                             arm=conn.arm if conn else None, truth=conn.truth if conn else None, runner=runner)
-    except SweepInterrupted as stopped:
-        clear_status()
-        _emit_init(stopped.report, args)  # what was done before the Ctrl-C; the interrupt then exits with 130
-        raise
-    except ValueError as exc:
-        raise CliError(f"--arm {args.arm}: {exc}") from exc
-    finally:
-        clear_status()
-        if conn is not None:
-            conn.close()
-        _closing(runner)
+    if args.arm != "sim":
+        in_this_process(args, "an arm behind a serial link initialises once, in this process")
+    with sweeping(args, INIT_PRELOAD, _emit_init) as runner:
+        conn = open_arm(args, params)
+        try:
+            report = init_report(params, args.starts, seed=args.seed, timeout_s=args.time_limit,
+                                 status=status_line(), arm=conn.arm if conn else None,
+                                 truth=conn.truth if conn else None, runner=runner)
+        except ValueError as exc:
+            raise CliError(f"--arm {args.arm}: {exc}") from exc
+        finally:
+            if conn is not None:
+                conn.close()
     return _emit_init(report, args)
 
 
@@ -377,35 +393,25 @@ def cmd_faults(args: argparse.Namespace) -> int:
     from ..faults.matrix import FAULTS_PRELOAD, fault_matrix
     from ..faults.twin import TWIN_FAULTS
     from ..hardware.firmware import FirmwareError
-    from ..runner import SweepInterrupted
 
     if args.link:
         if args.arm is not None:
             raise CliError(f"--arm {args.arm}: the link's faults always run against the firmware emulator in real"
                            " time; drop --arm or --link")
-        if args.workers != 1 or args.dask is not None:
-            option = f"--workers {args.workers}" if args.dask is None else "--dask"
-            raise CliError(f"{option}: the link's faults run in real time, one after another in this process (two at"
-                           " once would share the processor and change the timing they measure); drop"
-                           f" {option} or --link")
+        in_this_process(args, "the link's faults run in real time, one after another in this process (two at once"
+                        " would share the processor and change the timing they measure)", drop=" or --link")
         return _link_faults(args)
     arm = args.arm or "sim"
     faults = _choices(args.only, TWIN_FAULTS, "--only") if args.only else list(TWIN_FAULTS)
     phases = [FAULT_PHASES[p] for p in _choices(args.phases, FAULT_PHASES, "--phases")] if args.phases \
         else list(FAULT_PHASES.values())
     params = load_arm(args.params)
-    runner = sweep_runner(args, FAULTS_PRELOAD)
-    try:
-        report = fault_matrix(params, faults, phases, seed=args.seed, status=status_line(), arm=arm, runner=runner)
-    except SweepInterrupted as stopped:
-        clear_status()
-        _emit_faults(stopped.report, args)  # the cells done before the Ctrl-C; the interrupt then exits with 130
-        raise
-    except (FirmwareError, OSError) as exc:
-        raise CliError(f"the firmware emulator cannot run: {exc}") from None
-    finally:
-        clear_status()
-        _closing(runner)
+    with sweeping(args, FAULTS_PRELOAD, _emit_faults) as runner:
+        try:
+            report = fault_matrix(params, faults, phases, seed=args.seed, status=status_line(), arm=arm,
+                                  runner=runner)
+        except (FirmwareError, OSError) as exc:
+            raise CliError(f"the firmware emulator cannot run: {exc}") from None
     return _emit_faults(report, args)
 
 

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from array import array
 from collections import deque
-from collections.abc import Callable, Iterator, Mapping, MutableMapping, MutableSet, Sequence
+from collections.abc import Callable, Mapping, MutableSet, Sequence
 from functools import partial
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -38,6 +38,8 @@ from statemachine.factory import StateMachineMetaclass
 from statemachine.state import State
 from statemachine.transition import Transition
 
+from .chart_clock import ChartClock
+from .chart_data import ChartData
 from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, buffers, check_values, collect_declarations, make_slot
 from .engine import EarlyReturn, Execution
 from .errors import ChartDefinitionError, TemporalLogicError, UnknownEventError
@@ -50,7 +52,7 @@ from .structure import (
     states_entered_by,
     tag_tick_transitions,
 )
-from .temporal import DurationSpec, Temporal
+from .temporal import DurationSpec
 
 _NO_PLAN = object()
 #: The key of the chart's own clock in ``_entered_at``: temporal logic on a junction outside every state.
@@ -212,7 +214,7 @@ class _StateName:
             f"State overriding is not allowed. Trying to add {value!r} to {self.name}")
 
 
-class TickChart(Execution, StateChart, metaclass=TickChartMeta):
+class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChartMeta):
     """Base class of a Stateflow-style chart: subclass it and declare states and data.
 
     Parameters
@@ -471,33 +473,6 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
         """Events posted and not yet handled, oldest first."""
         return [(e, dict(data)) for e, data in self._queue]
 
-    @property
-    def tick_count(self) -> int:
-        """Chart ticks since construction (or since :meth:`start_clock_at`'s tick)."""
-        return self._ticks
-
-    def start_clock_at(self, tick: int) -> None:
-        """Count this chart's ticks from ``tick``: a chart that takes another's place mid-run keeps
-        the run's clock (its trace and timeline go on where the other's stopped).  Before its first tick only."""
-        d = self.__dict__
-        if d["_ticks"]:
-            raise TemporalLogicError(f"{self.chart_name}: its clock has run {d['_ticks']} ticks already;"
-                                     " start_clock_at is for a chart not yet ticked")
-        d["_ticks"] = int(tick)
-        for state in d["_entered_at"]:
-            d["_entered_at"][state] = int(tick)
-
-    @property
-    def time_s(self) -> float | None:
-        """Chart time: ticks times the tick period (``None`` without a period)."""
-        period = self.tick_period_s
-        return None if period is None else self._ticks * period
-
-    def ticks_in(self, state: State | str) -> int:
-        """Ticks since ``state`` was last entered (0 during the tick that entered it)."""
-        state_id = state if isinstance(state, str) else state.id
-        return self._ticks - self._entered_at[state_id]
-
     def _load_plan(self, raw: Any) -> _Plan:
         d = self.__dict__
         key = frozenset(raw) if isinstance(raw, MutableSet) else raw
@@ -564,55 +539,6 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
     def _compile_guard(self, seg: Seg) -> Guard | None:
         return compile_guard(self, seg.transition, _clock_of(seg))[0]
 
-    # -- temporal logic ---------------------------------------------------------
-
-    def temporal_holds(self, spec: Temporal, state: Any) -> bool:
-        """Whether a temporal operator holds for `state` (a state or its id) now."""
-        state_id = getattr(state, "id", state)
-        return spec.holds(int(self.temporal_count(spec.unit, state_id, raw=True)), spec.ticks(self.tick_period_s))
-
-    def temporal_count(self, unit: str = "tick", state: Any = None, raw: bool = False) -> float:
-        """Stateflow's ``temporalCount(unit)``: ticks, seconds (``sec``, ``msec``, ``usec``) or events E
-        counted since `state` was entered (default: the state whose action or transition is running).
-
-        With ``raw=True`` time units are counted in ticks.
-        """
-        from .temporal import TIME_UNITS
-
-        d = self.__dict__
-        if state is None:
-            state = self._current_state_id()
-        state_id = getattr(state, "id", state)
-        if unit == "tick" or unit in TIME_UNITS:
-            ticks = d["_ticks"] - d["_entered_at"][state_id]
-            if unit == "tick" or raw:
-                return ticks
-            if self.tick_period_s is None:
-                raise TemporalLogicError(f"temporal_count({unit!r}) needs the chart's tick period")
-            return ticks * self.tick_period_s / TIME_UNITS[unit]
-        return int(d["_counts"].get(state_id, {}).get(unit, 0))
-
-    def _current_state_id(self) -> str:
-        d = self.__dict__
-        if d["_frames"]:
-            kind, node, path = d["_frames"][-1]
-            return str(node.id)
-        if d["_cur"] is not None:
-            return str(d["_cur"].id)
-        raise TemporalLogicError(f"{self.chart_name}: temporal_count() without a state, outside an action:"
-                                 " name the state (temporal_count(unit, state))")
-
-    def duration_holds(self, spec: DurationSpec, state: Any) -> bool:
-        """Whether ``duration(condition) <op> seconds`` holds for `state` now."""
-        return spec.holds(self._duration_s(spec, getattr(state, "id", state)))
-
-    def _duration_s(self, spec: DurationSpec, state_id: str) -> float:
-        d = self.__dict__
-        since = d["_since"].get((state_id, spec))
-        if since is None or self.tick_period_s is None:
-            return 0.0
-        return (d["_ticks"] - since) * self.tick_period_s
-
     def _duration_condition(self, node: Node, spec: DurationSpec) -> Guard:
         conds = self.__dict__["_durations"]
         fn = conds.get(spec)
@@ -630,64 +556,6 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
             for info in self._structure.transitions if info.scope != "action" and id(info.transition) in segs
         }
 
-    # -- data ----------------------------------------------------------------
-
-    @classmethod
-    def declarations(cls) -> tuple[Data, ...]:
-        """The chart's inputs, outputs and local data, in declaration order."""
-        return cls._data_decls
-
-    @classmethod
-    def structure(cls) -> ChartStructure:
-        """States and transitions of the chart, as diagrams and coverage read them."""
-        return cls._structure
-
-    def snapshot(self, kinds: tuple[str, ...] = ("input", "output", "local")) -> dict[str, Any]:
-        """Current values of the declared data of the given kinds, by name."""
-        d = self.data_mapping()
-        return {decl.name: d[decl.name] for decl in self._data_decls if decl.kind in kinds}
-
-    def previous_outputs(self) -> dict[str, Any]:
-        """Each output's value one chart tick earlier, by output name."""
-        d = self.data_mapping()
-        return {name: d[prev] for name, prev in self._prev_pairs}
-
-    def set_inputs(self, **values: Any) -> None:
-        """Set inputs by name; an unknown name raises :class:`UnknownDataError`."""
-        check_values(type(self).__name__, self._data_decls, values, {"input"})
-        self.data_mapping().update(values)
-
-    def reset_data(self, kinds: tuple[str, ...] = ("input", "output", "local")) -> None:
-        """Put the declared data of the given kinds back to their defaults."""
-        for decl in self._data_decls:
-            if decl.kind in kinds:
-                setattr(self, decl.name, decl.fresh_default())
-                if decl.kind == "output":
-                    setattr(self, decl.name + PREVIOUS_SUFFIX, decl.fresh_default())
-
-    def data_mapping(self) -> MutableMapping[str, Any]:
-        """The chart's data (and each output's previous value) as a mapping by name, read and written live.
-
-        The instance's ``__dict__`` itself, where the data are plain attributes; for a
-        buffered chart, a view that reads and writes its buffer's numbers by name.
-        """
-        return self.__dict__ if not self._slots else _BufferedData(self)
-
-    def data_buffer(self) -> array:
-        """A buffered chart's float buffer (``array('d')``): :meth:`data_slots` says which datum is where.
-
-        Compiled code wraps it without a copy (``numpy.frombuffer``) and reads and writes
-        the chart's numbers in place; a flag is 1.0 or 0.0.
-        """
-        if not self._slots:
-            raise TypeError(f"{self.chart_name}: the chart is not buffered (buffered = True keeps its"
-                            " numbers in one buffer)")
-        return self.__dict__["_data_buffer"]  # type: ignore[no-any-return]
-
-    @classmethod
-    def data_slots(cls) -> dict[str, int]:
-        """Where each number of a buffered chart lies in :meth:`data_buffer`, by datum (``X_p`` too)."""
-        return dict(cls._slots)
 
 
 def _clock_of(seg: Seg) -> str:
@@ -717,37 +585,3 @@ class _Engine(SyncEngine):
 def entered_states(chart: StateChart, transition: Transition) -> list[State]:
     """Alias of :func:`.structure.states_entered_by`, for listeners written by users."""
     return states_entered_by(chart, transition)
-
-
-class _BufferedData(MutableMapping[str, Any]):
-    """A buffered chart's data as a mapping: a number by its slot, anything else in the instance dict."""
-
-    __slots__ = ("_chart", "_d")
-
-    def __init__(self, chart: TickChart) -> None:
-        self._chart = chart
-        self._d = chart.__dict__
-
-    def __getitem__(self, name: str) -> Any:
-        if name in self._chart._slots:
-            return getattr(self._chart, name)
-        return self._d[name]
-
-    def __setitem__(self, name: str, value: Any) -> None:
-        if name in self._chart._slots:
-            setattr(self._chart, name, value)
-        else:
-            self._d[name] = value
-
-    def __delitem__(self, name: str) -> None:
-        raise TypeError(f"{self._chart.chart_name}: a chart's data cannot be deleted ({name})")
-
-    def __contains__(self, name: object) -> bool:
-        return name in self._chart._slots or name in self._d
-
-    def __iter__(self) -> Iterator[str]:
-        yield from self._chart._slots
-        yield from (k for k in self._d if k not in self._chart._slots)
-
-    def __len__(self) -> int:
-        return len(self._chart._slots) + sum(k not in self._chart._slots for k in self._d)

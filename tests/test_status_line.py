@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import os
 import pty
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -76,3 +77,10 @@ def test_play_shows_the_simulated_time_and_what_it_waits_for_on_a_terminal_only(
     piped = subprocess.run([str(TTT), *argv[:-1], str(tmp_path / "again")], capture_output=True, text=True,
                            timeout=600, cwd=tmp_path)
     assert piped.returncode == 0 and "\r" not in piped.stderr and "s simulated: " not in piped.stderr
+    # a log shows both players: the simulated person's moves with the board after each, and the final board
+    moves = re.findall(r"\[person\] draws X in row (\d), column (\d):\n    1 2 3 4 5\n((?:  \d [.XO ]+\n){5})",
+                       piped.stderr)
+    assert len(moves) >= 2, piped.stderr[-2000:]
+    for row, column, picture in moves:
+        assert picture.splitlines()[int(row) - 1].split()[int(column)] == "X"
+    assert re.search(r"result: .*the board as the game ended:\n    1 2 3 4 5\n(  \d [.XO ]+\n){5}", piped.stderr)

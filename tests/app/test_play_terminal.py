@@ -50,6 +50,7 @@ def test_make_play_s_command_plays_a_whole_game_with_the_person_typing(tmp_path)
                             stderr=child_fd, close_fds=True, cwd=tmp_path)
     os.close(child_fd)
     buffer: list[str] = []
+    seen: list[str] = []  # the whole transcript (the buffer is cleared at each prompt)
     prompt = re.compile(r"(    1 2 3 4 5\r?\n(?:  \d [.XO ]+\r?\n){5})Your move \(X\): [^\n]*$")
     moves = 0
     try:
@@ -59,6 +60,7 @@ def test_make_play_s_command_plays_a_whole_game_with_the_person_typing(tmp_path)
                 break
             picture = found.group(1).replace("\r", "")
             row, column = _free_cell(picture)
+            seen.extend(buffer)
             buffer.clear()
             os.write(main_fd, f"{row} {column}\n".encode())
             moves += 1
@@ -69,6 +71,10 @@ def test_make_play_s_command_plays_a_whole_game_with_the_person_typing(tmp_path)
             proc.kill()
         os.close(main_fd)
     text = "".join(buffer)
+    seen.extend(buffer)
+    # every message starts on a line of its own: the status line is taken off first (it ran into them before)
+    for told in re.finditer(r"If it is your turn|Your move \(X\)", transcript := "".join(seen)):
+        assert transcript[:told.start()].endswith(("\n", "\x1b[K")), transcript[max(0, told.start() - 80):told.end()]
     assert moves >= 4  # four in a row takes at least four moves of the winner
     assert "The manipulator wins." in text or "You win." in text or "Draw" in text
     assert "erased: True" in text and (tmp_path / "game.jsonl").exists()

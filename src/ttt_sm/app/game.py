@@ -44,7 +44,7 @@ from .engines import engine_for
 from .game_outcome import GameError, GameInterrupted, outcome_in_words, result_of
 from .game_record import GameRecord, checkpoint, params_digest
 from .game_stages import NO_PRECISION, Flow, GameDriver, GameStage, PenPathStage, Wait
-from .person import Cell, Person, RemotePerson, SimulatedPerson
+from .person import Cell, Person, RemotePerson, SimulatedPerson, board_picture
 from .robot import Robot
 from .wires import GAME_WIRES
 
@@ -476,7 +476,7 @@ class GameSession:
         self._event("result", outcome=outcome)
         self._save_board("final")  # the board as the game ended, before the sponge
         self.say(f"result: {outcome_in_words(outcome, self.robot_symbol, self.person_symbol)}; "
-                 "erasing and turning off")
+                 f"erasing and turning off; the board as the game ended:\n{board_picture(self.board)}")
         yield Wait(lambda: self.game.ended, 600.0, "erasing and turning off")
         self._save_board("erased")
 

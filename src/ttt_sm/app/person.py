@@ -68,6 +68,14 @@ class SimulatedPerson:
                             "perfect": lambda: PerfectEngine(seed)}[strength]()
 
     def choose(self, board: str, symbol: str) -> Cell | None:
+        cell = self._choose(board, symbol)
+        if self.say and cell is not None:  # a log shows both players' moves and the board, not the robot's alone
+            i = cell_index(*cell)
+            self.say(f"  [person] draws {symbol} in row {cell[0]}, column {cell[1]}:\n"
+                     + board_picture(board[:i] + symbol + board[i + 1:]))
+        return cell
+
+    def _choose(self, board: str, symbol: str) -> Cell | None:
         if self._engine is not None:
             from ..game.engine import GameOver
 
@@ -92,12 +100,15 @@ class TerminalPerson:
 
     name = "terminal"
 
-    def __init__(self, stdin: Any = None, stdout: Any = None) -> None:
+    def __init__(self, stdin: Any = None, stdout: Any = None, before_write: Callable[[], None] | None = None) -> None:
         self.stdin = stdin or sys.stdin
         self.stdout = stdout or sys.stdout
+        #: Called before each line is written: takes a status line off the terminal (``ttt-sm play``).
+        self.before_write = before_write or (lambda: None)
 
     def choose(self, board: str, symbol: str) -> Cell | None:
-        self.stdout.write(_board_picture(board) + "\n")
+        self.before_write()
+        self.stdout.write(board_picture(board) + "\n")
         while True:
             self.stdout.write(f"Your move ({symbol}): row column, e.g. 2 3 (q to give up): ")
             self.stdout.flush()
@@ -114,6 +125,7 @@ class TerminalPerson:
                 self.stdout.write(f"not a cell: {line.strip()!r}\n")
 
     def tell(self, message: str) -> None:
+        self.before_write()
         self.stdout.write(message + "\n")
         self.stdout.flush()
 
@@ -141,7 +153,8 @@ class RemotePerson:
         self.told += 1
 
 
-def _board_picture(board: str) -> str:
+def board_picture(board: str) -> str:
+    """The 5x5 board as text: a header of column numbers, then a row number and the row's marks per line."""
     rows = ["    1 2 3 4 5"]
     for r in range(5):
         rows.append(f"  {r + 1} " + " ".join(board[5 * r:5 * r + 5]))

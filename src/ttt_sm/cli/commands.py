@@ -118,7 +118,8 @@ def cmd_play(args: argparse.Namespace) -> int:
             elif opponent == "terminal" and not stdin_open:
                 raise CliError("--opponent terminal: standard input is closed, so no one can type a move;"
                                " give it a terminal, or play against --opponent simulated")
-            person = TerminalPerson() if opponent == "terminal" else SimulatedPerson(args.seed, say, args.person)
+            person = (TerminalPerson(before_write=clear_status) if opponent == "terminal"
+                      else SimulatedPerson(args.seed, say, args.person))
             say(f"ttt-sm play: the robot plays {args.robot_symbol} ({args.engine} engine) against a "
                 f"{'person at this terminal' if opponent == 'terminal' else f'simulated person ({args.person})'}; "
                 f"camera {'behind a serial port' if args.camera == 'serial' else 'read directly'}")

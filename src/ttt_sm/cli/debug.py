@@ -120,6 +120,8 @@ def cmd_debug(args: argparse.Namespace) -> int:
         if conn is not None:
             conn.close()
     dbg.end_trace("finished", errors=shell.errors)
+    if dbg.trace_failure is not None:  # the one line at the end: which file, why, what to do
+        raise dbg.trace_failure
     return status
 
 

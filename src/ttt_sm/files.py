@@ -55,6 +55,28 @@ def _shown(path: Path) -> str:
     return text if text.isprintable() and len(text) <= 200 else repr(text[:200])
 
 
+def _busy(path: Path) -> RecordBusyError:
+    return RecordBusyError(f"{_shown(path)} is being written by another ttt-sm process now: give this run another"
+                           " file (or folder), or stop the other one first")
+
+
+def refuse_if_busy(path: str | Path) -> None:
+    """:class:`RecordBusyError` if a running process writes the record at ``path`` now (nothing is changed):
+    a command says so before it builds anything, then :class:`LineSink` takes the lock for good."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_CLOEXEC)
+    except OSError:  # not there (or not readable): nobody writes it, or opening it will say why
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise _busy(Path(path)) from None
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
 class LineSink:
     """A file of whole lines, appended one write at a time, locked against a second writer.
 
@@ -71,9 +93,7 @@ class LineSink:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             os.close(fd)
-            raise RecordBusyError(
-                f"{_shown(self.path)} is being written by another ttt-sm process now: give this run another"
-                " file (or folder), or stop the other one first") from None
+            raise _busy(self.path) from None
         except OSError:  # a file system without locks: write on unlocked
             pass
         try:
@@ -205,5 +225,5 @@ def save_figure(fig: Any, path: str | Path, **kwargs: Any) -> Path:
     return write_atomic(path, buf.getvalue())
 
 
-__all__ = ["ADVICE", "LineSink", "RecordBusyError", "RecordWriteError", "save_figure", "write_atomic",
-           "write_png", "write_text"]
+__all__ = ["ADVICE", "LineSink", "RecordBusyError", "RecordWriteError", "refuse_if_busy", "save_figure",
+           "write_atomic", "write_png", "write_text"]

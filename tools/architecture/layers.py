@@ -102,7 +102,7 @@ CONTRACT: tuple[Component, ...] = (
                     "sched", "hardware",
                     "vision staging", "app", "debug", "scenario", "web", "lab")),
     Component("cli common", 4, ("ttt_sm.cli.common",), "the CLI's one-line error, options and strict JSON output",
-              only=("runtime",)),
+              only=("runtime", "files")),
     Component("cli", 7, ("ttt_sm.cli",), "ttt-sm: parse, call, print; one module per command group"),
 )
 

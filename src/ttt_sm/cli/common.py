@@ -23,6 +23,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..files import RecordBusyError, refuse_if_busy
 from ..runtime.jsonable import dumps
 
 Command = Callable[[argparse.Namespace], int]
@@ -248,6 +249,10 @@ def trace_file(path: str, what: str = "--trace") -> Path:
     if file.is_dir():
         raise CliError(f"{what}: {path[:200]} is a folder; name the file the record is written to")
     out_dir(str(file.parent), f"{what} {path[:200]}: its folder")
+    try:
+        refuse_if_busy(file)  # a second ttt-sm on the same record: refused now, not after building the robot
+    except RecordBusyError as exc:
+        raise CliError(f"{what} {exc}") from None
     return file
 
 

@@ -67,10 +67,10 @@ WRITERS = (
     Writer("debug --trace, trace save", ["debug", "--trace", "trace.jsonl", "--commands", "commands.txt"],
            (8, 20, 40, 60)),
     Writer("scenario run --out --trace", ["scenario", "run", *SCENARIOS, "--out", "report.jsonl", "--trace",
-                                          "traces"], (8, 24, 60)),
+                                          "traces"], (8, 12, 16, 20)),
     Writer("demo --out", ["demo", "--out", "demo"], (32, 120, 200)),
     Writer("play --out", ["play", "--out", "play"], (32, 140, 250)),
-    Writer("draw --out", ["draw", "--out", "draw"], (16, 80)),
+    Writer("draw --out", ["draw", "X", "--out", "draw"], (16, 80, 140)),
     Writer("bench --out", ["bench", "--quick", "--only", "ik,charts", "--out", "bench"], (8,)),
     Writer("charts export --out", ["charts", "export", "--out", "charts"], (24, 120)),
 )
@@ -118,7 +118,10 @@ def full_disk_popen(argv: list[str], env: dict[str, str], disk: Path, copy: Path
     exits, what it wrote is copied to ``copy`` (the tmpfs goes with its namespace)."""
     if how == "tmpfs":
         script = ('D="$1"; C="$2"; shift 2; mount -t tmpfs -o size="$SIZE"k tmpfs "$D" || exit 97; '
-                  'cp -a "$C/given/." "$D/" 2>/dev/null; cd "$D"; "$@"; rc=$?; cp -a "$D/." "$C/"; exit $rc')
+                  'cp -a "$C/given/." "$D/" 2>/dev/null; cd "$D"; "$@" & pid=$!; '
+                  "trap 'kill -TERM $pid' TERM; wait $pid; rc=$?; "
+                  'while kill -0 $pid 2>/dev/null; do wait $pid; rc=$?; done; '  # a trap cut the first wait short
+                  'cp -a "$D/." "$C/"; exit $rc')
         return subprocess.Popen(["unshare", "-rm", "sh", "-c", script, "sh", str(disk), str(copy), *argv],
                                 env={**env, "SIZE": str(size_kb)}, text=True, **kw)
 
@@ -150,11 +153,20 @@ def inspect(folder: Path, outcome: Outcome) -> None:
                 except ValueError:
                     outcome.half_lines += 1
                     outcome.problems.append(f"{rel}:{n}: not a JSON line ({line[-40:]!r})")
+        elif path.suffix in (".svg", ".md", ".dot", ".json", ".csv", ".html", ".yaml") and _cut_short(path):
+            outcome.empty_pictures += 1
+            outcome.problems.append(f"{rel}: {path.stat().st_size} bytes, cut short")
         elif path.suffix == ".png":
             outcome.pictures += 1
             if not _decodes(path):
                 outcome.empty_pictures += 1
                 outcome.problems.append(f"{rel}: {path.stat().st_size} bytes, not a picture")
+
+
+def _cut_short(path: Path) -> bool:
+    """An empty file, or an SVG without its end."""
+    data = path.read_bytes()
+    return not data or (path.suffix == ".svg" and not data.rstrip().endswith(b"</svg>"))
 
 
 def _decodes(path: Path) -> bool:
@@ -200,7 +212,7 @@ def run_gui(src: Path, size_kb: int, how: str, work: Path, wait_s: float = 120.0
     (copy / "given").mkdir(parents=True)
     argv, env = command(src, ["gui", "--port", "0", "--speed", "max", "--trace", "trace.jsonl"])
     proc = full_disk_popen(argv, env, disk, copy, size_kb, how, stdin=subprocess.DEVNULL,
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     outcome = Outcome("gui --trace", size_kb, how, None)
     try:
         url = _printed_url(proc, wait_s)
@@ -209,11 +221,11 @@ def run_gui(src: Path, size_kb: int, how: str, work: Path, wait_s: float = 120.0
         else:
             outcome.problems += _as_a_page(url, wait_s)
     finally:
-        os.killpg(proc.pid, signal.SIGTERM)
+        proc.send_signal(signal.SIGTERM)  # the shell in the namespace passes it on (or, without one, the cockpit)
         try:
             _, err = proc.communicate(timeout=60)
         except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
+            proc.kill()
             _, err = proc.communicate()
     outcome.status = proc.returncode
     inspect(copy if how == "tmpfs" else disk, outcome)

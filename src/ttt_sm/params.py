@@ -554,7 +554,7 @@ def _read_text(path: Path, where: str) -> str:
         raise ParameterError(f"{where}: more than {MAX_FILE_BYTES} bytes: not a parameter file"
                              f" (the packaged one has about 6 kB)")
     try:
-        return raw.decode("utf-8")
+        return raw.decode("utf-8-sig")  # a byte-order mark first (Windows editors write one) is not TOML: left out
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
         column = exc.start - (raw.rfind(b"\n", 0, exc.start) + 1) + 1

@@ -229,6 +229,8 @@ def seed(text: str) -> int:
 
 def out_dir(path: str, what: str = "--out") -> Path:
     """The folder a command writes to, made now and known writable: refused before the run, not after it."""
+    if not path.strip():  # Path('') is the current folder: a command would write its files among yours
+        raise CliError(f"{what}: the folder name is empty; name one, e.g. {what} out/run")
     folder = Path(path)
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -245,6 +247,8 @@ def out_dir(path: str, what: str = "--out") -> Path:
 
 def trace_file(path: str, what: str = "--trace") -> Path:
     """A file a command streams a record to: not a folder, its folder made and known writable, before the run."""
+    if not path.strip():
+        raise CliError(f"{what}: the file name is empty; name one, e.g. {what} out/trace.jsonl")
     file = Path(path)
     if file.is_dir():
         raise CliError(f"{what}: {path[:200]} is a folder; name the file the record is written to")

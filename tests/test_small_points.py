@@ -72,3 +72,45 @@ def test_a_parameter_file_with_a_byte_order_mark_loads_as_without(tmp_path: Path
     plain.write_text(text, encoding="utf-8")
     assert load_params(path).drives == load_params(plain).drives
     assert load_params(path).control == load_params(plain).control
+
+
+def _arm_file(tmp_path: Path, *edits: tuple[str, str]) -> Path:
+    text = resources.files("ttt_sm.data").joinpath("arm.toml").read_text(encoding="utf-8")
+    for old, new in edits:
+        assert old in text
+        text = text.replace(old, new, 1)
+    path = tmp_path / "arm.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("edits, message", [
+    ((("rate_hz = 1000.0", "rate_hz = 20000.0"),), r"arm\.toml:64: \[control\] rate_hz = 20000: outside 700\.\.1250"),
+    ((("gear_ratio = 150.0", "gear_ratio = 1.0"),),
+     r"arm\.toml: \[drive\.1\] gear_ratio = 1: the encoder shows 0\.16 counts per chart tick .* gear_ratio >= 25\.1"),
+    ((("rate_hz = 1000.0", "rate_hz = 1250.0"), ("chart_divider = 2", "chart_divider = 1")), None),
+    ((("gear_stiffness = 10000.0", "gear_stiffness = 1.0e6"),),
+     r"\[drive\.1\] gear_ratio = 150: the gear spring's natural frequency \(\d+ Hz\) is too fast for the twin's"
+     r" step of 80 us|\[drive\.1\] gear_ratio = 150: the gear spring's natural frequency .* step of 100 us"),
+])
+def test_the_drives_relations_are_checked_at_load(tmp_path: Path, edits: tuple[tuple[str, str], ...],
+                                                  message: str | None) -> None:
+    """Values the drives and the twin cannot honour (they passed, then failed: a switch "not found", an encoder
+    "jumped 5.5e18 rad/s") are refused when the file is loaded, naming the file, the key and the range."""
+    from ttt_sm.params import ParameterError
+    from ttt_sm.twin.workspace import load_arm
+
+    path = _arm_file(tmp_path, *edits)
+    if message is None:
+        load_arm(path)  # 1250 Hz with the charts at every control step: 7.6 counts per tick, within the bounds
+        return
+    with pytest.raises(ParameterError, match=message):
+        load_arm(path)
+
+
+def test_the_still_speed_the_check_assumes_is_the_charts() -> None:
+    from ttt_sm.charts.drive_init import DriveInit1
+    from ttt_sm.twin.workspace import INIT_STILL_SPEED_RAD_S
+
+    declared = {d.name: d.default for d in DriveInit1.declarations()}
+    assert declared["still_speed"] == INIT_STILL_SPEED_RAD_S

@@ -182,15 +182,17 @@ def run_writer(src: Path, writer: Writer, size_kb: int, how: str, work: Path) ->
     (copy / "given" / "commands.txt").write_text(writer.commands)
     argv, env = command(src, writer.argv)
     proc = full_disk_popen(argv, env, disk, copy, size_kb, how, stdin=subprocess.DEVNULL,
-                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
-        _, err = proc.communicate(timeout=writer.timeout_s)
+        out, err = proc.communicate(timeout=writer.timeout_s)
     except subprocess.TimeoutExpired:
         proc.kill()
-        _, err = proc.communicate()
+        out, err = proc.communicate()
     outcome = Outcome(writer.name, size_kb, how, proc.returncode)
     inspect(copy if how == "tmpfs" else disk, outcome)
-    judge_stderr(err, outcome)
+    # the debugger says a command's error on standard output ("error: ..."), the session going on
+    told = [ln for ln in out.splitlines() if ln.startswith("error: ")]
+    judge_stderr(err if err.strip() or not told else told[-1], outcome)
     return outcome
 
 
@@ -199,7 +201,7 @@ def judge_stderr(err: str, outcome: Outcome) -> None:
     outcome.last_line = lines[-1][:300] if lines else ""
     outcome.traceback = "Traceback" in err
     # a refused write names a file (a path with a folder or an extension) before the reason
-    outcome.names_the_file = bool(re.search(r"error: \S*(\.jsonl|\.png|\.svg|\.md|\.json|\.csv|/)\S*: "
+    outcome.names_the_file = bool(re.search(r"error: .*?\S+(\.jsonl|\.png|\.svg|\.md|\.json|\.csv|\.yaml)'?: "
                                             r"(No space left|File too large)", outcome.last_line))
 
 
@@ -314,7 +316,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 outcomes.append(run_writer(args.src, writer, size, how, Path(work)))
                 print(json.dumps(asdict(outcomes[-1])), file=sys.stderr, flush=True)
     if args.only is None or "gui" in args.only:
-        for size in (24, 96):
+        for size in (24, 48):
             with tempfile.TemporaryDirectory() as work:
                 outcomes.append(run_gui(args.src, size, how, Path(work)))
                 print(json.dumps(asdict(outcomes[-1])), file=sys.stderr, flush=True)

@@ -52,7 +52,8 @@ class ChartWatch:
     def attach(self, robot: Robot) -> None:
         """Watch a robot's charts from its power-on: a new trace and timeline, the listeners on every chart."""
         self.robot = robot
-        self.trace = Trace(sink=self.trace_file, limit=self.trace_keep)
+        # a full disk stops the trace file, not the session (trace_failure says so)
+        self.trace = Trace(sink=self.trace_file, limit=self.trace_keep, keep_going=True)
         self.state_history = Timeline()
         for chart in robot.charts.values():
             chart.add_listener(self.trace, *self._listeners)

@@ -114,8 +114,10 @@ class Trace:
         If given, each record is also written to it as one JSON line when it
         happens, and flushed, so a long run keeps its whole trace on disk
         (a :class:`~.recordfile.RecordFile`) without holding it in memory.
-        A sink that fails (the disk full) is let go: the charts run on,
-        :attr:`sink_error` says why, the records are kept in memory still.
+        A write that fails (the disk full) raises from the chart's step,
+        which ends a run; with ``keep_going`` the sink is let go instead:
+        the charts run on, :attr:`sink_error` says why, the records are kept
+        in memory still (the debugger's and the cockpit's sessions).
     keep : bool
         Keep the records in :attr:`records`.
     limit : int, optional
@@ -123,7 +125,8 @@ class Trace:
         still counts them all.  None: keep every record.
     """
 
-    def __init__(self, sink: IO[str] | Any | None = None, keep: bool = True, limit: int | None = None) -> None:
+    def __init__(self, sink: IO[str] | Any | None = None, keep: bool = True, limit: int | None = None,
+                 keep_going: bool = False) -> None:
         self.records: list[TraceRecord] | KeptRecords = [] if limit is None else KeptRecords(limit)
         self.sink = sink
         self.keep = keep
@@ -131,6 +134,7 @@ class Trace:
         self.count = 0
         #: Why the sink was let go (an ``OSError`` writing it: the disk full), or None.
         self.sink_error: OSError | None = None
+        self.keep_going = keep_going
 
     @property
     def dropped(self) -> int:
@@ -173,8 +177,10 @@ class Trace:
             try:
                 self.sink.write(record.to_json() + "\n")
                 self.sink.flush()
-            except OSError as exc:  # a chart's step must not break off in the middle for a full disk
+            except OSError as exc:
                 self.sink_error, self.sink = exc, None
+                if not self.keep_going:
+                    raise
 
     def write_jsonl(self, path: str | Path) -> Path:
         """Write the kept records to ``path``, one JSON object per line: the whole file or, if the disk

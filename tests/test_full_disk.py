@@ -121,9 +121,9 @@ def _writer(name: str) -> Writer:
 def test_the_debuggers_trace_and_trace_save_on_a_full_disk(tmp_path: Path) -> None:
     """The trace fills the disk: the session goes on (told once), ``trace save`` is an error line, and the run
     ends with one line naming the trace file and what to do, status 2."""
-    writer = Writer("debug", ["debug", "--trace", "trace.jsonl", "--commands", "commands.txt"], (8,), 120,
-                    "tick 5\nrun 15\ntrace save saved.jsonl\nrun 5\nquit\n")
-    outcome = run_writer(SRC, writer, 8, HOW, tmp_path)
+    writer = Writer("debug", ["debug", "--trace", "trace.jsonl", "--commands", "commands.txt"], (4,), 120,
+                    "tick 5\nrun 8\ntrace save saved.jsonl\nquit\n")
+    outcome = run_writer(SRC, writer, 4, HOW, tmp_path)
     assert outcome.half_lines == 0 and outcome.records >= 1, (HOW, outcome)
     assert outcome.status == 2 and not outcome.traceback, (HOW, outcome)
     assert outcome.last_line.startswith("ttt-sm debug: error: trace.jsonl: "), (HOW, outcome.last_line)
@@ -131,6 +131,7 @@ def test_the_debuggers_trace_and_trace_save_on_a_full_disk(tmp_path: Path) -> No
     assert outcome.names_the_file and outcome.problems == [], outcome
 
 
+@pytest.mark.soak  # 20-35 s: the cockpit's start, the disk filling at full speed, a page, its stop
 @pytest.mark.skipif(HOW != "tmpfs", reason="the cockpit's other files need a disk that is full, not a size limit")
 def test_the_cockpit_survives_a_full_disk_under_gui_trace(tmp_path: Path) -> None:
     """``gui --trace`` on a 24 kB disk: the trace stops with whole lines, the page is told, the ink picture is

@@ -193,7 +193,8 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
             tmp.unlink()
         except OSError:
             pass
-        raise RecordWriteError(exc.errno or errno.EIO, f"{exc.strerror or exc} (not written)", str(path)) from None
+        reason = f"{exc.strerror or exc}" + (" (not written)" if exc.errno in ADVICE else "")  # the disk's refusal
+        raise RecordWriteError(exc.errno or errno.EIO, reason, str(path)) from None
     return path
 
 

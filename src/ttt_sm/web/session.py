@@ -229,7 +229,10 @@ class Session:
         gc.unfreeze()
         game = self.debugger.game
         if game is not None:
-            game.close()  # its record ends (as interrupted, unless the game ended)
+            try:
+                game.close()  # its record ends (as interrupted, unless the game ended)
+            except OSError:  # the disk refused the record's last line: it ends at its last whole line
+                log.exception("the game's record could not be ended")
         if self.camera_feed is not None:
             self.camera_feed.stop()
         if self.debugger.trace_file is not None:

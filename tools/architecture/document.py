@@ -108,7 +108,10 @@ def layers_section(pictures: Pictures) -> str:
 
 The package is cut into components stacked in tiers. A component may import
 components of lower tiers only: never one beside it in its own tier, never
-one above; where the table lists what it may import, only those. The rule
+one above; where the table lists what it may import, only those. One
+exception: `files` (how anything is written to disk, so that a full disk
+leaves whole lines and whole pictures) imports nothing and may be imported
+from every tier, its own too. The rule
 is code, `tools.architecture.layers.CONTRACT` (a development tool of the repository,
 not in the installed package), and `tests/test_layers.py`
 holds the source to it with an `ast` scan of every `import` statement

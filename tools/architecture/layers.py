@@ -42,6 +42,8 @@ class Component:
     ``only``, when not ``None``, narrows what it may import to those
     components (all of a lower tier); ``None`` allows every lower tier.
     ``exact``: the prefixes name single modules, not their submodules.
+    ``base``: every component may import it, those of its own tier too (only
+    ``files``: the one way anything is written to disk); it imports nothing.
     """
 
     name: str
@@ -50,6 +52,7 @@ class Component:
     role: str
     only: tuple[str, ...] | None = None
     exact: bool = False
+    base: bool = False
 
 
 #: Tier names, bottom up.
@@ -59,6 +62,9 @@ CONTRACT: tuple[Component, ...] = (
     Component("package", 0, ("ttt_sm",), "the package's docstring and version", exact=True),
     Component("runtime", 0, ("ttt_sm.runtime",),
               "the Stateflow clock on python-statemachine, traces, diagrams, strict JSON: generic, no robot code"),
+    Component("files", 0, ("ttt_sm.files",),
+              "files a full disk cannot corrupt: records a whole line at a time, one writer each; pictures renamed"
+              " into place", only=(), exact=True, base=True),
     Component("params", 0, ("ttt_sm.params", "ttt_sm.data"), "the arm's assumed physical values (arm.toml)"),
     Component("arm", 0, ("ttt_sm.arm",), "the Arm protocol the scheduler drives: the twin or a real arm"),
     Component("runner", 0, ("ttt_sm.runner",),
@@ -69,12 +75,12 @@ CONTRACT: tuple[Component, ...] = (
               " an emulator's thread, the CRC-16", only=()),
     Component("charts", 1, ("ttt_sm.charts",), "the thesis' Stateflow charts", only=("runtime",)),
     Component("twin", 1, ("ttt_sm.twin",),
-              "the digital twin: kinematics, plant, control, tuning, whiteboard", only=("params", "arm")),
+              "the digital twin: kinematics, plant, control, tuning, whiteboard", only=("params", "arm", "files")),
     Component("game", 1, ("ttt_sm.game",), "rules and engines of the game", only=()),
     Component("smartcam", 1, ("ttt_sm.smartcam",), "the smart camera's serial line: protocol, reader, emulator",
               only=("ptylink",)),
     Component("vision", 1, ("ttt_sm.vision",), "cameras, the field's grid, detection, percent-process",
-              only=("params",)),
+              only=("params", "files")),
     Component("sched", 2, ("ttt_sm.sched",), "clocks and the control-step scheduler, over the arm",
               only=("params", "arm", "twin")),
     Component("hardware", 2, ("ttt_sm.hardware",),
@@ -82,7 +88,7 @@ CONTRACT: tuple[Component, ...] = (
               only=("params", "arm", "twin", "ptylink")),
     Component("vision staging", 2, ("ttt_sm.vision.scenes", "ttt_sm.vision.bench", "ttt_sm.vision.pictures"),
               "photos of boards drawn on the twin's whiteboard: the vision bench and docs pictures",
-              only=("params", "twin", "vision")),
+              only=("params", "twin", "vision", "files")),
     Component("app", 3, ("ttt_sm.app",), "the application: wires charts, scheduler, twin, camera and game"),
     Component("debug", 4, ("ttt_sm.debug",), "the step-through debugger"),
     Component("scenario", 4, ("ttt_sm.scenario",), "scenario tests of event sequences (YAML)"),
@@ -96,7 +102,7 @@ CONTRACT: tuple[Component, ...] = (
                     "sched", "hardware",
                     "vision staging", "app", "debug", "scenario", "web", "lab")),
     Component("cli common", 4, ("ttt_sm.cli.common",), "the CLI's one-line error, options and strict JSON output",
-              only=("runtime",)),
+              only=("runtime", "files")),
     Component("cli", 7, ("ttt_sm.cli",), "ttt-sm: parse, call, print; one module per command group"),
 )
 
@@ -183,7 +189,7 @@ def component_of(module: str, contract: Sequence[Component] = CONTRACT) -> Compo
 
 def allowed(comp: Component, contract: Sequence[Component] = CONTRACT) -> list[str]:
     """Names of the components ``comp`` may import."""
-    lower = [c.name for c in contract if c.tier < comp.tier]
+    lower = [c.name for c in contract if c.tier < comp.tier or (c.base and c is not comp)]
     return lower if comp.only is None else [c for c in comp.only if c in lower]
 
 

@@ -32,6 +32,7 @@ from typing import Any, cast
 
 from ..arm import Arm
 from ..charts.game import AlgorithmActivator, Game
+from ..files import RecordWriteError
 from ..game.bitboard import cell_index
 from ..params import ArmParams
 from ..runtime.listeners import Trace
@@ -412,8 +413,11 @@ class GameSession:
         wait = self._wait
         where = {"waiting_for": wait.what if wait is not None else "the start of the game",
                  "control": sorted(self.robot.active("Control")), "game": sorted(self.robot.active("Game"))}
-        if how != "finished":
-            self._save_board("final" if "final" not in self.pictures else "erased", ending=how)
+        if how != "finished" and self.record.failed is None:  # the record's disk failed: that is what is said
+            try:
+                self._save_board("final" if "final" not in self.pictures else "erased", ending=how)
+            except RecordWriteError as exc:  # how the game ended matters more than its picture
+                self.pictures["not_written"] = f"{exc.filename}: {exc.strerror}"
         self._event(how, **data, **({} if how == "finished" else where), pictures=dict(self.pictures),
                     state=self.checkpoint())
         self.record.close()

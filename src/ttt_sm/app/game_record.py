@@ -25,14 +25,15 @@ from __future__ import annotations
 import hashlib
 from dataclasses import asdict
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 import numpy as np
 
+from ..files import RecordWriteError
 from ..params import ArmParams
 from ..runtime.jsonable import dumps, jsonable
 from ..runtime.listeners import Trace
-from ..runtime.recordfile import ENDINGS
+from ..runtime.recordfile import ENDINGS, RecordFile
 from ..runtime.recordfile import read_lines as read_record
 from .robot import Robot
 
@@ -81,7 +82,8 @@ class GameRecord:
         self.events: list[dict[str, Any]] = []
         self.trace = trace
         self.path: Path | None = None
-        self._sink: IO[str] | None = None
+        self._sink: RecordFile | None = None
+        self._failure: RecordWriteError | None = None
         self._marks: list[int] = []  # len(trace.records) when each event was added
         self._traced = 0
         self.ended: str | None = None
@@ -103,14 +105,12 @@ class GameRecord:
             if path != self.path:
                 raise ValueError(f"the record is written to {self.path} already, not {path}")
             return
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self._sink = path.open("w", encoding="utf-8")
+        self._sink = RecordFile(path)  # whole lines or none; refused if another process writes it now
         self.path = path
         for event, mark in zip(self.events, self._marks, strict=True):
             self._write_transitions(mark)
             self._write(event)
         self._write_transitions(len(self.trace.records) if self.trace is not None else 0)
-        self._sink.flush()
 
     def add(self, t: float, kind: str, tick: int | None = None, **data: Any) -> dict[str, Any]:
         """Record an event at simulated time ``t`` (and chart tick ``tick``); written and flushed if attached."""
@@ -120,7 +120,6 @@ class GameRecord:
         if self._sink is not None:
             self._write_transitions(self._marks[-1])
             self._write(event)
-            self._sink.flush()
         if kind in ENDINGS:
             self.ended = kind
         return event
@@ -130,19 +129,25 @@ class GameRecord:
         if self._sink is not None:
             self._write_transitions(len(self.trace.records) if self.trace is not None else 0)
             self._sink.close()
+            self._failure = self._sink.failed
             self._sink = None
+
+    @property
+    def failed(self) -> RecordWriteError | None:
+        """Why the file stopped before the game's end (the disk full: it holds whole lines only), or None."""
+        return self._sink.failed if self._sink is not None else self._failure
 
     def _write(self, event: dict[str, Any]) -> None:
         assert self._sink is not None
-        self._sink.write(dumps(event) + "\n")
+        self._sink.write(dumps(event) + "\n")  # after a failed write: nothing (the file ended there)
 
     def _write_transitions(self, upto: int) -> None:
         if self.trace is None or self._sink is None:
             return
         records = self.trace.records
-        for rec in records[self._traced:upto]:
-            self._sink.write(dumps({"event": "transition", **asdict(rec)}) + "\n")
+        lines = "".join(dumps({"event": "transition", **asdict(rec)}) + "\n" for rec in records[self._traced:upto])
         self._traced = max(self._traced, upto)
+        self._sink.write(lines)
 
 
 __all__ = ["ENDINGS", "GameRecord", "params_digest", "read_record"]

@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..files import save_figure
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -146,8 +148,7 @@ def save_path_plot(d: PathData, path: str | Path, title: str, subtitle: str = ""
     """Write :func:`path_figure` to a PNG file; returns the path."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    path_figure(d, title, subtitle).savefig(p)
-    return p
+    return save_figure(path_figure(d, title, subtitle), p)
 
 
 # ----------------------------------------------------------------------------- panels

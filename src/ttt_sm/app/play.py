@@ -62,6 +62,8 @@ def run_play(params: ArmParams, seed: int = 0, out_dir: Path = Path("out/play"),
     except BaseException as exc:  # the record says where it stopped, with the board as it is
         how, data = ending_of(exc)
         try:
+            if record.failed is not None:  # the disk refused the record: no picture either, that error stands
+                raise record.failed
             picture = str(save_board_picture(robot.board, out_dir / "board_stopped.png",
                                              f"The whiteboard when the demo stopped ({how})",
                                              f"ttt-sm demo, seed {seed}, t = {robot.t:.1f} s"))

@@ -30,7 +30,7 @@ from ..sched.scheduler import Scheduler, Signals, Stage
 from ..twin.sim import ArmSim
 from ..twin.truth import GroundTruth
 from ..twin.whiteboard import Whiteboard
-from ..twin.workspace import check_reach
+from ..twin.workspace import check_drives, check_reach
 from .compensation import GearPlayCompensation
 from .control_wiring import ControlStage, make_control_chart
 from .init_wiring import DriveInitStage, make_init_charts, settled_pose
@@ -97,6 +97,7 @@ class Robot:
                  settle_s: float = 0.0, listeners: Sequence[object] = (), arm: Arm | None = None,
                  truth: GroundTruth | None = None, wires: Sequence[Wire] = ROBOT_WIRES,
                  slots: ChartSlots | None = None) -> None:
+        check_drives(params)  # an encoder too coarse for the charts, a gear too stiff for the twin's step
         check_reach(params)  # a field out of reach would be drawn as nothing, silently
         self.params = params
         self.seed = seed

@@ -36,6 +36,7 @@ import signal
 import sys
 from collections.abc import Sequence
 
+from ..files import ADVICE as WRITE_ADVICE
 from ..params import shown_path
 from ..runtime.recordfile import interruption
 from . import ai, arm, camera, commands, debug, gui, lab, scenario, vision
@@ -68,9 +69,9 @@ _OS_ADVICE = {
     errno.EROFS: "it is on a read-only file system: choose another path",
     errno.EISDIR: "it is a folder where a file belongs: name a file",
     errno.ENOTDIR: "a part of it is a file where a folder belongs: choose another path",
-    errno.ENOSPC: "the disk is full: free some space or choose another path",
     errno.EEXIST: "something of that name is already there: choose another path",
     errno.ENAMETOOLONG: "the name is too long: choose a shorter path",
+    **WRITE_ADVICE,  # a full disk, a quota, a file-size limit
 }
 
 

@@ -23,6 +23,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..files import RecordBusyError, refuse_if_busy
 from ..runtime.jsonable import dumps
 
 Command = Callable[[argparse.Namespace], int]
@@ -228,6 +229,8 @@ def seed(text: str) -> int:
 
 def out_dir(path: str, what: str = "--out") -> Path:
     """The folder a command writes to, made now and known writable: refused before the run, not after it."""
+    if not path.strip():  # Path('') is the current folder: a command would write its files among yours
+        raise CliError(f"{what}: the folder name is empty; name one, e.g. {what} out/run")
     folder = Path(path)
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -244,10 +247,16 @@ def out_dir(path: str, what: str = "--out") -> Path:
 
 def trace_file(path: str, what: str = "--trace") -> Path:
     """A file a command streams a record to: not a folder, its folder made and known writable, before the run."""
+    if not path.strip():
+        raise CliError(f"{what}: the file name is empty; name one, e.g. {what} out/trace.jsonl")
     file = Path(path)
     if file.is_dir():
         raise CliError(f"{what}: {path[:200]} is a folder; name the file the record is written to")
     out_dir(str(file.parent), f"{what} {path[:200]}: its folder")
+    try:
+        refuse_if_busy(file)  # a second ttt-sm on the same record: refused now, not after building the robot
+    except RecordBusyError as exc:
+        raise CliError(f"{what} {exc}") from None
     return file
 
 

@@ -92,7 +92,7 @@ def cmd_debug(args: argparse.Namespace) -> int:
     max_run = DEFAULT_MAX_RUN_S if args.max_run is None else args.max_run
     if not (math.isfinite(max_run) and max_run > 0):
         raise CliError(f"--max-run must be a positive number of seconds, got {args.max_run}")
-    trace_path = trace_file(args.trace) if args.trace else None  # refused now if it cannot be written
+    trace_path = trace_file(args.trace) if args.trace is not None else None  # refused now if it cannot be written
     params = load_arm(getattr(args, "params", None))
     try:
         q_start = parse_start(args.start) if args.start else None
@@ -120,6 +120,8 @@ def cmd_debug(args: argparse.Namespace) -> int:
         if conn is not None:
             conn.close()
     dbg.end_trace("finished", errors=shell.errors)
+    if dbg.trace_failure is not None:  # the one line at the end: which file, why, what to do
+        raise dbg.trace_failure
     return status
 
 

@@ -176,6 +176,8 @@ def cmd_gui(args: argparse.Namespace) -> int:
             conn.close()
     dbg.end_trace("finished")  # nothing if the session ended it already
     print("ttt-sm gui: stopped", flush=True)
+    if dbg.trace_failure is not None:  # the session went on without its trace: the last line says which, why
+        raise dbg.trace_failure
     return 0
 
 

@@ -26,6 +26,7 @@ import argparse
 import sys
 from typing import Any
 
+from ..files import write_atomic
 from ..scenario.errors import ScenarioError
 from ..scenario.generate import STRATEGIES
 from ..scenario.loader import load_scenario, scenario_files
@@ -222,7 +223,7 @@ def _suggest(report: RunReport, params: Any, folder: str) -> list[dict[str, Any]
             if key not in written:
                 path = Path(folder) / file_name(scenario, len(written) + 1)
                 command = f"ttt-sm scenario run ... --coverage --suggest {folder}"
-                path.write_text(to_yaml(scenario, command), encoding="utf-8")
+                write_atomic(path, to_yaml(scenario, command))
                 written[key] = str(path)
             out.append({"chart": cov.chart, "transition": label, "file": written[key], "reason": None})
     return out

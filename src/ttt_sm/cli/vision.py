@@ -86,12 +86,14 @@ def _picture_path(path: str, what: str) -> Path:
 
 
 def _write_picture(path: Path, image: Any, what: str) -> None:
+    from ..files import write_png
+
     try:
-        ok = cv2.imwrite(str(path), image)
-    except cv2.error:
-        ok = False
-    if not ok:
-        raise VisionError(f"{what} {str(path)!r}: could not write the picture (does the folder exist?)")
+        write_png(path, image)  # whole, or not there (a full disk: the error names the file)
+    except (ValueError, cv2.error):
+        raise VisionError(f"{what} {str(path)!r}: could not encode the picture") from None
+    except FileNotFoundError:
+        raise VisionError(f"{what} {str(path)!r}: could not write the picture (does the folder exist?)") from None
 
 
 def _fail(exc: Exception) -> int:

@@ -211,6 +211,12 @@ class Debugger:
         return self.watch.trace
 
     @property
+    def trace_failure(self) -> OSError | None:
+        """Why the trace file stopped before the session's end (the disk full), or None: the file holds
+        whole lines only, the session goes on with the transitions in memory."""
+        return self.watch.trace_failure
+
+    @property
     def state_history(self) -> Timeline:
         """When each chart's states were entered and left (see :meth:`~.watch.ChartWatch.timeline`)."""
         return self.watch.state_history

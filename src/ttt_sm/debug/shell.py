@@ -71,6 +71,7 @@ class DebugShell(cmd.Cmd):
         self._progress_shown = False
         #: The command running now (None between commands): where an interrupted session stood.
         self.command: str | None = None
+        self._trace_failure_told = False
 
     # -- plumbing -----------------------------------------------------------------
 
@@ -99,6 +100,11 @@ class DebugShell(cmd.Cmd):
         except Exception as exc:  # a bug in a chart action: say it, keep the session
             self.error(f"{type(exc).__name__}: {exc}")
         self.command = None
+        failure = self.dbg.trace_failure
+        if failure is not None and not self._trace_failure_told:  # once: the trace file stopped (a full disk)
+            self._trace_failure_told = True
+            self.error(f"the trace file {failure.filename} stopped: {failure.strerror}; the session goes on,"
+                       " the newest transitions in memory (trace save FILE elsewhere keeps them)")
         return done
 
     def emptyline(self) -> bool:
@@ -292,6 +298,10 @@ class DebugShell(cmd.Cmd):
         """trace [N]: the last N transitions (default 10); trace save FILE: all kept, as JSON Lines."""
         words = arg.split()
         if words and words[0] == "save":
+            try:
+                words = shlex.split(arg)  # a quoted name: '' is an empty name, not a file called ''
+            except ValueError as exc:
+                raise DebugError(f"trace save: {exc} in {arg!r}") from None
             if len(words) != 2:
                 raise DebugError("trace save: expected one file name, e.g. trace save out/trace.jsonl")
             path = self.dbg.save_trace(words[1])

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ..app.robot import Robot
+from ..files import write_atomic
 from ..runtime import TickChart
 from ..runtime.errors import GraphvizMissingError
 from ..runtime.export import render_active
@@ -51,7 +52,8 @@ class ChartWatch:
     def attach(self, robot: Robot) -> None:
         """Watch a robot's charts from its power-on: a new trace and timeline, the listeners on every chart."""
         self.robot = robot
-        self.trace = Trace(sink=self.trace_file, limit=self.trace_keep)
+        # a full disk stops the trace file, not the session (trace_failure says so)
+        self.trace = Trace(sink=self.trace_file, limit=self.trace_keep, keep_going=True)
         self.state_history = Timeline()
         for chart in robot.charts.values():
             chart.add_listener(self.trace, *self._listeners)
@@ -135,10 +137,7 @@ class ChartWatch:
             raise DebugError(str(exc)) from None
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            if isinstance(picture, bytes):
-                path.write_bytes(picture)
-            else:
-                path.write_text(picture, encoding="utf-8")
+            write_atomic(path, picture)
         except OSError as exc:
             raise DebugError(f"diagram: cannot write {str(path)!r}: {exc.strerror or exc}") from None
         return path
@@ -182,6 +181,8 @@ class ChartWatch:
         happened; :attr:`trace.dropped <ttt_sm.runtime.listeners.Trace.dropped>`
         says how many older ones were let go (the trace file has them).
         """
+        if not str(path).strip():
+            raise DebugError("trace save: the file name is empty; e.g. trace save out/trace.jsonl")
         try:
             return self.trace.write_jsonl(path)
         except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
@@ -196,14 +197,26 @@ class ChartWatch:
     def mark(self, event: str, **data: Any) -> None:
         """A line in the trace file (if any) saying what the session did here (a replay, a start over)."""
         if self.trace_file is not None:
-            self.trace_file.add({"event": event, **self.where_now(), **data})
+            try:
+                self.trace_file.add({"event": event, **self.where_now(), **data})
+            except OSError as exc:  # the disk is full: the trace file stops (trace_failure), the session goes on
+                self.trace.sink_error, self.trace.sink = exc, None
+
+    @property
+    def trace_failure(self) -> OSError | None:
+        """Why the trace file stopped before the session's end (the disk full: it holds whole lines only), or
+        None."""
+        return self.trace_file.failed if self.trace_file is not None else None
 
     def end_trace(self, how: str = "finished", **data: Any) -> Path | None:
         """End the trace file (if any) with ``how`` (``finished``, ``interrupted``, ``error``) and where
         the session stood; its path.  Only the first call writes."""
         if self.trace_file is None:
             return None
-        self.trace_file.end(how, **data, **self.where_now(), transitions=self.trace.count)
+        try:
+            self.trace_file.end(how, **data, **self.where_now(), transitions=self.trace.count)
+        except OSError:  # the disk full at the last line: the file holds whole lines, trace_failure says why
+            pass
         return self.trace_file.path
 
 

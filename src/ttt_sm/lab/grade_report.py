@@ -16,11 +16,13 @@ from __future__ import annotations
 
 import csv
 import html
+import io
 import re
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
+from ..files import write_atomic
 from ..runtime.jsonable import dumps
 from .grade import RESULTS, STATUSES, read_results
 
@@ -87,14 +89,15 @@ def summary(exercise: str, results: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def write_csv(path: Path, results: list[dict[str, Any]], names: list[str]) -> None:
-    with path.open("w", encoding="utf-8", newline="") as f:
-        out = csv.writer(f)
-        out.writerow(["student", "status", "score", "total", "passed", *names, "error"])
-        for r in results:
-            by_name = {c["name"]: c["passed"] for c in r.get("checks", [])}
-            cells = ["" if n not in by_name else "pass" if by_name[n] else "fail" for n in names]
-            out.writerow([r["student"], r["status"], r["score"], r["total"], "yes" if r["passed"] else "no",
-                          *cells, r.get("error", "")])
+    f = io.StringIO(newline="")  # the whole table, then written whole (write_atomic)
+    out = csv.writer(f)
+    out.writerow(["student", "status", "score", "total", "passed", *names, "error"])
+    for r in results:
+        by_name = {c["name"]: c["passed"] for c in r.get("checks", [])}
+        cells = ["" if n not in by_name else "pass" if by_name[n] else "fail" for n in names]
+        out.writerow([r["student"], r["status"], r["score"], r["total"], "yes" if r["passed"] else "no",
+                      *cells, r.get("error", "")])
+    write_atomic(path, f.getvalue())
 
 
 _STYLE = """
@@ -202,6 +205,6 @@ def build_reports(folder: Path) -> dict[str, Any]:
     write_csv(folder / "grades.csv", results, names)
     report = {**summary(exercise, results), "checks": names, "shared_failures": shared_failures(results),
               "transitions": transition_heat(results), "results": results}
-    (folder / "report.json").write_text(dumps(report, indent=2) + "\n", encoding="utf-8")
-    (folder / "report.html").write_text(render_html(exercise, results, names), encoding="utf-8")
+    write_atomic(folder / "report.json", dumps(report, indent=2) + "\n")
+    write_atomic(folder / "report.html", render_html(exercise, results, names))
     return report

@@ -81,6 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--params", default=None, help="the arm's parameter file (default: the packaged one)")
     args = parser.parse_args(argv)
     # imported before the limit: the libraries' own mappings are not the student's to pay for
+    from ..files import write_atomic
     from ..runtime.jsonable import dumps
     from . import checks  # noqa: F401
 
@@ -96,7 +97,7 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # the student's code: whatever it raises is their result, in one line
         result = {"status": "crashed", "error": f"{type(exc).__name__}: {' '.join(str(exc).split())[:500]}"}
     del reserve
-    args.result.write_text(dumps(result), encoding="utf-8")
+    write_atomic(args.result, dumps(result))
     return 0
 
 

@@ -30,6 +30,7 @@ from pathlib import Path
 
 from statemachine import StateChart
 
+from ..files import write_atomic
 from .diagram import active_ids, chart_class, to_markdown, to_mermaid
 from .dot import WHOLE, View, to_dot, views
 from .errors import GraphvizMissingError
@@ -211,7 +212,7 @@ def export_chart(chart: Chart, out_dir: str | Path, formats: Sequence[str] = FOR
     written = []
     for name, (_hash, produce) in _expected(chart, formats).items():
         path = out / name
-        path.write_bytes(produce())
+        write_atomic(path, produce())
         written.append(path)
     return written
 
@@ -271,10 +272,10 @@ def export_all(charts: Iterable[Chart], out_dir: str | Path, formats: Sequence[s
     for extra in extras:
         for name, (_hash, produce) in _extra_expected(extra, formats).items():
             path = Path(out_dir) / name
-            path.write_bytes(produce())
+            write_atomic(path, produce())
             written.append(path)
     index = Path(out_dir) / "index.md"
-    index.write_text(index_page(charts, formats, extras), encoding="utf-8")
+    write_atomic(index, index_page(charts, formats, extras))
     return written + [index]
 
 

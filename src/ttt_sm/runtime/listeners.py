@@ -20,6 +20,7 @@ from typing import IO, Any, overload
 from statemachine import StateChart
 from statemachine.transition import Transition
 
+from ..files import write_atomic
 from .jsonable import dumps, jsonable
 from .structure import TICK_EVENT_NAME, TICK_EVENT_PREFIX, build_structure, states_entered_by
 
@@ -113,6 +114,10 @@ class Trace:
         If given, each record is also written to it as one JSON line when it
         happens, and flushed, so a long run keeps its whole trace on disk
         (a :class:`~.recordfile.RecordFile`) without holding it in memory.
+        A write that fails (the disk full) raises from the chart's step,
+        which ends a run; with ``keep_going`` the sink is let go instead:
+        the charts run on, :attr:`sink_error` says why, the records are kept
+        in memory still (the debugger's and the cockpit's sessions).
     keep : bool
         Keep the records in :attr:`records`.
     limit : int, optional
@@ -120,12 +125,16 @@ class Trace:
         still counts them all.  None: keep every record.
     """
 
-    def __init__(self, sink: IO[str] | Any | None = None, keep: bool = True, limit: int | None = None) -> None:
+    def __init__(self, sink: IO[str] | Any | None = None, keep: bool = True, limit: int | None = None,
+                 keep_going: bool = False) -> None:
         self.records: list[TraceRecord] | KeptRecords = [] if limit is None else KeptRecords(limit)
         self.sink = sink
         self.keep = keep
         #: Every record this trace has seen, kept or not.
         self.count = 0
+        #: Why the sink was let go (an ``OSError`` writing it: the disk full), or None.
+        self.sink_error: OSError | None = None
+        self.keep_going = keep_going
 
     @property
     def dropped(self) -> int:
@@ -165,17 +174,20 @@ class Trace:
         if self.keep:
             self.records.append(record)
         if self.sink is not None:
-            self.sink.write(record.to_json() + "\n")
-            self.sink.flush()
+            try:
+                self.sink.write(record.to_json() + "\n")
+                self.sink.flush()
+            except OSError as exc:
+                self.sink_error, self.sink = exc, None
+                if not self.keep_going:
+                    raise
 
     def write_jsonl(self, path: str | Path) -> Path:
-        """Write the kept records to ``path``, one JSON object per line."""
+        """Write the kept records to ``path``, one JSON object per line: the whole file or, if the disk
+        refuses it, the file as it was (:func:`~.files.write_atomic`)."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        with path.open("w", encoding="utf-8") as f:
-            for record in self.records:
-                f.write(record.to_json() + "\n")
-        return path
+        return write_atomic(path, "".join(record.to_json() + "\n" for record in self.records))
 
     @staticmethod
     def read_jsonl(path: str | Path) -> list[TraceRecord]:

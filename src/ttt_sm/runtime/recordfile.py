@@ -14,7 +14,15 @@ goes through :class:`RecordFile`:
   "message": ...}``, with where the run stood (docs/reliability.md, "Records
   that survive").  A record whose last line is not an ending was cut short
   by something no program can answer (``kill -9``, the power): every line it
-  has still parses.
+  has still parses;
+- a line is written whole or not at all (:class:`~.files.LineSink`): when
+  the disk is full the file is cut back to its last whole line, an ending
+  ``{"event": "error", "message": "...No space left on device..."}`` is
+  written if the space it freed takes it, and the write raises
+  :class:`~.files.RecordWriteError` naming the file (:attr:`RecordFile.failed`
+  keeps it); later writes do nothing;
+- one process writes a record at a time: a second one is refused at once
+  (:class:`~.files.RecordBusyError`).
 
 :func:`read_lines` reads any such record back, and names the line that does
 not parse, if one does not.
@@ -25,8 +33,9 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
+from ..files import LineSink, RecordWriteError
 from .jsonable import dumps
 
 #: The events that end a record.
@@ -44,10 +53,12 @@ class RecordFile:
         """Start the file anew, or with ``append`` go on after the lines it holds."""
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._file: IO[str] | None = self.path.open("a" if append else "w", encoding="utf-8")
+        self._file: LineSink | None = LineSink(self.path, append=append)
         self.lines = 0
         #: The ending written (``"finished"``, ``"interrupted"``, ``"error"``), once :meth:`end` ran.
         self.ended: str | None = None
+        #: Why the record stopped before its end (the disk full, say), or None.
+        self.failed: RecordWriteError | None = None
 
     @property
     def closed(self) -> bool:
@@ -58,16 +69,37 @@ class RecordFile:
         self.write(dumps(line) + "\n")
 
     def write(self, text: str) -> None:
-        """Append text made of whole JSON lines, and flush it (a :class:`~.listeners.Trace` sink)."""
+        """Append text made of whole JSON lines, on disk when this returns (a :class:`~.listeners.Trace` sink).
+
+        All of it or none: a write the disk refuses leaves the record at its
+        last whole line, ended by an ``error`` line if that still fits, the
+        record closed, and raises :class:`~.files.RecordWriteError` (also
+        kept as :attr:`failed`).
+        """
         if self._file is None:
             return
-        self._file.write(text)
-        self._file.flush()
+        try:
+            self._file.write(text)
+        except RecordWriteError as exc:
+            self.failed = exc
+            self._end_after_failure(exc)
+            raise
         self.lines += text.count("\n")
 
+    def _end_after_failure(self, exc: RecordWriteError) -> None:
+        """The record's last line says the disk refused it, if the space freed by the cut takes that line."""
+        assert self._file is not None
+        try:
+            self._file.write(dumps({"event": "error", "message": f"the record could not be written on: "
+                                    f"{exc.strerror}", "errno": exc.errno}) + "\n")
+            self.ended = "error"
+            self.lines += 1
+        except RecordWriteError:
+            pass
+        self.close()
+
     def flush(self) -> None:
-        if self._file is not None:
-            self._file.flush()
+        """Nothing to do: each :meth:`write` is on disk when it returns (a text sink's method)."""
 
     def end(self, how: str, **data: Any) -> None:
         """Write the ending line ``{"event": how, ...data}`` and close the file; only the first call writes."""

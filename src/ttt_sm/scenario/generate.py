@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..files import write_atomic
 from ..runtime import TickChart
 from ..runtime.jsonable import dumps
 from ..runtime.structure import TransitionInfo
@@ -345,7 +346,7 @@ def write(generated: Generated, out_dir: Path, command: str) -> list[Path]:
     paths = []
     for k, scenario in enumerate(generated.scenarios, 1):
         path = out_dir / file_name(scenario, k)
-        path.write_text(to_yaml(scenario, command), encoding="utf-8")
+        write_atomic(path, to_yaml(scenario, command))
         paths.append(path)
     generated.files = [str(p) for p in paths]
     return paths

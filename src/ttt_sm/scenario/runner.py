@@ -26,6 +26,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from ..files import RecordWriteError
 from ..params import ArmParams
 from ..runtime import TickChart, states_entered_by
 from ..runtime.conditions import UNITS, ExprError, Expression, Ref
@@ -313,6 +314,8 @@ class _Run:
             except ExprError as exc:
                 self.failures.append(Failure(step.where, f"{step.kind}: {exc}"))
                 return
+            except RecordWriteError:  # the disk refused the trace: the run ends there, the scenario did not fail
+                raise
             except Exception as exc:  # a chart's bug or a robot refusal: report it where it happened
                 self.failures.append(Failure(step.where, f"{step.kind}: {type(exc).__name__}: {exc}"))
                 return

@@ -115,6 +115,12 @@ MarkedLoader.yaml_implicit_resolvers = {
     for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
 }
 MarkedLoader.add_implicit_resolver(_BOOL, re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF"))
+# Numbers in exponent form as YAML 1.2 reads them: 1e12, 2.5e-3, 1.0e12.  YAML 1.1 (PyYAML) wants a dot
+# and a signed exponent (1.0e+12), so `timeout_s: 1e12` was the text '1e12' and its message "expected a
+# number, got text" named the wrong problem.
+MarkedLoader.add_implicit_resolver("tag:yaml.org,2002:float",
+                                   re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$"),
+                                   list("-+0123456789."))
 
 
 def _cut(text: Any, limit: int = 40) -> str:

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..files import save_figure
 from .whiteboard import HAND_INK_BGR, ROBOT_INK_BGR, Region, Whiteboard
 
 if TYPE_CHECKING:
@@ -172,8 +173,7 @@ def save_board_picture(board: Whiteboard, path: str | Path, title: str, subtitle
     """Write :func:`board_figure` to a PNG file; returns the path."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    board_figure(board, title, subtitle).savefig(p)
-    return p
+    return save_figure(board_figure(board, title, subtitle), p)
 
 
 __all__ = ["crop_region", "board_figure", "save_board_picture", "PX_PER_MM", "SCALE_BAR_MM"]

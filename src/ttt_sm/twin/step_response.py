@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..files import save_figure
 from ..params import ArmParams
 from .gains import Gains, check_drive
 from .sim import ArmSim
@@ -203,8 +204,7 @@ def plot_step(m: StepMetrics, path: Path) -> Path:
     """Write :func:`step_figure` of a step response to a PNG file; returns the path."""
     fig = step_figure(m)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    return path
+    return save_figure(fig, path)
 
 
 #: The Bode plot :func:`tune_report` writes beside the step plots.

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import control as ct
 import numpy as np
 
+from ..files import save_figure
 from ..params import ArmParams, ParameterError
 from .gains import DriveGains, Gains, check_drive, max_joint_speed, speed_filter_alpha
 
@@ -346,8 +347,7 @@ def plot_loops(params: ArmParams, gains: Gains, path: Path) -> Path:
     """Write :func:`loops_figure` to a PNG file; returns the path."""
     fig = loops_figure(params, gains)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    return path
+    return save_figure(fig, path)
 
 
 __all__ = [

@@ -81,8 +81,68 @@ def check_reach(params: ArmParams) -> None:
         raise ParameterError(f"{params.source}: {problem}")
 
 
+#: The slowest joint speed the drive-initialisation charts tell from a stall, rad/s: DriveInit1's
+#: ``still_speed`` (a test holds the two equal; charts and twin import nothing of each other).
+INIT_STILL_SPEED_RAD_S = 0.25
+#: Encoder counts the joint must turn per chart tick at that speed, at least: the charts compare each tick's
+#: encoder step with ``still_speed * tick``, and a step is known to within one count, so one count must be at
+#: most a quarter of the threshold.  Below it a drive under way shows ticks of no count, read as a stall: a
+#: gear ratio of 1 (0.16 counts) or a control rate of 20 kHz (1.2 counts) never initialised.
+INIT_COUNTS_PER_TICK = 4.0
+#: The largest product of the gear spring's natural frequency and the plant's sub-step (rad): the
+#: semi-implicit sub-step of the twin (docs/model.md) is stable below 2 and loses little amplitude below 0.5.
+PLANT_OMEGA_H = 0.5
+
+
+def drive_problem(params: ArmParams) -> str | None:
+    """Why a drive's encoder, gear and the control rate cannot work together, or None (docs/parameters.md).
+
+    - The initialisation charts must see a drive turning at
+      :data:`INIT_STILL_SPEED_RAD_S` as at least :data:`INIT_COUNTS_PER_TICK`
+      encoder counts per chart tick: ``0.25 rad/s * chart_dt * encoder_counts
+      * gear_ratio / 2 pi``.
+    - The twin's gear spring must be resolved by its sub-step ``h = dt /
+      SUBSTEPS``: ``omega * h <= 0.5`` with ``omega**2 = gear_stiffness * (1 /
+      load_inertia + 1 / (gear_ratio**2 * rotor_inertia))``.
+    """
+    from .plant import SUBSTEPS
+
+    c = params.control
+    h = c.dt / SUBSTEPS
+    for i, d in enumerate(params.drives, start=1):
+        where = f"[drive.{i}]"
+        counts = INIT_STILL_SPEED_RAD_S * c.chart_dt * d.encoder_counts * d.gear_ratio / (2 * math.pi)
+        if counts < INIT_COUNTS_PER_TICK:
+            need = INIT_COUNTS_PER_TICK * 2 * math.pi / (INIT_STILL_SPEED_RAD_S * c.chart_dt * d.encoder_counts)
+            return (f"{where} gear_ratio = {d.gear_ratio:g}: the encoder shows {counts:.2g} counts per chart tick at"
+                    f" {INIT_STILL_SPEED_RAD_S:g} rad/s, the initialisation charts need >= {INIT_COUNTS_PER_TICK:g}"
+                    f" to tell a turning drive from a stalled one: gear_ratio >= {need:.3g} with encoder_counts ="
+                    f" {d.encoder_counts} and a chart tick of {c.chart_dt * 1000:g} ms ([control] rate_hz /"
+                    f" chart_divider) (docs/parameters.md, The drives and the control rate)")
+        omega = math.sqrt(d.gear_stiffness * (1 / d.load_inertia + 1 / (d.gear_ratio**2 * d.rotor_inertia)))
+        if omega * h > PLANT_OMEGA_H:
+            lowest = (PLANT_OMEGA_H / h) ** 2 / d.gear_stiffness - 1 / d.load_inertia
+            need_text = (f"gear_ratio >= {math.sqrt(1 / (d.rotor_inertia * lowest)):.3g}" if lowest > 0 else
+                         "a softer gear_stiffness or a higher [control] rate_hz")
+            return (f"{where} gear_ratio = {d.gear_ratio:g}: the gear spring's natural frequency"
+                    f" ({omega / (2 * math.pi):.4g} Hz) is too fast for the twin's step of {h * 1e6:g} us"
+                    f" (omega * h = {omega * h:.2g} > {PLANT_OMEGA_H:g}): {need_text} with gear_stiffness ="
+                    f" {d.gear_stiffness:g} and rotor_inertia = {d.rotor_inertia:g}"
+                    " (docs/parameters.md, The drives and the control rate)")
+    return None
+
+
+def check_drives(params: ArmParams) -> None:
+    """Raise :class:`~ttt_sm.params.ParameterError` naming the file if :func:`drive_problem` finds one."""
+    problem = drive_problem(params)
+    if problem:
+        raise ParameterError(f"{params.source}: {problem}")
+
+
 def load_arm(path: str | Path | None = None) -> ArmParams:
-    """:func:`~ttt_sm.params.load_params` (default: the packaged file), then :func:`check_reach`."""
+    """:func:`~ttt_sm.params.load_params` (default: the packaged file), then :func:`check_drives` and
+    :func:`check_reach`."""
     params = load_params(path)
+    check_drives(params)
     check_reach(params)
     return params

@@ -7,6 +7,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from ttt_sm.files import write_png
 from ttt_sm.params import ArmParams
 
 from .detection import CELL_MARGIN, CELL_PX, INK_LEVEL, Detection, ink_image, rectify, working_image
@@ -186,10 +187,7 @@ def doc_pictures(out_dir: str | Path, params: ArmParams | None = None) -> list[P
     }
     paths = []
     for name, img in pictures.items():
-        p = out / name
-        if not cv2.imwrite(str(p), img, [cv2.IMWRITE_PNG_COMPRESSION, 9]):
-            raise OSError(f"{p}: could not write the picture")
-        paths.append(p)
+        paths.append(write_png(out / name, img, [cv2.IMWRITE_PNG_COMPRESSION, 9]))
     return paths
 
 

@@ -274,7 +274,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                 await asyncio.to_thread(lab.stop)
             if manage_session:
                 saved = await asyncio.to_thread(session.stop)
-                if saved is not None:
+                if saved is not None and session.debugger.trace_failure is None:  # else ttt-sm gui says why
                     print(f"ttt-sm gui: trace saved to {saved} ({session.debugger.trace.count}"
                           " transitions)", flush=True)
 

@@ -164,6 +164,8 @@ class Session:
         #: How the session ends, for the trace file's last line: ``("interrupted", {"signal": "SIGTERM"})``
         #: when a signal stops the server (``ttt-sm gui`` sets it), else finished (or the error).
         self.ending: tuple[str, dict[str, Any]] | None = None
+        #: Why tracing stopped (``gui --trace`` on a full disk: the file keeps whole lines), told to every page.
+        self.trace_stopped: str | None = None
         #: The scenario runs for the diagrams' coverage colours (web/coverage.py).
         self.coverage = CoverageRuns(self.params, self.chart_classes, scenarios or {}, self.send_to, self.broadcast)
         #: The Operational page's side (web/operate.py): its graphs' samples, Trigger, the precision.
@@ -227,7 +229,10 @@ class Session:
         gc.unfreeze()
         game = self.debugger.game
         if game is not None:
-            game.close()  # its record ends (as interrupted, unless the game ended)
+            try:
+                game.close()  # its record ends (as interrupted, unless the game ended)
+            except OSError:  # the disk refused the record's last line: it ends at its last whole line
+                log.exception("the game's record could not be ended")
         if self.camera_feed is not None:
             self.camera_feed.stop()
         if self.debugger.trace_file is not None:
@@ -278,6 +283,8 @@ class Session:
         self.send_to(cid, self.frames.frame(True, self._status()))
         if self.coverage.shown is not None:
             self.send_to(cid, {"type": "coverage", **self.coverage.shown})
+        if self.trace_stopped is not None:
+            self.send_to(cid, {"type": "error", "id": None, "command": None, "error": self.trace_stopped})
         with self._lock:
             client.joined, client.page = True, page
 
@@ -427,11 +434,21 @@ class Session:
             self.note_stop(reason)
 
     def _flush(self) -> None:
+        if self.trace_stopped is None and self.debugger.trace_failure is not None:
+            self._trace_stopped(self.debugger.trace_failure)
         if self.camera_feed is not None and self.camera_feed.grabs != self._feed_grabs:
             self._feed_grabs = self.camera_feed.grabs
             self._dirty = True
         if self._dirty and time.perf_counter() - self._last_frame_at >= self.frame_period * 0.999:
             self.publish()
+
+    def _trace_stopped(self, failure: OSError) -> None:
+        """The trace file could not be written on (the disk full): it stops, whole lines only; the session goes
+        on, and every page is told once (a page that joins later, when it joins)."""
+        self.trace_stopped = (f"tracing stopped: {failure.filename}: {failure.strerror}; the session goes on"
+                              " without a trace file (free some space and start again to trace)")
+        log.error("%s", self.trace_stopped)
+        self.broadcast({"type": "error", "id": None, "command": None, "error": self.trace_stopped})
 
     def _install_clock(self) -> None:
         self.debugger.robot.sched.set_clock(_SessionClock(self))

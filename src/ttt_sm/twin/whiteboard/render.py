@@ -14,6 +14,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from ... import files
 from .errors import WhiteboardError
 from .raster import InkRaster, Region
 
@@ -136,6 +137,7 @@ def draw_grid(img: np.ndarray, rx0: float, ry0: float, px_per_m: float) -> None:
 def write_png(image: np.ndarray, path: str | Path) -> Path:
     """Write an image to a PNG file; returns the path."""
     p = Path(path)
-    if not cv2.imwrite(str(p), image):
-        raise WhiteboardError(f"{p}: could not write the PNG (does the folder exist?)")
-    return p
+    try:
+        return files.write_png(p, image)  # whole, or not there (a full disk)
+    except ValueError:
+        raise WhiteboardError(f"{p}: could not encode the PNG") from None

@@ -88,7 +88,8 @@ def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_ha
     # the picture's title and the terminal's line say who won in words, not a bare symbol
     words = {"O": "the robot (O) won", "X": "the person (X) won"}[report["outcome"]]
     assert titles[0].startswith(f"The whiteboard at the end of the game: {words},"), titles
-    assert f"result: {words}; erasing and turning off" in said, said
+    assert any(line.startswith(f"result: {words}; erasing and turning off; the board as the game ended:\n")
+               for line in said), said
     assert Path(files["board_png"]).name == "board_final.png"
     assert Path(files["board_erased_png"]).name == "board_erased.png"
     # the person's black ink and the robot's dark blue are on the final board, not on the erased one

@@ -198,6 +198,17 @@ class ControlParams:
         return self.chart_divider / self.rate_hz
 
 
+#: The cascade gains ``[tuning] preset`` may name (docs/tuning.md, "The thesis' tuning beside ours").
+TUNING_PRESETS = ("ours", "thesis")
+
+
+@dataclass(frozen=True)
+class Tuning:
+    """Which gains the cascades run: ``"ours"`` (designed, docs/tuning.md) or ``"thesis"`` (hand-set as the thesis')."""
+
+    preset: str = "ours"
+
+
 @dataclass(frozen=True)
 class IKParams:
     """Levenberg-Marquardt damped least squares settings (eq. 3.35)."""
@@ -275,6 +286,7 @@ class ArmParams:
     ik: IKParams
     safety: SafetyParams
     drives: tuple[DriveParams, DriveParams, DriveParams]
+    tuning: Tuning = Tuning()
     source: str = "<built-in>"
 
     @property
@@ -485,6 +497,20 @@ def _check(params: ArmParams, where: _Where) -> None:
                                      f" limits")
 
 
+def _tuning(raw: Any, where: _Where) -> Tuning:
+    """The optional ``[tuning]`` table: ``preset``, one of :data:`TUNING_PRESETS` (default "ours")."""
+    if not isinstance(raw, dict):
+        raise ParameterError(f"{where.at('tuning')}: [tuning] must be a table")
+    unknown = sorted(set(raw) - {"preset"})
+    if unknown:
+        raise ParameterError(f"{where.at('tuning', str(unknown[0]))}: [tuning] has an unknown key {_short(unknown[0])}")
+    preset = raw.get("preset", "ours")
+    if preset not in TUNING_PRESETS:
+        raise ParameterError(f"{where.at('tuning', 'preset')}: [tuning] preset must be one of"
+                             f" {', '.join(TUNING_PRESETS)}, got {_short(preset)}")
+    return Tuning(preset=preset)
+
+
 def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> ArmParams:
     """Build :class:`ArmParams` from a parsed TOML document; `where` names it in errors.
 
@@ -494,7 +520,7 @@ def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> A
     sections = {"geometry": Geometry, "board": Board, "pen": Pen, "sponge": Sponge,
                 "servo": Servo, "masses": Masses, "control": ControlParams, "ik": IKParams,
                 "safety": SafetyParams}
-    unknown = sorted(set(data) - set(sections) - {"drive"})
+    unknown = sorted(set(data) - set(sections) - {"drive", "tuning"})
     if unknown:
         raise ParameterError(f"{where}: unknown section(s) {', '.join(str(u)[:30] for u in unknown[:5])}")
     built: dict[str, Any] = {}
@@ -506,7 +532,8 @@ def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> A
     if not isinstance(drives_raw, dict) or sorted(drives_raw) != ["1", "2", "3"]:
         raise ParameterError(f"{where}: needs exactly the tables [drive.1], [drive.2], [drive.3]")
     drives = tuple(_section(drives_raw[k], DriveParams, f"drive.{k}", at) for k in ("1", "2", "3"))
-    params = ArmParams(drives=drives, source=where, **built)  # type: ignore[arg-type]
+    params = ArmParams(drives=drives, tuning=_tuning(data.get("tuning", {}), at), source=where,
+                       **built)  # type: ignore[arg-type]
     _check(params, at)
     return params
 

@@ -204,7 +204,15 @@ def cmd_tune(args: argparse.Namespace) -> int:
     out = out_dir(args.out)
     params = load_arm(args.params)
     rows = tune_report(params, out)
-    emit(rows, args.json, report_text(rows))
+    if args.preset != "thesis":
+        emit(rows, args.json, report_text(rows))
+        return 0
+    # the thesis' tuning beside ours (docs/tuning.md): both tables, both sets of plots
+    thesis = tune_report(params, out, "thesis")
+    emit({"ours": rows, "thesis": thesis}, args.json,
+         "ours (designed from the parameter file):\n" + report_text(rows)
+         + "\n\nthesis (its structure, gains set by hand to reproduce figs. 3.7-3.9; thesis at 0.5 s: 0.007,"
+           " 0.0035, 0.003 rad):\n" + report_text(thesis))
     return 0
 
 
@@ -547,6 +555,8 @@ def register(sub: Any) -> None:
     add_arm_option(sp)
     sp = add_command(sub, "tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
+    sp.add_argument("--preset", choices=["ours", "thesis"], default="ours",
+                    help="ours (default): the designed gains; thesis: the thesis' hand-set gains beside ours")
     sp = add_command(sub, "bench", cmd_bench, "measure the speed and quality targets")
     sp.add_argument("--only", default=None,
                     help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui,link;"

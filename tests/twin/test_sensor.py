@@ -45,3 +45,13 @@ def test_a_tilted_sensor_reads_the_motion_shortened_by_the_cosine():
     moved = s.position(s.distance(np.array([0.0, 0.25, 0.08])), z) - s.position(s.distance(
         np.array([0.0, 0.25, 0.03])), z)
     assert math.isclose(moved, 0.05 * math.cos(tilt), abs_tol=2e-9)
+
+
+def test_the_true_tool_is_the_arm_as_built_not_as_measured(params):
+    from ttt_sm.twin.kinematics import fk
+    from ttt_sm.twin.sim import ArmSim
+
+    sim = ArmSim(params)
+    q = sim.truth.q
+    assert np.allclose(sim.truth.tool_pose(), fk(q, params.true_geometry))
+    assert not np.allclose(sim.truth.tool_pose()[:3], fk(q, params.geometry)[:3], atol=2e-5)

@@ -7,8 +7,10 @@ tip leaves.  :func:`draw` commands one drawing through the Control chart
 (the field, an X, an O or the sine wave of section 3.5.3) and measures it:
 `rms_error_mm` / `max_error_mm` (true ink against the desired pen-down
 path), `fk_vs_true_max_mm` (what clearance and model error hide from the
-encoders), `closure_gap_mm` for an O, the longest pen-lift/lower tail, and
-the duration.  It writes the board picture (:mod:`ttt_sm.twin.board_picture`)
+encoders; split into `length_error_max_mm`, the measured link lengths
+against the arm as built, and `clearance_error_max_mm`, the rest),
+`closure_gap_mm` for an O, the longest pen-lift/lower tail, and the
+duration.  It writes the board picture (:mod:`ttt_sm.twin.board_picture`)
 and the path plot (:mod:`.path_plot`: the path seen from above, the pen's
 height, the error along the path and the Control chart's states over time;
 figs. 3.15-3.20).
@@ -49,6 +51,8 @@ class DrawRecord:
     t: list[float] = field(default_factory=list)
     desired: list[tuple[float, float, float]] = field(default_factory=list)
     fk_encoder: list[tuple[float, float, float]] = field(default_factory=list)
+    #: Forward kinematics of the same encoder angles with the arm's true lengths (``[as_built]``).
+    fk_as_built: list[tuple[float, float, float]] = field(default_factory=list)
     fk_true: list[tuple[float, float, float]] = field(default_factory=list)
     tip: list[tuple[float, float]] = field(default_factory=list)  # NaN while the pen is lifted
 
@@ -115,6 +119,7 @@ class RecordStage:
         rec.t.append(r.t)
         rec.desired.append((c.X_out, c.Y_out, c.Z_out))
         rec.fk_encoder.append(tuple(fk((q_enc[0], q_enc[1], q_enc[2], servo), g)[:3]))
+        rec.fk_as_built.append(tuple(fk((q_enc[0], q_enc[1], q_enc[2], servo), r.params.true_geometry)[:3]))
         rec.fk_true.append(tuple(self.truth.tool_pose()[:3]))
         contact = r.board.contact
         rec.tip.append(contact.tip_m if contact.pen_touching and contact.tip_m else (math.nan, math.nan))
@@ -140,6 +145,11 @@ class DrawResult:
     wall_time_s: float
     board_png: str | None = None
     plot_png: str | None = None
+    #: Of ``fk_vs_true_max_mm``, what the link lengths alone cause: FK of the encoder angles with the
+    #: measured lengths against FK with the true ones (``[as_built]``), largest while the pen touches, mm.
+    length_error_max_mm: float | None = None
+    #: And what is left: FK with the true lengths against the true tip (clearances, deflection, pen play), mm.
+    clearance_error_max_mm: float | None = None
 
 
 def _pen_down_runs(desired: np.ndarray, surface_z: float) -> list[np.ndarray]:
@@ -254,6 +264,9 @@ def measure(robot: Robot, rec: DrawRecord, kind: str, row: int, column: int, t0:
     fk_enc = np.asarray(rec.fk_encoder)[:, :2]
     touching = np.isfinite(tip[:, 0])
     fk_vs_true = np.hypot(*(fk_enc[touching] - tip[touching]).T) * 1e3 if touching.any() else np.zeros(1)
+    fk_built = np.asarray(rec.fk_as_built)[:, :2]
+    lengths = np.hypot(*(fk_enc[touching] - fk_built[touching]).T) * 1e3 if touching.any() else np.zeros(1)
+    clearance = np.hypot(*(fk_built[touching] - tip[touching]).T) * 1e3 if touching.any() else np.zeros(1)
     gap = None
     if kind == "O":
         gap = round(closure_gap_mm(board, c.x0, c.y0, c.R, tol_m=0.0005), 3)
@@ -266,6 +279,7 @@ def measure(robot: Robot, rec: DrawRecord, kind: str, row: int, column: int, t0:
         longest_tail_mm=round(float(tail), 3), ink_points=int(len(ink)),
         duration_s=round(robot.t - t0, 3), sim_time_s=round(robot.t, 3),
         wall_time_s=round(time.perf_counter() - wall0, 3),
+        length_error_max_mm=round(float(lengths.max()), 4), clearance_error_max_mm=round(float(clearance.max()), 4),
     )
 
 

@@ -73,6 +73,10 @@ SENSOR_STANDOFF_M = 0.07
 #: The three comparisons of section 3.5, by name: (minuend, subtrahend).
 COMPARISONS = {"desired_vs_fk": ("desired", "fk"), "fk_vs_sensor": ("fk", "sensor"),
                "desired_vs_sensor": ("desired", "sensor")}
+#: The two parts of FK vs sensor (item by item: ``fk - sensor = lengths + clearance``): the lengths
+#: forward kinematics assumes against the arm's true ones (``[geometry]`` vs ``[as_built]``: FK of the
+#: same encoder angles with each), and what is left (clearances, the gears' deflection, the sensor).
+PARTS = {"lengths": ("fk", "fk_as_built"), "clearance": ("fk_as_built", "sensor")}
 #: Which thesis figure each staircase reproduces (Y: section 3.5.2 says it matches X; no figure).
 THESIS_FIGURE = {("z", "small"): "3.15", ("z", "big"): "3.16", ("x", "small"): "3.17", ("x", "big"): "3.18"}
 
@@ -236,7 +240,11 @@ class StaircaseResult:
     stair_times: tuple[float, ...] = ()
 
     def report(self) -> dict[str, Any]:
-        """The result as plain data (no arrays): what ``--json`` prints."""
+        """The result as plain data (no arrays): what ``--json`` prints.
+
+        ``errors`` and ``summary`` hold the three comparisons of :data:`COMPARISONS` and the two parts
+        of FK vs sensor of :data:`PARTS`.
+        """
         return {
             "axis": self.axis, "steps": self.steps, "tuning": self.tuning, "step_mm": self.step_mm,
             "stairs": self.stairs, "hold_s": self.hold_s, "seed": self.seed, "thesis_figure": self.thesis_figure,
@@ -349,10 +357,12 @@ def run_staircase(params: ArmParams, axis: str, steps: str, tuning: str = "ours"
         "sensor": np.array([math.nan if v is None else v for v in rec.sensor]),
     }
     stair_times = [t_start + (k - first) * chart_dt for k in ticks]
-    errors = {name: step_errors(t, series[p] - series[m], stair_times, spec.hold_s)
-              for name, (p, m) in COMPARISONS.items()}
-    summary = {name: _summary(v) for name, v in errors.items()}
+    tg = params.true_geometry
     q_enc = np.asarray(rec.q_encoder)
+    series["fk_as_built"] = np.array([arm_chain_py(*q, tg.L1, tg.L2, tg.L3, tg.L4, tg.l_f)[a] for q in q_enc])
+    errors = {name: step_errors(t, series[p] - series[m], stair_times, spec.hold_s)
+              for name, (p, m) in {**COMPARISONS, **PARTS}.items()}
+    summary = {name: _summary(v) for name, v in errors.items()}
     bound = max(clearance_bound_m(params, q, e, sspec) for q in q_enc[:: max(1, len(q_enc) // 50)])
     result = StaircaseResult(
         axis=axis, steps=steps, tuning=tuning, step_mm=spec.step_m * 1e3, stairs=spec.count, hold_s=spec.hold_s,
@@ -379,6 +389,7 @@ def _with_reading(r: StaircaseResult) -> StaircaseResult:
     """The result with a short reading of what each difference is due to (the thesis' reading, ours)."""
     s = r.summary
     dfk, fks, ds = s["desired_vs_fk"], s["fk_vs_sensor"], s["desired_vs_sensor"]
+    lengths, clearance = s["lengths"], s["clearance"]
 
     def mm(v: float | None) -> str:
         return "no reading" if v is None else f"{v:.3f} mm"
@@ -389,9 +400,10 @@ def _with_reading(r: StaircaseResult) -> StaircaseResult:
         f"desired vs FK (controllers, inverse kinematics): dynamic up to {mm(dfk['max_dynamic_mm'])}, static up to"
         f" {mm(dfk['max_static_mm'])} -- the dynamic part is the controllers' lag behind the stairs ({lag}),"
         f" the static part what the controllers and the IK tolerance leave",
-        f"FK vs sensor (clearances, deflection, lengths): static up to {mm(fks['max_static_mm'])} against a bound of"
-        f" {r.clearance_bound_mm:.3f} mm from the clearances, the gears' deflection, one encoder count and the"
-        f" sensor",
+        f"FK vs sensor (clearances, deflection, lengths): static up to {mm(fks['max_static_mm'])}; of it the link"
+        f" lengths FK assumes against the arm as built {mm(lengths['max_static_mm'])}, and the rest"
+        f" {mm(clearance['max_static_mm'])} against a bound of {r.clearance_bound_mm:.3f} mm from the clearances,"
+        f" the gears' deflection, one encoder count and the sensor",
         f"desired vs sensor (overall): static up to {mm(ds['max_static_mm'])}, dynamic up to"
         f" {mm(ds['max_dynamic_mm'])}",
     ]
@@ -401,5 +413,5 @@ def _with_reading(r: StaircaseResult) -> StaircaseResult:
 
 
 __all__ = ["AXES", "STEP_KINDS", "STEP_M", "STAIRS", "HOLD_S", "STATIC_WINDOW_S", "DYNAMIC_WINDOW_S",
-           "COMPARISONS", "THESIS_FIGURE", "PrecisionError", "StaircaseSpec", "StairRecord", "StairRecorder",
+           "COMPARISONS", "PARTS", "THESIS_FIGURE", "PrecisionError", "StaircaseSpec", "StairRecord", "StairRecorder",
            "StepErrors", "StaircaseResult", "staircase_poses", "step_errors", "clearance_bound_m", "run_staircase"]

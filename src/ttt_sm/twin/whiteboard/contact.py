@@ -112,7 +112,7 @@ class BoardContact:
     """
 
     def __init__(self, params: ArmParams, raster: InkRaster, log: StrokeLog) -> None:
-        g, b = params.geometry, params.board
+        g, b = params.true_geometry, params.board  # the true pen: the arm as built
         self._L1, self._L2, self._L3, self._L4, self._lf = g.L1, g.L2, g.L3, g.L4, g.l_f
         self._surface = b.surface_z
         self._raster, self._log = raster, log

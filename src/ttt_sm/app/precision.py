@@ -40,7 +40,7 @@ import numpy as np
 
 from ..params import ArmParams, Tuning
 from ..sched.scheduler import PathStage, Signals
-from ..twin.kinematics import arm_chain_py, jacobian
+from ..twin.kinematics import arm_chain_py, fk, jacobian
 from ..twin.plant import gear_play, gravity_torques
 from ..twin.sensor import SensorMount, SensorSpec, TriangulationSensor
 from ..twin.truth import GroundTruth
@@ -359,7 +359,7 @@ def run_staircase(params: ArmParams, axis: str, steps: str, tuning: str = "ours"
     stair_times = [t_start + (k - first) * chart_dt for k in ticks]
     tg = params.true_geometry
     q_enc = np.asarray(rec.q_encoder)
-    series["fk_as_built"] = np.array([arm_chain_py(*q, tg.L1, tg.L2, tg.L3, tg.L4, tg.l_f)[a] for q in q_enc])
+    series["fk_as_built"] = np.array([fk(q, tg)[a] for q in q_enc])
     errors = {name: step_errors(t, series[p] - series[m], stair_times, spec.hold_s)
               for name, (p, m) in {**COMPARISONS, **PARTS}.items()}
     summary = {name: _summary(v) for name, v in errors.items()}

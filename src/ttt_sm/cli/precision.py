@@ -66,18 +66,21 @@ def _text(rep: dict[str, Any]) -> str:
     fig = f" (thesis fig. {rep['thesis_figure']})" if rep["thesis_figure"] else ""
 
     def mm(v: float | None) -> str:
-        return "    null" if v is None else f"{v:8.4f}"
+        return "null" if v is None else f"{v:.4f}"
 
+    names = {"desired_vs_fk": "desired - FK", "fk_vs_sensor": "FK - sensor", "desired_vs_sensor": "desired - sensor",
+             "lengths": "of it: lengths", "clearance": "of it: clearance"}
     lines = [f"staircase along {rep['axis'].upper()}, {rep['stairs']} {rep['steps']} stairs of {rep['step_mm']:g} mm,"
              f" tuning {rep['tuning']!r}{fig}", "",
-             f"{'stair':>5} " + " ".join(f"{n:>25}" for n in rep["errors"]),
-             f"{'':>5} " + " ".join(f"{'static mm':>12} {'dynamic mm':>12}" for _ in rep["errors"])]
+             f"{'':>5} " + " ".join(f"{names.get(n, n):>19}" for n in rep["errors"]),
+             f"{'stair':>5} " + " ".join(f"{'static':>9} {'dynamic':>9}" for _ in rep["errors"])]
     for k in range(rep["stairs"]):
-        cells = [f"{mm(v[k]['static_mm']):>12} {mm(v[k]['dynamic_mm']):>12}" for v in rep["errors"].values()]
+        cells = [f"{mm(v[k]['static_mm']):>9} {mm(v[k]['dynamic_mm']):>9}" for v in rep["errors"].values()]
         lines.append(f"{k + 1:>5} " + " ".join(cells))
     lines += ["", f"clearance bound (FK vs sensor): {rep['clearance_bound_mm']:.4f} mm;"
               f" sensor readings out of range: {rep['sensor_out_of_range']} of {rep['samples']}",
-              "static: mean error over the last 0.3 s of a stair; dynamic: mean |error| over the first 0.5 s after it",
+              "mm; static: mean error over the last 0.3 s of a stair; dynamic: mean |error| over the first 0.5 s"
+              " after it; FK - sensor = lengths (FK with the measured lengths - with the true ones) + clearance",
               "", "reading:", *(f"  {line}" for line in rep["reading"]), "",
               f"figure: {rep['plot']}", f"samples: {rep['samples_file']}"]
     return "\n".join(lines)

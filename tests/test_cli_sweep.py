@@ -84,6 +84,8 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     numbers(draw, "--column", (*BAD_INTS, "-3"))
     numbers(draw, "--speed", BAD_POSITIVE)
     numbers(draw, "--size", BAD_POSITIVE)
+    numbers(["draw", "lines"], "--spacing", BAD_POSITIVE)
+    cases.append((["draw", "X", "--spacing", "40"], "--spacing"))
     out_dirs(draw)
     out_dirs(["tune"])
     stair = ["precision", "staircase", "--count", "1"]

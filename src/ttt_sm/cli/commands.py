@@ -176,18 +176,21 @@ def cmd_draw(args: argparse.Namespace) -> int:
     params = load_arm(args.params)
     speed = None if args.speed is None else args.speed / 1000
     size = None if args.size is None else args.size / 1000
+    spacing = None if args.spacing is None else args.spacing / 1000
     try:
-        check_request(params, args.kind, args.row, args.column, speed, size)
+        check_request(params, args.kind, args.row, args.column, speed, size, spacing)
     except DrawError as exc:  # the request's own words, with the option they came from
         text = str(exc)
-        option = {"cell": "--row/--column", "speed": "--speed", "size": "--size"}.get(text.split(" ", 1)[0])
+        option = {"cell": "--row/--column", "speed": "--speed", "size": "--size",
+                  "spacing": "--spacing"}.get(text.split(" ", 1)[0])
         raise CliError(f"{option}: {text}" if option else text) from exc
     conn = open_arm(args, params)
     try:
         session = DrawSession(params, seed=args.seed, progress=progress(True), arm=conn.arm if conn else None,
                               truth=conn.truth if conn else None)
         session.start()
-        result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=out)
+        result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=out,
+                              spacing=spacing)
     except DrawError as exc:
         raise CliError(str(exc)) from exc
     finally:
@@ -546,11 +549,14 @@ def register(sub: Any) -> None:
     add_arm_option(sp)
     sp = add_command(sub, "draw", cmd_draw,
                      "draw one thing with the Control chart and measure its precision (thesis 3.5)")
-    sp.add_argument("kind", choices=["field", "X", "O", "sine"])
+    sp.add_argument("kind", choices=["field", "X", "O", "sine", "lines"],
+                    help="lines: two lines parallel to X on millimetre paper (thesis fig. 3.19)")
     sp.add_argument("--row", type=int, default=3, help="cell row 1..5 for X and O (default 3)")
     sp.add_argument("--column", type=int, default=3, help="cell column 1..5 for X and O (default 3)")
     sp.add_argument("--speed", type=float, default=None, help="drawing speed, mm/s (default 20)")
     sp.add_argument("--size", type=float, default=None, help="symbol size, mm (default 18)")
+    sp.add_argument("--spacing", type=float, default=None, metavar="MM",
+                    help="lines only: the distance between the two lines, mm (default 50, as fig. 3.19)")
     sp.add_argument("--out", default="out/draw", help="folder for the board PNG and the path plot")
     add_arm_option(sp)
     sp = add_command(sub, "tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")

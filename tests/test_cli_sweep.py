@@ -99,6 +99,9 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     cases.append((["bench", "--only", "nothing-of-that-name"], "--only"))
     out_dirs(["bench", "--only", "ik", "--quick"])
     numbers(["ik", "150", "0", "100"], "--phi", BAD_FINITE)
+    cases.append((["ik", "150", "0", "100", "--method", "newton"], "--method"))
+    cases.append((["ik", "150", "0", "100", "--elbow", "sideways"], "--elbow"))
+    cases.append((["ik", "150", "0", "100", "--elbow", "down"], "--elbow"))
     for i, value in enumerate(BAD_FINITE):
         argv = ["ik", "150", "0", "100"]
         argv[1 + i % 3] = value

@@ -273,22 +273,53 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def cmd_ik(args: argparse.Namespace) -> int:
-    from ..twin.kinematics import IKSolver, fk
+    """One pose by one of three methods (docs/kinematics.md): ``dls`` (the control loop's: eq. 3.35 with
+    adaptive damping), ``dls-fixed`` (the thesis' own loop: lambda fixed at ``[ik] damping``), ``closed``
+    (the geometric solution, elbow up or down); ``--trace`` prints each iteration's residual."""
+    from ..twin.kinematics import HOME_Q, IKSolver, damped_least_squares, fk, ik_closed_form
 
     bad = [f"{name} = {value}" for name, value in (("x", args.x), ("y", args.y), ("z", args.z), ("--phi", args.phi))
            if not np.isfinite(value)]
     if bad:
         raise CliError(f"the target must be finite numbers (mm, degrees), got {', '.join(bad)}")
+    if args.elbow is not None and args.method != "closed":
+        raise CliError(f"--elbow {args.elbow}: the iterative methods start from the home pose (elbow up);"
+                       " --elbow picks the branch of --method closed")
+    if args.trace and args.method == "closed":
+        raise CliError("--trace: the closed form does not iterate; trace --method dls or dls-fixed")
     params = load_arm(args.params)
+    g = params.geometry
     target = np.array([args.x / 1000, args.y / 1000, args.z / 1000, np.radians(args.phi)])
-    solver = IKSolver(params)
-    res = solver.solve(target)
-    reached = fk(res.q, params.geometry)
-    data = {"q_deg": np.degrees(res.q).round(4).tolist(), "iterations": res.iterations,
-            "residual": res.residual, "reached_mm_deg": [*(reached[:3] * 1000).round(4).tolist(),
-                                                         round(float(np.degrees(reached[3])), 4)]}
-    emit(data, args.json, f"q = {data['q_deg']} deg after {res.iterations} iterations "
-                           f"(residual {res.residual:.2e})")
+    trace: list[dict[str, Any]] = []
+    if args.method == "closed":
+        q = ik_closed_form(target, g, elbow_up=args.elbow != "down")
+        iterations = 0
+        residual = float(np.linalg.norm(fk(q, g) - target))
+    else:
+        adaptive = args.method == "dls"
+        res = IKSolver(params, adaptive=adaptive).solve(target)  # a fresh solver starts from HOME_Q
+        q, iterations, residual = res.q, res.iterations, res.residual
+        for k in range(1, iterations + 1) if args.trace else ():
+            # the same compiled loop stopped after k steps: the trace is the solver's own path
+            step = damped_least_squares(target, HOME_Q, g, dataclasses.replace(params.ik, max_iterations=k),
+                                        adaptive=adaptive)
+            trace.append({"iteration": k, "residual": step.residual,
+                          "q_deg": np.degrees(step.q).round(4).tolist()})
+    reached = fk(q, g)
+    lo, hi = np.array(params.joint_min), np.array(params.joint_max)
+    data = {"method": args.method, "q_deg": np.degrees(q).round(4).tolist(), "iterations": iterations,
+            "residual": residual, "reached_mm_deg": [*(reached[:3] * 1000).round(4).tolist(),
+                                                     round(float(np.degrees(reached[3])), 4)],
+            "within_limits": bool(np.all((q >= lo) & (q <= hi))), "damping": params.ik.damping,
+            "tolerance": params.ik.tolerance}
+    if trace:
+        data["trace"] = trace
+    lines = [f"  {t['iteration']:3d}: residual {t['residual']:.3e}, q = {t['q_deg']} deg" for t in trace]
+    how = {"dls": "eq. 3.35, adaptive damping", "dls-fixed": f"eq. 3.35, lambda fixed at {params.ik.damping:g}",
+           "closed": f"closed form, elbow {args.elbow or 'up'}"}[args.method]
+    text = "\n".join([*lines, f"q = {data['q_deg']} deg after {iterations} iterations (residual {residual:.2e};"
+                                f" {how})" + ("" if data["within_limits"] else "; outside the joint limits")])
+    emit(data, args.json, text)
     return 0
 
 
@@ -581,6 +612,13 @@ def register(sub: Any) -> None:
     sp.add_argument("y", type=float, help="mm")
     sp.add_argument("z", type=float, help="mm")
     sp.add_argument("--phi", type=float, default=0.0, help="pen angle phi, degrees (default 0)")
+    sp.add_argument("--method", choices=["dls", "dls-fixed", "closed"], default="dls",
+                    help="dls (default): eq. 3.35 with adaptive damping, as the control loop runs it; dls-fixed:"
+                         " the thesis' loop, lambda fixed at [ik] damping (0.001); closed: the geometric solution")
+    sp.add_argument("--elbow", choices=["up", "down"], default=None,
+                    help="--method closed: the elbow-up (default, the working pose) or elbow-down branch")
+    sp.add_argument("--trace", action="store_true",
+                    help="print each iteration's residual and joint angles (dls, dls-fixed), from the home pose")
     sp = add_command(sub, "init", cmd_init, "initialise the drives with the init charts from random power-on poses")
     sp.add_argument("--starts", type=int, default=20,
                     help=f"number of random power-on poses, 1..{MAX_STARTS} (default 20)")

@@ -28,6 +28,10 @@ def test_the_two_lines_are_parallel_to_x_and_as_far_apart_as_asked(lines):
     assert all(abs(a) < 0.3 for a in lines.lines_angle_deg)
     assert lines.lines_parallel_deg < 0.05
     assert lines.lines_spacing_mm == pytest.approx(40.0, abs=0.3)
+    # section 3.5's first comparison, point by point in time: the encoders trail the desired pen along the
+    # line by the setpoint filters' delay (critically damped at 8 Hz: 2 / (2 pi 8 Hz) = 40 ms, 0.8 mm at 20 mm/s)
+    lag_mm = lines.speed_mm_s * 2 / (2 * math.pi * P.control.setpoint_cutoff_hz)
+    assert 0.5 * lag_mm < lines.desired_vs_fk_max_mm < 2 * lag_mm
 
 
 def test_the_board_picture_is_on_millimetre_paper(lines):

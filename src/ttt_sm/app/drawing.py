@@ -155,6 +155,9 @@ class DrawResult:
     length_error_max_mm: float | None = None
     #: And what is left: FK with the true lengths against the true tip (clearances, deflection, pen play), mm.
     clearance_error_max_mm: float | None = None
+    #: Desired against forward kinematics of the encoders (thesis section 3.5's first comparison: the
+    #: controllers and inverse kinematics), largest while the pen is commanded down, in x and y, mm.
+    desired_vs_fk_max_mm: float | None = None
     #: ``lines`` only (fig. 3.19): each line's angle to the X axis (deg, from a straight line fitted to its
     #: ink), the angle between them (deg) and their distance at the field's centre (mm).
     lines_angle_deg: tuple[float, float] | None = None
@@ -289,6 +292,8 @@ def measure(robot: Robot, rec: DrawRecord, kind: str, row: int, column: int, t0:
     tail = longest_tail_mm(strokes, runs, tol_m=TAIL_TOL_M)
     lines = _lines_geometry(ink, params.board.field_center_x, params.board.field_center_y) if kind == "lines" \
         else None
+    down = desired[:, 2] <= params.board.surface_z
+    desired_vs_fk = np.hypot(*(desired[down, :2] - fk_enc[down]).T) * 1e3 if down.any() else np.zeros(1)
     return DrawResult(
         kind=kind, row=row if kind in ("X", "O") else None, column=column if kind in ("X", "O") else None,
         speed_mm_s=round(c.speed * 1e3, 3), size_mm=round(c.size * 1e3, 3) if kind in ("X", "O") else None,
@@ -298,7 +303,7 @@ def measure(robot: Robot, rec: DrawRecord, kind: str, row: int, column: int, t0:
         duration_s=round(robot.t - t0, 3), sim_time_s=round(robot.t, 3),
         wall_time_s=round(time.perf_counter() - wall0, 3),
         length_error_max_mm=round(float(lengths.max()), 4), clearance_error_max_mm=round(float(clearance.max()), 4),
-        **(lines or {}),
+        desired_vs_fk_max_mm=round(float(desired_vs_fk.max()), 4), **(lines or {}),
     )
 
 

@@ -125,8 +125,9 @@ def test_the_command_refuses_too_many_stairs_in_one_line(capsys, tmp_path):
 def test_the_full_staircases_of_figs_3_15_to_3_18_keep_the_findings(params, axis, steps):
     thesis = run_staircase(params, axis, steps, "thesis")
     ours = run_staircase(params, axis, steps, "ours")
-    for e in thesis.errors["fk_vs_sensor"]:
+    for e in thesis.errors["clearance"]:
         assert abs(e.static_mm) <= thesis.clearance_bound_mm
     for e in ours.errors["desired_vs_sensor"]:
         assert abs(e.static_mm) <= 0.1
-    assert thesis.summary["desired_vs_fk"]["max_dynamic_mm"] > ours.summary["desired_vs_fk"]["max_dynamic_mm"]
+    # overall, our loops follow the stairs more closely (desired vs FK also holds ours' gear-play feed-forward)
+    assert thesis.summary["desired_vs_sensor"]["max_dynamic_mm"] > ours.summary["desired_vs_sensor"]["max_dynamic_mm"]

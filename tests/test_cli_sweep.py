@@ -65,7 +65,8 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
             cases.append((argv, p[key]))
 
     # the parameter file every robot command reads
-    for command in (["params"], ["ik", "150", "0", "100"], ["init", "--starts", "1"], ["demo"], ["tune"]):
+    for command in (["params"], ["ik", "150", "0", "100"], ["init", "--starts", "1"], ["demo"], ["tune"],
+                    ["precision", "staircase", "--count", "1"]):
         for key in ("missing", "folder", "garbage"):
             cases.append((["--params", p[key], *command], p[key]))
     play = ["play", "--opponent", "simulated", "--camera", "direct"]
@@ -83,11 +84,24 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     numbers(draw, "--column", (*BAD_INTS, "-3"))
     numbers(draw, "--speed", BAD_POSITIVE)
     numbers(draw, "--size", BAD_POSITIVE)
+    numbers(["draw", "lines"], "--spacing", BAD_POSITIVE)
+    cases.append((["draw", "X", "--spacing", "40"], "--spacing"))
     out_dirs(draw)
     out_dirs(["tune"])
+    stair = ["precision", "staircase", "--count", "1"]
+    cases.append((["precision", "staircase", "--axis", "w"], "--axis"))
+    cases.append((["precision", "staircase", "--steps", "huge"], "--steps"))
+    cases.append((["precision", "staircase", "--tuning", "mine"], "--tuning"))
+    numbers(["precision", "staircase"], "--count", (*BAD_INTS, "0", "21"))
+    numbers(stair, "--hold", ("abc", "nan", "inf", "0", "-1", "11"))
+    out_dirs(stair)
+    cases.append((["precision"], "precision"))
     cases.append((["bench", "--only", "nothing-of-that-name"], "--only"))
     out_dirs(["bench", "--only", "ik", "--quick"])
     numbers(["ik", "150", "0", "100"], "--phi", BAD_FINITE)
+    cases.append((["ik", "150", "0", "100", "--method", "newton"], "--method"))
+    cases.append((["ik", "150", "0", "100", "--elbow", "sideways"], "--elbow"))
+    cases.append((["ik", "150", "0", "100", "--elbow", "down"], "--elbow"))
     for i, value in enumerate(BAD_FINITE):
         argv = ["ik", "150", "0", "100"]
         argv[1 + i % 3] = value

@@ -26,6 +26,17 @@ def test_default_file_loads_in_si_units():
     assert p.joint_min[3] == p.servo.min_rad
 
 
+def test_the_arm_is_built_a_tenth_of_a_millimetre_off_its_measured_lengths():
+    p = load_params()
+    assert p.as_built is not None and p.true_geometry == p.as_built
+    for name in ("L1", "L2", "L3", "L4", "l_f"):
+        assert abs(getattr(p.as_built, name) - getattr(p.geometry, name)) == pytest.approx(1e-4)
+    doc = default_doc()
+    del doc["as_built"]
+    exact = parse_params(doc, "exact.toml")
+    assert exact.as_built is None and exact.true_geometry == exact.geometry
+
+
 def test_encoder_resolution_follows_gear_and_counts():
     d = load_params().drives[0]
     assert d.rad_per_count == pytest.approx(2 * math.pi / (d.encoder_counts * d.gear_ratio))
@@ -56,6 +67,9 @@ def test_board_zone():
     (lambda d: d["servo"].update(wobble=1), r"\[servo\] has an unknown key 'wobble'"),
     (lambda d: d.update(extra={}), r"unknown section\(s\) extra"),
     (lambda d: d["control"].update(chart_divider=2.5), r"chart_divider must be an integer"),
+    (lambda d: d["as_built"].update(L3=0.21), r"\[as_built\] L3 = 0.21 m lies 10.0 mm from \[geometry\] L3"),
+    (lambda d: d["as_built"].pop("l_f"), r"\[as_built\] is missing l_f"),
+    (lambda d: d["tuning"].update(preset="fast"), r"\[tuning\] preset must be one of ours, thesis"),
 ])
 def test_bad_documents_name_section_and_key(mutate, message):
     doc = default_doc()

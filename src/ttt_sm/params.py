@@ -28,7 +28,13 @@ class ParameterError(ValueError):
 
 @dataclass(frozen=True)
 class Geometry:
-    """Link lengths of the RRRR arm (eqs. 3.17-3.21), metres."""
+    """Link lengths of the RRRR arm (eqs. 3.17-3.21), metres.
+
+    ``[geometry]`` holds the lengths as measured (with a steel rule), which
+    the controller's inverse and forward kinematics use; ``[as_built]`` the
+    arm's true lengths, which only the simulated plant knows
+    (:attr:`ArmParams.true_geometry`; docs/parameters.md).
+    """
 
     L1: float
     L2: float
@@ -205,6 +211,17 @@ class ControlParams:
         return self.chart_divider / self.rate_hz
 
 
+#: The cascade gains ``[tuning] preset`` may name (docs/tuning.md, "The thesis' tuning beside ours").
+TUNING_PRESETS = ("ours", "thesis")
+
+
+@dataclass(frozen=True)
+class Tuning:
+    """Which gains the cascades run: ``"ours"`` (designed, docs/tuning.md) or ``"thesis"`` (hand-set as the thesis')."""
+
+    preset: str = "ours"
+
+
 @dataclass(frozen=True)
 class IKParams:
     """Levenberg-Marquardt damped least squares settings (eq. 3.35)."""
@@ -282,7 +299,16 @@ class ArmParams:
     ik: IKParams
     safety: SafetyParams
     drives: tuple[DriveParams, DriveParams, DriveParams]
+    tuning: Tuning = Tuning()
+    #: The arm's true link lengths (``[as_built]``), None: as measured (``geometry``).  Simulation only:
+    #: the plant, the true tool and the whiteboard use them; kinematics on the controller's side never does.
+    as_built: Geometry | None = None
     source: str = "<built-in>"
+
+    @property
+    def true_geometry(self) -> Geometry:
+        """The lengths the simulated arm really has: ``[as_built]``, else the nominal ``[geometry]``."""
+        return self.as_built if self.as_built is not None else self.geometry
 
     @property
     def joint_min(self) -> tuple[float, float, float, float]:
@@ -310,6 +336,8 @@ MAX_FILE_BYTES = 1_000_000
 LIMITS: dict[str, tuple[float, float]] = {
     "geometry.L1": (0.01, 2.0), "geometry.L2": (0.01, 2.0), "geometry.L3": (0.01, 2.0),
     "geometry.L4": (0.005, 1.0), "geometry.l_f": (-0.5, 0.5),
+    "as_built.L1": (0.01, 2.0), "as_built.L2": (0.01, 2.0), "as_built.L3": (0.01, 2.0),
+    "as_built.L4": (0.005, 1.0), "as_built.l_f": (-0.5, 0.5),
     "board.surface_z": (-1.0, 1.0), "board.field_center_x": (-2.0, 2.0), "board.field_center_y": (-2.0, 2.0),
     "board.field_size": (0.02, 1.0), "board.cells": (5, 5), "board.width": (0.02, 4.0),
     "board.depth": (0.02, 4.0), "board.zone_clearance": (0.0, 0.5), "board.zone_depth": (0.0, 1.0),
@@ -448,8 +476,19 @@ def _short(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[:limit] + f"...({len(text)} characters)"
 
 
+#: How far a true length may lie from the measured one, m: more is a typo, not a measurement error.
+MAX_LENGTH_ERROR_M = 0.005
+
+
 def _check(params: ArmParams, where: _Where) -> None:
     """Relations between keys that no single limit expresses; the message names the key and the fix."""
+    if params.as_built is not None:
+        for f in fields(Geometry):
+            true, measured = getattr(params.as_built, f.name), getattr(params.geometry, f.name)
+            if abs(true - measured) > MAX_LENGTH_ERROR_M:
+                raise ParameterError(f"{where.at('as_built', f.name)}: [as_built] {f.name} = {true:g} m lies"
+                                     f" {abs(true - measured) * 1000:.1f} mm from [geometry] {f.name} = {measured:g} m:"
+                                     f" a measurement misses by less than {MAX_LENGTH_ERROR_M * 1000:g} mm")
     s, c, b = params.servo, params.control, params.board
     if not s.min_rad < s.max_rad:
         raise ParameterError(f"{where.at('servo', 'max_deg')}: [servo] min_deg must be below max_deg")
@@ -494,6 +533,20 @@ def _check(params: ArmParams, where: _Where) -> None:
                                      f" limits")
 
 
+def _tuning(raw: Any, where: _Where) -> Tuning:
+    """The optional ``[tuning]`` table: ``preset``, one of :data:`TUNING_PRESETS` (default "ours")."""
+    if not isinstance(raw, dict):
+        raise ParameterError(f"{where.at('tuning')}: [tuning] must be a table")
+    unknown = sorted(set(raw) - {"preset"})
+    if unknown:
+        raise ParameterError(f"{where.at('tuning', str(unknown[0]))}: [tuning] has an unknown key {_short(unknown[0])}")
+    preset = raw.get("preset", "ours")
+    if preset not in TUNING_PRESETS:
+        raise ParameterError(f"{where.at('tuning', 'preset')}: [tuning] preset must be one of"
+                             f" {', '.join(TUNING_PRESETS)}, got {_short(preset)}")
+    return Tuning(preset=preset)
+
+
 def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> ArmParams:
     """Build :class:`ArmParams` from a parsed TOML document; `where` names it in errors.
 
@@ -503,7 +556,7 @@ def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> A
     sections = {"geometry": Geometry, "board": Board, "pen": Pen, "sponge": Sponge,
                 "servo": Servo, "masses": Masses, "control": ControlParams, "ik": IKParams,
                 "safety": SafetyParams}
-    unknown = sorted(set(data) - set(sections) - {"drive"})
+    unknown = sorted(set(data) - set(sections) - {"drive", "tuning", "as_built"})
     if unknown:
         raise ParameterError(f"{where}: unknown section(s) {', '.join(str(u)[:30] for u in unknown[:5])}")
     built: dict[str, Any] = {}
@@ -515,7 +568,9 @@ def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> A
     if not isinstance(drives_raw, dict) or sorted(drives_raw) != ["1", "2", "3"]:
         raise ParameterError(f"{where}: needs exactly the tables [drive.1], [drive.2], [drive.3]")
     drives = tuple(_section(drives_raw[k], DriveParams, f"drive.{k}", at) for k in ("1", "2", "3"))
-    params = ArmParams(drives=drives, source=where, **built)  # type: ignore[arg-type]
+    as_built = _section(data["as_built"], Geometry, "as_built", at) if "as_built" in data else None
+    params = ArmParams(drives=drives, tuning=_tuning(data.get("tuning", {}), at), as_built=as_built, source=where,
+                       **built)  # type: ignore[arg-type]
     _check(params, at)
     return params
 

@@ -200,7 +200,7 @@ def test_finish_mid_stroke_lifts_the_pen_off_the_board_and_the_arm_returns_to_it
     lowest_over_board = math.inf
     while "finished" not in robot.active("Control"):
         robot.chart_step()
-        x, y, z, _ = fk(robot.truth.q, P.geometry)
+        x, y, z, _ = fk(robot.truth.q, P.true_geometry)
         if P.board.in_zone(x, y, 0.0):
             lowest_over_board = min(lowest_over_board, z)
         assert robot.t < 60.0
@@ -208,7 +208,7 @@ def test_finish_mid_stroke_lifts_the_pen_off_the_board_and_the_arm_returns_to_it
     assert lowest_over_board > P.board.surface_z
     assert board.ink_area_mm2() == ink_at_lift and board.contact.pen_collision_count == 0
     robot.run_for(1.0)
-    tool = fk(robot.truth.q, P.geometry)[:3]
+    tool = fk(robot.truth.q, P.true_geometry)[:3]
     assert np.linalg.norm(tool - (c.x_start, c.y_start, c.z_start)) < 0.002
 
 

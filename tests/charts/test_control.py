@@ -263,13 +263,14 @@ def test_an_o_is_four_arcs_each_a_bit_over_a_quarter_that_close_the_circle(row, 
         r = np.hypot(arc[:, 0] - c.x0, arc[:, 1] - c.y0)
         assert np.allclose(r, c.R, atol=1e-9), k
         assert np.all(arc[:, 2] == c.z_draw)
-        # one coordinate is incremented or decreased (eqs. 3.48, 3.50), the other follows the circle
+        # one coordinate is decreased or incremented (eqs. 3.48, 3.50: X down along the lower half, then Y up
+        # along the left half; parts 3 and 4 the other way), the other follows the circle: clockwise
         moving = arc[:, 0] if k in (1, 3) else arc[:, 1]
-        assert np.all(np.diff(moving) > 0) if k in (1, 2) else np.all(np.diff(moving) < 0)
+        assert np.all(np.diff(moving) < 0) if k in (1, 4) else np.all(np.diff(moving) > 0)
         # each arc goes on from where the last ended: no jump
         assert np.hypot(*(arc[0, :2] - prev_end[:2])) < 1.01 * c.speed * P.control.chart_dt
         a = angles(np.vstack([prev_end[None, :], arc]), c.x0, c.y0)
-        spans.append(a[-1] - a[0])
+        spans.append(a[0] - a[-1])
         prev_end = arc[-1]
     # a bit more than a quarter each
     assert c.arc_overlap > 0
@@ -278,8 +279,8 @@ def test_an_o_is_four_arcs_each_a_bit_over_a_quarter_that_close_the_circle(row, 
     # the whole circle, and the end past the beginning: it closes
     circle = np.vstack([start[-1:], *arcs])
     a = angles(circle, c.x0, c.y0)
-    assert np.all(np.diff(a) >= 0)  # once round, one way (an arc's first tick repeats the last one's end)
-    assert a[-1] - a[0] == pytest.approx(2 * math.pi + 4 * c.arc_overlap, abs=1e-6)
+    assert np.all(np.diff(a) <= 0)  # once round, clockwise (an arc's first tick repeats the last one's end)
+    assert a[0] - a[-1] == pytest.approx(2 * math.pi + 4 * c.arc_overlap, abs=1e-6)
     # the arcs lie inside the cell
     assert np.all((x0 < circle[:, 0]) & (circle[:, 0] < x1) & (y0 < circle[:, 1]) & (circle[:, 1] < y1))
     (up,) = log.points("o_pen_up")

@@ -140,15 +140,16 @@ def test_the_circle_equations_give_the_four_halves():
 def test_the_o_is_four_arcs_each_a_bit_over_a_quarter_that_close_the_circle(overlap):
     starts = [O_START] + [arc_end(k, overlap) for k in range(3)]
     ends = [arc_end(k, overlap) for k in range(4)]
-    assert O_START == approx(math.radians(-135.0))  # the lower left, as in fig. 3.27
+    assert O_START == approx(math.radians(-45.0))  # the lower right: eq. 3.48 decreases X from there
     for a, b in zip(starts, ends, strict=True):
-        assert b - a == approx(math.pi / 2 + overlap)  # a quarter, and the overlap
+        assert a - b == approx(math.pi / 2 + overlap)  # a quarter, and the overlap, clockwise (eqs. 3.48-3.51)
     # together they turn 2 pi and four overlaps: the last arc runs past the first one's start
-    assert ends[-1] - O_START == approx(2 * math.pi + 4 * overlap)
+    assert O_START - ends[-1] == approx(2 * math.pi + 4 * overlap)
     x0, y0, R = 0.0, 0.28, 0.009
     # each arc's ends lie on the half of the circle whose single equation the chart follows
-    # (section 3.6.1's second reason for four parts): lower (y), right (x), upper (y), left (x)
-    halves = [("y", -1.0), ("x", 1.0), ("y", 1.0), ("x", -1.0)]
+    # (section 3.6.1's second reason for four parts): lower (y, eq. 3.49), left (x, eq. 3.51), upper (y),
+    # right (x): the signs of the roots the thesis gives each part
+    halves = [("y", -1.0), ("x", -1.0), ("y", 1.0), ("x", 1.0)]
     for a, b, (axis, side) in zip(starts, ends, halves, strict=True):
         for angle in (a, b):
             px, py = circle_point(x0, y0, R, angle)
@@ -161,7 +162,7 @@ def test_the_o_is_four_arcs_each_a_bit_over_a_quarter_that_close_the_circle(over
 
 def test_arc_ends_by_hand_for_two_degrees_of_overlap():
     ov = math.radians(2.0)
-    assert [math.degrees(arc_end(k, ov)) for k in range(4)] == approx([-43.0, 49.0, 141.0, 233.0])
+    assert [math.degrees(arc_end(k, ov)) for k in range(4)] == approx([-137.0, -229.0, -321.0, -413.0])
     assert circle_point(0.0, 0.28, 0.009, math.radians(-90.0)) == approx((0.0, 0.271), abs=1e-12)
 
 

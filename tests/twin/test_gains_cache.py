@@ -21,7 +21,7 @@ def test_kept_gains_are_the_designed_ones_cold_and_warm(tmp_path: Path) -> None:
     designed = design_gains(P)
     cold = kept_gains(P, tmp_path)
     files = list(tmp_path.glob("*.json"))
-    assert [f.name for f in files] == [f"{cache_key(P)}.json"]
+    assert [f.name for f in files] == [f"ours-{cache_key(P)}.json"]
     warm = kept_gains(P, tmp_path)
     # equal as frozen dataclasses of floats: every field bit for bit (NaN margins would break ==: none here)
     assert cold == designed and warm == designed
@@ -36,7 +36,7 @@ def test_another_parameter_is_another_key() -> None:
 
 @pytest.mark.parametrize("content", ["", '{"drives": [', '{"drives": [{"kp_pos": 1}]}', "not json at all"])
 def test_a_broken_cache_file_is_designed_again_and_replaced(tmp_path: Path, content: str) -> None:
-    path = tmp_path / f"{cache_key(P)}.json"
+    path = tmp_path / f"ours-{cache_key(P)}.json"
     path.write_text(content)
     assert kept_gains(P, tmp_path) == design_gains(P)
     assert kept_gains(P, tmp_path) == design_gains(P) and path.read_text() != content

@@ -183,3 +183,39 @@ def test_the_bode_plot_draws_the_margins_the_design_reports(params, gains):
             assert high - low == pytest.approx(gm) and high == pytest.approx(0.0, abs=0.3)
             assert any(f"drive {drive}: phase margin {pm:.0f}°" in t.get_text()
                        for t in ph.get_legend().get_texts())
+
+
+# ---- the thesis' tuning beside ours (docs/tuning.md) -------------------------------------------------------
+
+#: Thesis section 3.2: |error| 0.5 s after the step, rad, drives 1-3.
+THESIS_ERROR_AT_0_5_S = {1: 0.007, 2: 0.0035, 3: 0.003}
+
+
+@pytest.mark.parametrize("drive", [1, 2, 3])
+def test_the_thesis_preset_reproduces_the_thesis_error_half_a_second_after_the_step(params, drive):
+    from ttt_sm.twin.tuning import thesis_gains
+
+    thesis = thesis_gains(params)
+    g = thesis.drive(drive)
+    assert g.kff_speed == 0.0  # fig. 3.6: no speed feed-forward
+    assert g.outer_phase_margin_deg >= 45.0 and g.inner_phase_margin_deg >= 45.0
+    m = step_response(params, thesis, drive, STEP_RAD[drive])
+    assert THESIS_ERROR_AT_0_5_S[drive] / 2 <= m.error_at_0_5s_rad <= 2 * THESIS_ERROR_AT_0_5_S[drive]
+    assert m.static_error_rad < 0.0015  # the thesis: < 0.0002, 0.0015, < 0.0015 rad
+
+
+def test_the_tuning_preset_is_read_from_the_parameter_file_and_checked(tmp_path):
+    from importlib import resources
+
+    from ttt_sm.params import DEFAULT_PARAMS_NAME, ParameterError, load_params
+    from ttt_sm.twin.tuning import design_gains, gains_for, thesis_gains
+
+    base = resources.files("ttt_sm.data").joinpath(DEFAULT_PARAMS_NAME).read_text()
+    f = tmp_path / "arm.toml"
+    f.write_text(base.replace('preset = "ours"', 'preset = "thesis"'))
+    p = load_params(f)
+    assert p.tuning.preset == "thesis" and gains_for(p) == thesis_gains(p)
+    assert gains_for(p, "ours") == design_gains(p)
+    f.write_text(base.replace('preset = "ours"', 'preset = "fast"'))
+    with pytest.raises(ParameterError, match=r"\[tuning\] preset must be one of ours, thesis"):
+        load_params(f)

@@ -26,7 +26,7 @@ from ttt_sm.twin.whiteboard import (
 )
 
 PARAMS = load_params()
-GEOM = PARAMS.geometry
+GEOM = PARAMS.true_geometry  # the whiteboard sees the true pen: the arm as built
 BOARD = PARAMS.board
 DT = 1.0 / 500.0  # chart step
 RES = 0.2e-3

@@ -44,7 +44,7 @@ def arm_cockpit() -> Iterator[Cockpit]:
 def truth_now(d: Debugger) -> dict[str, Any]:
     assert d.robot.sim is not None
     q = d.robot.sim.truth.q
-    g = d.robot.params.geometry
+    g = d.robot.params.true_geometry  # the view draws the true arm, as built
     return {"q": q, "tip_mm": fk(q, g)[:3] * 1e3, "points_mm": arm_points(q, g) * 1e3, "tick": d.robot.chart_ticks,
             "pen": d.robot.board.contact.pen_touching, "ink_mm2": d.robot.board.ink_area_mm2(),
             "ink": list(d.robot.board.ink_version)}

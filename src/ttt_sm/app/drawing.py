@@ -7,8 +7,10 @@ tip leaves.  :func:`draw` commands one drawing through the Control chart
 (the field, an X, an O or the sine wave of section 3.5.3) and measures it:
 `rms_error_mm` / `max_error_mm` (true ink against the desired pen-down
 path), `fk_vs_true_max_mm` (what clearance and model error hide from the
-encoders), `closure_gap_mm` for an O, the longest pen-lift/lower tail, and
-the duration.  It writes the board picture (:mod:`ttt_sm.twin.board_picture`)
+encoders; split into `length_error_max_mm`, the measured link lengths
+against the arm as built, and `clearance_error_max_mm`, the rest),
+`closure_gap_mm` for an O, the longest pen-lift/lower tail, and the
+duration.  It writes the board picture (:mod:`ttt_sm.twin.board_picture`)
 and the path plot (:mod:`.path_plot`: the path seen from above, the pen's
 height, the error along the path and the Control chart's states over time;
 figs. 3.15-3.20).
@@ -27,15 +29,20 @@ import numpy as np
 
 from ..arm import Arm
 from ..params import ArmParams
-from ..sched.scheduler import Signals
-from ..sched.trajectory import distance_to_path, simplify_polyline
+from ..sched.scheduler import PathStage, Signals
+from ..sched.trajectory import Waypoint, distance_to_path, sample_polyline, simplify_polyline
 from ..twin.board_picture import save_board_picture
 from ..twin.kinematics import fk
 from ..twin.truth import GroundTruth
 from .path_plot import PathData, save_path_plot
 from .robot import Robot
 
-KINDS = ("field", "X", "O", "sine")
+KINDS = ("field", "X", "O", "sine", "lines")
+
+#: Fig. 3.19 (section 3.5.3): two lines parallel to X, 5 cm apart by default, each this long, centred on the
+#: field; drawn on millimetre paper.
+LINES_SPACING_M = 0.05
+LINES_LENGTH_M = 0.10
 
 
 class DrawError(ValueError):
@@ -49,6 +56,8 @@ class DrawRecord:
     t: list[float] = field(default_factory=list)
     desired: list[tuple[float, float, float]] = field(default_factory=list)
     fk_encoder: list[tuple[float, float, float]] = field(default_factory=list)
+    #: Forward kinematics of the same encoder angles with the arm's true lengths (``[as_built]``).
+    fk_as_built: list[tuple[float, float, float]] = field(default_factory=list)
     fk_true: list[tuple[float, float, float]] = field(default_factory=list)
     tip: list[tuple[float, float]] = field(default_factory=list)  # NaN while the pen is lifted
 
@@ -107,14 +116,15 @@ class RecordStage:
         if not self.on:
             return
         r = self.robot
-        c = r.control
         g = r.params.geometry
         q_enc = r.arm.encoder_angles()
         servo = float(signals.q_set[3])
         rec = self.record
         rec.t.append(r.t)
-        rec.desired.append((c.X_out, c.Y_out, c.Z_out))
+        task = signals.task  # the Control chart's pose, or the pose of a path stage after it (``draw lines``)
+        rec.desired.append((float(task[0]), float(task[1]), float(task[2])))
         rec.fk_encoder.append(tuple(fk((q_enc[0], q_enc[1], q_enc[2], servo), g)[:3]))
+        rec.fk_as_built.append(tuple(fk((q_enc[0], q_enc[1], q_enc[2], servo), r.params.true_geometry)[:3]))
         rec.fk_true.append(tuple(self.truth.tool_pose()[:3]))
         contact = r.board.contact
         rec.tip.append(contact.tip_m if contact.pen_touching and contact.tip_m else (math.nan, math.nan))
@@ -140,6 +150,19 @@ class DrawResult:
     wall_time_s: float
     board_png: str | None = None
     plot_png: str | None = None
+    #: Of ``fk_vs_true_max_mm``, what the link lengths alone cause: FK of the encoder angles with the
+    #: measured lengths against FK with the true ones (``[as_built]``), largest while the pen touches, mm.
+    length_error_max_mm: float | None = None
+    #: And what is left: FK with the true lengths against the true tip (clearances, deflection, pen play), mm.
+    clearance_error_max_mm: float | None = None
+    #: Desired against forward kinematics of the encoders (thesis section 3.5's first comparison: the
+    #: controllers and inverse kinematics), largest while the pen is commanded down, in x and y, mm.
+    desired_vs_fk_max_mm: float | None = None
+    #: ``lines`` only (fig. 3.19): each line's angle to the X axis (deg, from a straight line fitted to its
+    #: ink), the angle between them (deg) and their distance at the field's centre (mm).
+    lines_angle_deg: tuple[float, float] | None = None
+    lines_parallel_deg: float | None = None
+    lines_spacing_mm: float | None = None
 
 
 def _pen_down_runs(desired: np.ndarray, surface_z: float) -> list[np.ndarray]:
@@ -218,11 +241,17 @@ def longest_tail_mm(strokes: list[Any], runs: list[np.ndarray], tol_m: float) ->
 
 
 def check_request(params: ArmParams, kind: str, row: int, column: int, speed: float | None,
-                  size: float | None) -> None:
+                  size: float | None, spacing: float | None = None) -> None:
     """Reject a drawing request that cannot be drawn, naming what is wrong (before anything moves)."""
     if kind not in KINDS:
         raise DrawError(f"unknown drawing {kind!r}; choose from {', '.join(KINDS)}")
     b = params.board
+    if spacing is not None:
+        if kind != "lines":
+            raise DrawError(f"spacing is for the two lines of fig. 3.19 (draw lines), not for {kind}")
+        if not 0.002 <= spacing <= b.field_size:
+            raise DrawError(f"spacing {spacing * 1000:.1f} mm is outside 2..{b.field_size * 1000:.0f} mm"
+                            " (both lines on the field)")
     if not (1 <= row <= b.cells and 1 <= column <= b.cells):
         raise DrawError(f"cell ({row}, {column}) is off the {b.cells}x{b.cells} field")
     if speed is not None and not 0.001 <= speed <= 0.1:
@@ -254,10 +283,17 @@ def measure(robot: Robot, rec: DrawRecord, kind: str, row: int, column: int, t0:
     fk_enc = np.asarray(rec.fk_encoder)[:, :2]
     touching = np.isfinite(tip[:, 0])
     fk_vs_true = np.hypot(*(fk_enc[touching] - tip[touching]).T) * 1e3 if touching.any() else np.zeros(1)
+    fk_built = np.asarray(rec.fk_as_built)[:, :2]
+    lengths = np.hypot(*(fk_enc[touching] - fk_built[touching]).T) * 1e3 if touching.any() else np.zeros(1)
+    clearance = np.hypot(*(fk_built[touching] - tip[touching]).T) * 1e3 if touching.any() else np.zeros(1)
     gap = None
     if kind == "O":
         gap = round(closure_gap_mm(board, c.x0, c.y0, c.R, tol_m=0.0005), 3)
     tail = longest_tail_mm(strokes, runs, tol_m=TAIL_TOL_M)
+    lines = _lines_geometry(ink, params.board.field_center_x, params.board.field_center_y) if kind == "lines" \
+        else None
+    down = desired[:, 2] <= params.board.surface_z
+    desired_vs_fk = np.hypot(*(desired[down, :2] - fk_enc[down]).T) * 1e3 if down.any() else np.zeros(1)
     return DrawResult(
         kind=kind, row=row if kind in ("X", "O") else None, column=column if kind in ("X", "O") else None,
         speed_mm_s=round(c.speed * 1e3, 3), size_mm=round(c.size * 1e3, 3) if kind in ("X", "O") else None,
@@ -266,7 +302,47 @@ def measure(robot: Robot, rec: DrawRecord, kind: str, row: int, column: int, t0:
         longest_tail_mm=round(float(tail), 3), ink_points=int(len(ink)),
         duration_s=round(robot.t - t0, 3), sim_time_s=round(robot.t, 3),
         wall_time_s=round(time.perf_counter() - wall0, 3),
+        length_error_max_mm=round(float(lengths.max()), 4), clearance_error_max_mm=round(float(clearance.max()), 4),
+        desired_vs_fk_max_mm=round(float(desired_vs_fk.max()), 4), **(lines or {}),
     )
+
+
+def _lines_geometry(ink: np.ndarray, cx: float, cy: float) -> dict[str, Any] | None:
+    """Fig. 3.19's two lines measured on their ink: angles to X, the angle between them, their spacing.
+
+    The ink below the field's centre line (``y < cy``) is the first line, above it the second; a
+    straight line ``y = a x + b`` is fitted to each; the spacing is the distance between the two fitted
+    lines at ``x = cx``, measured square to their mean direction.
+    """
+    parts = [ink[ink[:, 1] < cy], ink[ink[:, 1] >= cy]]
+    if any(len(p) < 10 for p in parts):
+        return None
+    fits = [np.polyfit(p[:, 0], p[:, 1], 1) for p in parts]
+    angles = [math.degrees(math.atan(a)) for a, _ in fits]
+    y_at = [a * cx + b for a, b in fits]
+    mean = math.radians((angles[0] + angles[1]) / 2)
+    return {"lines_angle_deg": (round(angles[0], 4), round(angles[1], 4)),
+            "lines_parallel_deg": round(abs(angles[1] - angles[0]), 4),
+            "lines_spacing_mm": round(abs(y_at[1] - y_at[0]) * math.cos(mean) * 1e3, 4)}
+
+
+def lines_path(params: ArmParams, control: Any, spacing: float, chart_dt: float) -> np.ndarray:
+    """The task poses of fig. 3.19, one per chart tick, from where the Control chart holds the tool.
+
+    Two lines parallel to X, `spacing` apart (m) on either side of the field's centre, each
+    ``LINES_LENGTH_M`` long, drawn towards -X as the Control chart draws (eq. 3.36): pen-up moves at the
+    chart's ``travel_speed``, the pen lowered to ``z_draw`` and lifted to ``z_up`` at ``z_speed``, the
+    lines at ``speed``; back to the starting pose at the end.
+    """
+    c, b = control, params.board
+    x_a, x_b = b.field_center_x + LINES_LENGTH_M / 2, b.field_center_x - LINES_LENGTH_M / 2
+    here = Waypoint(c.X_out, c.Y_out, c.Z_out)
+    pts = [here]
+    for y in (b.field_center_y - spacing / 2, b.field_center_y + spacing / 2):
+        pts += [Waypoint(x_a, y, c.z_up, speed=c.travel_speed), Waypoint(x_a, y, c.z_draw, speed=c.z_speed),
+                Waypoint(x_b, y, c.z_draw, speed=c.speed), Waypoint(x_b, y, c.z_up, speed=c.z_speed)]
+    pts.append(Waypoint(here.x, here.y, here.z, speed=c.travel_speed))
+    return sample_polyline(pts, c.speed, chart_dt)
 
 
 class DrawSession:
@@ -282,6 +358,7 @@ class DrawSession:
         self.control_states = ActiveStateLog(lambda: self.robot.t).observe(self.robot.control)
         self.say = progress or (lambda _m: None)
         self._last: tuple[float, int] | None = None  # the last drawing's start time and first stroke
+        self._spacing_mm = LINES_SPACING_M * 1000  # the last lines' spacing, for the picture's command line
 
     def run_to_wait(self, timeout_s: float) -> None:
         """Run until the Control chart waits in wait_1 (raises DrawError on timeout)."""
@@ -303,9 +380,13 @@ class DrawSession:
         return r.t
 
     def draw(self, kind: str, row: int = 3, column: int = 3, speed: float | None = None,
-             size: float | None = None, out_dir: Path | None = None) -> DrawResult:
-        """Draw one thing from wait_1 and measure it."""
-        check_request(self.params, kind, row, column, speed, size)
+             size: float | None = None, out_dir: Path | None = None, spacing: float | None = None) -> DrawResult:
+        """Draw one thing from wait_1 and measure it.
+
+        ``lines`` (fig. 3.19) is no sub-chart of the Control chart: a path stage after it
+        (:func:`lines_path`) plays the two lines while the chart waits in ``wait_1``.
+        """
+        check_request(self.params, kind, row, column, speed, size, spacing)
         c = self.robot.control
         if speed is not None:
             c.speed = speed
@@ -319,6 +400,14 @@ class DrawSession:
         t0 = self.robot.t
         strokes_before = len(self.robot.board.strokes)
         c.row, c.column = row, column
+        if kind == "lines":
+            self.say(f"drawing two lines parallel to X, {(spacing or LINES_SPACING_M) * 1000:g} mm apart (fig. 3.19)")
+            self._spacing_mm = (spacing or LINES_SPACING_M) * 1000
+            self._draw_lines(spacing or LINES_SPACING_M)
+            self.recorder.on = False
+            self._last = (t0, strokes_before)
+            result = self._measure(kind, row, column, t0, strokes_before, wall0)
+            return self._write(result, out_dir) if out_dir is not None else result
         if kind == "field":
             c.Pl_fld = False
         elif kind == "sine":
@@ -338,6 +427,17 @@ class DrawSession:
             result = self._write(result, out_dir)
         return result
 
+    def _draw_lines(self, spacing: float) -> None:
+        r = self.robot
+        path = PathStage(lines_path(self.params, r.control, spacing, self.params.control.chart_dt))
+        r.sched.task_stages.append(path)  # after the Control chart's stage: its pose wins
+        try:
+            if not r.run_until(lambda: path.done or r.tripped, 120.0) or r.tripped:
+                raise DrawError(f"the lines were not drawn: {r.safety.reason or 'still drawing after 120 s'}")
+            r.run_for(0.5)  # the arm settles at the waiting pose
+        finally:
+            r.sched.task_stages.remove(path)
+
     def _measure(self, kind: str, row: int, column: int, t0: float, strokes_before: int,
                  wall0: float) -> DrawResult:
         return measure(self.robot, self.recorder.record, kind, row, column, t0, strokes_before, wall0)
@@ -347,11 +447,16 @@ class DrawSession:
         name = result.kind + (f"_r{result.row}c{result.column}" if result.row else "")
         what = _what(result)
         seed = self.robot.seed
+        lines = result.kind == "lines"  # fig. 3.19: on millimetre paper, the desired lines drawn over the ink
         board_png = save_board_picture(
             self.robot.board, out_dir / f"board_{name}.png", f"{what}, drawn by the robot on the simulated whiteboard",
             f"ttt-sm draw {result.kind}" + (f" --row {result.row} --column {result.column}" if result.row else "")
             + f" --speed {result.speed_mm_s:g}" + (f" --size {result.size_mm:g}" if result.size_mm else "")
-            + f" --seed {seed}: the whole board as it is after this drawing")
+            + (f" --spacing {self._spacing_mm:g}" if result.kind == "lines" else "")
+            + f" --seed {seed}: the whole board as it is after this drawing",
+            grid_mm=lines,
+            desired=_pen_down_runs(np.asarray(self.recorder.record.desired), self.params.board.surface_z) if lines
+            else ())
         t0 = self._last[0] if self._last else self.robot.t
         plot_png = save_path_plot(
             self.path_data(), out_dir / f"paths_{name}.png", f"{what}: where the pen went",
@@ -388,6 +493,8 @@ class DrawSession:
 
 
 def _what(result: DrawResult) -> str:
+    if result.kind == "lines":
+        return "Two lines parallel to X on millimetre paper (thesis fig. 3.19)"
     if result.kind == "field":
         return "The playing field"
     if result.kind == "sine":

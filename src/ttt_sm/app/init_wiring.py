@@ -229,7 +229,7 @@ class InitMonitor:
         if np.any(over > 0):
             self.limit_violations += 1
         board = self.params.board
-        if any(board.in_zone(x, y, z) for x, y, z in link_points(truth.q, self.params.geometry)):
+        if any(board.in_zone(x, y, z) for x, y, z in link_points(truth.q, self.params.true_geometry)):
             self.zone_ticks += 1
 
 

@@ -27,6 +27,8 @@ from ..arm import Arm
 from ..params import ArmParams
 from ..runtime import TickChart
 from ..sched.scheduler import Scheduler, Signals, Stage
+from ..twin.gains import preset_params
+from ..twin.gains_cache import kept_gains
 from ..twin.sim import ArmSim
 from ..twin.truth import GroundTruth
 from ..twin.whiteboard import Whiteboard
@@ -53,6 +55,30 @@ class BoardStage:
     def tick(self, signals: Signals) -> None:
         """Ink or wipe where the true tool touches the board now."""
         self.board.update(signals.t, self.truth.angles())
+
+
+class PresetGainsStage:
+    """Joint stage: once the drives are initialised, switch the cascades to the file's tuning preset.
+
+    The init charts' stall rule (a setpoint ``stall_lag`` ahead of a still
+    encoder) is set for the designed loops, which follow a search ramp
+    closely; the "thesis" preset's position loop, with no speed
+    feedforward, trails a 1 rad/s ramp by 1/kp = 0.06 rad and would read as
+    a stall.  So the arm initialises with the designed gains and runs the
+    preset's from the first chart step after (docs/tuning.md).
+    """
+
+    def __init__(self, arm: Any, gains: Any, initialised: Callable[[], bool]) -> None:
+        self.arm = arm
+        self.gains = gains
+        self.initialised = initialised
+        self.switched = False
+
+    def tick(self, signals: Signals) -> None:
+        """Switch the gains at the first chart step the drives are initialised in (once)."""
+        if not self.switched and self.initialised():
+            self.arm.set_gains(self.gains)
+            self.switched = True
 
 
 class RobotError(ValueError):
@@ -99,6 +125,7 @@ class Robot:
                  slots: ChartSlots | None = None) -> None:
         check_drives(params)  # an encoder too coarse for the charts, a gear too stiff for the twin's step
         check_reach(params)  # a field out of reach would be drawn as nothing, silently
+        params = preset_params(params)  # the Safety chart's thresholds a slower tuning preset needs
         self.params = params
         self.seed = seed
         #: The class in each replaceable chart's place (the game takes its charts' from here too).
@@ -126,6 +153,9 @@ class Robot:
         self.safety = make_safety_chart(params, listeners)
         self.safety_stage = SafetyStage(params, arm, self.sched, self.safety, self.reinitialise, self.camera_status)
         joint_stages: list[Stage] = [self.init_stage, self.compensation, self.safety_stage]
+        if params.tuning.preset != "ours" and hasattr(arm, "set_gains"):
+            preset = kept_gains(params, params.tuning.preset)
+            joint_stages.append(PresetGainsStage(arm, preset, lambda: self.init_stage.done))
         if truth is not None:
             joint_stages.append(BoardStage(self.board, truth))
         self.sched.joint_stages = joint_stages

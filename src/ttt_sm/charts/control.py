@@ -459,7 +459,7 @@ class Control(TickChart):
         # eqs. 3.45-3.47; R = size/2 (the printed R = L/4 is the size L/2)
         self.x0, self.y0 = o_centre(self.x11, self.y11, self.L, self.row, self.column)
         self.R = o_radius(self.size)
-        # part 1 starts at the lower left, as in fig. 3.27
+        # part 1 starts at the lower right: eq. 3.48 decreases X along the lower half (eq. 3.49)
         self._aim(*circle_point(self.x0, self.y0, self.R, O_START), self.z_up)
 
     def start_arc_1(self) -> None:
@@ -471,7 +471,7 @@ class Control(TickChart):
         self._aim_arc()
 
     def _aim_arc(self) -> None:
-        """End point of arc k: a quarter plus the overlap, counter-clockwise from -135 deg."""
+        """End point of arc k: a quarter plus the overlap, clockwise from -45 deg (eqs. 3.48-3.51)."""
         self.arc_end = arc_end(self.k, self.arc_overlap)
         self._aim(*circle_point(self.x0, self.y0, self.R, self.arc_end), self.z_draw)
 
@@ -479,30 +479,30 @@ class Control(TickChart):
         return self.speed * self.tick_period_s * math.sqrt(0.5)
 
     def during_arc_1(self) -> None:
-        # eqs. 3.48-3.49: X increases along the lower half, Y from the circle
-        self.X_out = min(self.X_out_p + self._arc_step(), self.tx)
+        # eqs. 3.48-3.49: X decreases along the lower half, Y from the circle (the negative root)
+        self.X_out = max(self.X_out_p - self._arc_step(), self.tx)
         self.Y_out = circle_y(self.X_out, self.x0, self.y0, self.R, -1.0)
         if self.X_out == self.tx:
             self.Y_out = self.ty
 
     def during_arc_2(self) -> None:
-        # eqs. 3.50-3.51: Y increases along the right half, X from the circle
+        # eqs. 3.50-3.51: Y increases along the left half, X from the circle (the negative root)
         self.Y_out = min(self.Y_out_p + self._arc_step(), self.ty)
-        self.X_out = circle_x(self.Y_out, self.x0, self.y0, self.R, 1.0)
+        self.X_out = circle_x(self.Y_out, self.x0, self.y0, self.R, -1.0)
         if self.Y_out == self.ty:
             self.X_out = self.tx
 
     def during_arc_3(self) -> None:
-        # like part 1 mirrored: X decreases along the upper half
-        self.X_out = max(self.X_out_p - self._arc_step(), self.tx)
+        # like part 1, "X_out is incremented" and the root positive: the upper half
+        self.X_out = min(self.X_out_p + self._arc_step(), self.tx)
         self.Y_out = circle_y(self.X_out, self.x0, self.y0, self.R, 1.0)
         if self.X_out == self.tx:
             self.Y_out = self.ty
 
     def during_arc_4(self) -> None:
-        # like part 2 mirrored: Y decreases along the left half
+        # like part 2, "Y_out is decreased" and the root positive: the right half
         self.Y_out = max(self.Y_out_p - self._arc_step(), self.ty)
-        self.X_out = circle_x(self.Y_out, self.x0, self.y0, self.R, -1.0)
+        self.X_out = circle_x(self.Y_out, self.x0, self.y0, self.R, 1.0)
         if self.Y_out == self.ty:
             self.X_out = self.tx
 

@@ -24,8 +24,9 @@ from __future__ import annotations
 
 import math
 
-#: Angle where the O's first arc starts: the lower left of the circle, as in fig. 3.27 (rad).
-O_START = -0.75 * math.pi
+#: Angle where the O's first arc starts: the lower right of the circle (rad).  Part 1 runs from there
+#: along the lower half with X decreasing (eqs. 3.48-3.49): the O is drawn clockwise, seen from above.
+O_START = -0.25 * math.pi
 
 
 def field_line(x11: float, y11: float, L: float, cells: int, k: int) -> tuple[float, float, float, float]:
@@ -114,7 +115,7 @@ def o_radius(size: float) -> float:
 
 
 def arc_end(k: int, overlap: float) -> float:
-    """Angle (rad) where arc `k` (0-3) of the O ends, counter-clockwise from :data:`O_START`.
+    """Angle (rad) where arc `k` (0-3) of the O ends, clockwise from :data:`O_START` (eqs. 3.48-3.51).
 
     Each arc is a quarter turn plus `overlap`, so the four together turn
     ``2 pi + 4 overlap``: the circle closes with its ends overlapping
@@ -122,7 +123,7 @@ def arc_end(k: int, overlap: float) -> float:
     every arc stays on one half of the circle, where one equation gives it
     (:func:`circle_y`, :func:`circle_x`: the second reason).
     """
-    return O_START + (k + 1) * (math.pi / 2 + overlap)
+    return O_START - (k + 1) * (math.pi / 2 + overlap)
 
 
 def circle_point(x0: float, y0: float, R: float, angle: float) -> tuple[float, float]:

@@ -179,18 +179,21 @@ def cmd_draw(args: argparse.Namespace) -> int:
     params = load_arm(args.params)
     speed = None if args.speed is None else args.speed / 1000
     size = None if args.size is None else args.size / 1000
+    spacing = None if args.spacing is None else args.spacing / 1000
     try:
-        check_request(params, args.kind, args.row, args.column, speed, size)
+        check_request(params, args.kind, args.row, args.column, speed, size, spacing)
     except DrawError as exc:  # the request's own words, with the option they came from
         text = str(exc)
-        option = {"cell": "--row/--column", "speed": "--speed", "size": "--size"}.get(text.split(" ", 1)[0])
+        option = {"cell": "--row/--column", "speed": "--speed", "size": "--size",
+                  "spacing": "--spacing"}.get(text.split(" ", 1)[0])
         raise CliError(f"{option}: {text}" if option else text) from exc
     conn = open_arm(args, params)
     try:
         session = DrawSession(params, seed=args.seed, progress=progress(True), arm=conn.arm if conn else None,
                               truth=conn.truth if conn else None)
         session.start()
-        result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=out)
+        result = session.draw(args.kind, args.row, args.column, speed=speed, size=size, out_dir=out,
+                              spacing=spacing)
     except DrawError as exc:
         raise CliError(str(exc)) from exc
     finally:
@@ -207,7 +210,15 @@ def cmd_tune(args: argparse.Namespace) -> int:
     out = out_dir(args.out)
     params = load_arm(args.params)
     rows = tune_report(params, out)
-    emit(rows, args.json, report_text(rows))
+    if args.preset != "thesis":
+        emit(rows, args.json, report_text(rows))
+        return 0
+    # the thesis' tuning beside ours (docs/tuning.md): both tables, both sets of plots
+    thesis = tune_report(params, out, "thesis")
+    emit({"ours": rows, "thesis": thesis}, args.json,
+         "ours (designed from the parameter file):\n" + report_text(rows)
+         + "\n\nthesis (its structure, gains set by hand to reproduce figs. 3.7-3.9; thesis at 0.5 s: 0.007,"
+           " 0.0035, 0.003 rad):\n" + report_text(thesis))
     return 0
 
 
@@ -265,22 +276,53 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def cmd_ik(args: argparse.Namespace) -> int:
-    from ..twin.kinematics import IKSolver, fk
+    """One pose by one of three methods (docs/kinematics.md): ``dls`` (the control loop's: eq. 3.35 with
+    adaptive damping), ``dls-fixed`` (the thesis' own loop: lambda fixed at ``[ik] damping``), ``closed``
+    (the geometric solution, elbow up or down); ``--trace`` prints each iteration's residual."""
+    from ..twin.kinematics import HOME_Q, IKSolver, damped_least_squares, fk, ik_closed_form
 
     bad = [f"{name} = {value}" for name, value in (("x", args.x), ("y", args.y), ("z", args.z), ("--phi", args.phi))
            if not np.isfinite(value)]
     if bad:
         raise CliError(f"the target must be finite numbers (mm, degrees), got {', '.join(bad)}")
+    if args.elbow is not None and args.method != "closed":
+        raise CliError(f"--elbow {args.elbow}: the iterative methods start from the home pose (elbow up);"
+                       " --elbow picks the branch of --method closed")
+    if args.trace and args.method == "closed":
+        raise CliError("--trace: the closed form does not iterate; trace --method dls or dls-fixed")
     params = load_arm(args.params)
+    g = params.geometry
     target = np.array([args.x / 1000, args.y / 1000, args.z / 1000, np.radians(args.phi)])
-    solver = IKSolver(params)
-    res = solver.solve(target)
-    reached = fk(res.q, params.geometry)
-    data = {"q_deg": np.degrees(res.q).round(4).tolist(), "iterations": res.iterations,
-            "residual": res.residual, "reached_mm_deg": [*(reached[:3] * 1000).round(4).tolist(),
-                                                         round(float(np.degrees(reached[3])), 4)]}
-    emit(data, args.json, f"q = {data['q_deg']} deg after {res.iterations} iterations "
-                           f"(residual {res.residual:.2e})")
+    trace: list[dict[str, Any]] = []
+    if args.method == "closed":
+        q = ik_closed_form(target, g, elbow_up=args.elbow != "down")
+        iterations = 0
+        residual = float(np.linalg.norm(fk(q, g) - target))
+    else:
+        adaptive = args.method == "dls"
+        res = IKSolver(params, adaptive=adaptive).solve(target)  # a fresh solver starts from HOME_Q
+        q, iterations, residual = res.q, res.iterations, res.residual
+        for k in range(1, iterations + 1) if args.trace else ():
+            # the same compiled loop stopped after k steps: the trace is the solver's own path
+            step = damped_least_squares(target, HOME_Q, g, dataclasses.replace(params.ik, max_iterations=k),
+                                        adaptive=adaptive)
+            trace.append({"iteration": k, "residual": step.residual,
+                          "q_deg": np.degrees(step.q).round(4).tolist()})
+    reached = fk(q, g)
+    lo, hi = np.array(params.joint_min), np.array(params.joint_max)
+    data = {"method": args.method, "q_deg": np.degrees(q).round(4).tolist(), "iterations": iterations,
+            "residual": residual, "reached_mm_deg": [*(reached[:3] * 1000).round(4).tolist(),
+                                                     round(float(np.degrees(reached[3])), 4)],
+            "within_limits": bool(np.all((q >= lo) & (q <= hi))), "damping": params.ik.damping,
+            "tolerance": params.ik.tolerance}
+    if trace:
+        data["trace"] = trace
+    lines = [f"  {t['iteration']:3d}: residual {t['residual']:.3e}, q = {t['q_deg']} deg" for t in trace]
+    how = {"dls": "eq. 3.35, adaptive damping", "dls-fixed": f"eq. 3.35, lambda fixed at {params.ik.damping:g}",
+           "closed": f"closed form, elbow {args.elbow or 'up'}"}[args.method]
+    text = "\n".join([*lines, f"q = {data['q_deg']} deg after {iterations} iterations (residual {residual:.2e};"
+                                f" {how})" + ("" if data["within_limits"] else "; outside the joint limits")])
+    emit(data, args.json, text)
     return 0
 
 
@@ -545,15 +587,20 @@ def register(sub: Any) -> None:
     add_arm_option(sp)
     sp = add_command(sub, "draw", cmd_draw,
                      "draw one thing with the Control chart and measure its precision (thesis 3.5)")
-    sp.add_argument("kind", choices=["field", "X", "O", "sine"])
+    sp.add_argument("kind", choices=["field", "X", "O", "sine", "lines"],
+                    help="lines: two lines parallel to X on millimetre paper (thesis fig. 3.19)")
     sp.add_argument("--row", type=int, default=3, help="cell row 1..5 for X and O (default 3)")
     sp.add_argument("--column", type=int, default=3, help="cell column 1..5 for X and O (default 3)")
     sp.add_argument("--speed", type=float, default=None, help="drawing speed, mm/s (default 20)")
     sp.add_argument("--size", type=float, default=None, help="symbol size, mm (default 18)")
+    sp.add_argument("--spacing", type=float, default=None, metavar="MM",
+                    help="lines only: the distance between the two lines, mm (default 50, as fig. 3.19)")
     sp.add_argument("--out", default="out/draw", help="folder for the board PNG and the path plot")
     add_arm_option(sp)
     sp = add_command(sub, "tune", cmd_tune, "design the cascade controllers and step each drive on the nonlinear twin")
     sp.add_argument("--out", default="out/tune", help="folder for the step-response PNGs")
+    sp.add_argument("--preset", choices=["ours", "thesis"], default="ours",
+                    help="ours (default): the designed gains; thesis: the thesis' hand-set gains beside ours")
     sp = add_command(sub, "bench", cmd_bench, "measure the speed and quality targets")
     sp.add_argument("--only", default=None,
                     help="comma-separated sections: steps,ik,loop,pacing,charts,init,motion,vision,ai,game,gui,link;"
@@ -572,6 +619,13 @@ def register(sub: Any) -> None:
     sp.add_argument("y", type=float, help="mm")
     sp.add_argument("z", type=float, help="mm")
     sp.add_argument("--phi", type=float, default=0.0, help="pen angle phi, degrees (default 0)")
+    sp.add_argument("--method", choices=["dls", "dls-fixed", "closed"], default="dls",
+                    help="dls (default): eq. 3.35 with adaptive damping, as the control loop runs it; dls-fixed:"
+                         " the thesis' loop, lambda fixed at [ik] damping (0.001); closed: the geometric solution")
+    sp.add_argument("--elbow", choices=["up", "down"], default=None,
+                    help="--method closed: the elbow-up (default, the working pose) or elbow-down branch")
+    sp.add_argument("--trace", action="store_true",
+                    help="print each iteration's residual and joint angles (dls, dls-fixed), from the home pose")
     sp = add_command(sub, "init", cmd_init, "initialise the drives with the init charts from random power-on poses")
     sp.add_argument("--starts", type=int, default=20,
                     help=f"number of random power-on poses, 1..{MAX_STARTS} (default 20)")

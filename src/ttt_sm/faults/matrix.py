@@ -184,7 +184,7 @@ class _Watch:
         allowance = (allowance_rad, 0.0, 0.0)
         self.lo = [d.limit_min_rad - a for d, a in zip(params.drives, allowance, strict=True)]
         self.hi = [d.limit_max_rad + a for d, a in zip(params.drives, allowance, strict=True)]
-        g = params.geometry
+        g = params.true_geometry  # the true tool: the arm as built
         self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
         self._step = 0
         self.limit_violations = 0
@@ -208,7 +208,7 @@ class _Watch:
         self._step += 1
         if self.count_zone and self._step % ZONE_EVERY == 0:
             inside = any(board.in_zone(px, py, pz) for px, py, pz in link_points(np.array([q1, q2, q3, q4]),
-                                                                                   self.params.geometry))
+                                                                                   self.params.true_geometry))
             if inside and not self._in_zone:
                 self.zone_entries += 1
             self._in_zone = inside

@@ -122,7 +122,7 @@ class LinkTruth:
 
     def tool_pose(self) -> np.ndarray:
         """The true tool pose x, y, z (m), phi (rad): forward kinematics of :attr:`q`."""
-        return fk(self.q, self.params.geometry)
+        return fk(self.q, self.params.true_geometry)
 
     @property
     def speed_load(self) -> np.ndarray:

@@ -19,6 +19,7 @@ docs/whiteboard.md shows one.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -82,7 +83,8 @@ def _ink_over_white(bgr: np.ndarray) -> np.ndarray:
     return np.dstack((bgr[:, :, ::-1] / 255.0, alpha))
 
 
-def board_figure(board: Whiteboard, title: str, subtitle: str = "") -> Figure:
+def board_figure(board: Whiteboard, title: str, subtitle: str = "", grid_mm: bool = False,
+                 desired: Sequence[np.ndarray] = ()) -> Figure:
     """The picture of the board as a matplotlib figure, in millimetres of the global frame.
 
     Parameters
@@ -93,6 +95,11 @@ def board_figure(board: Whiteboard, title: str, subtitle: str = "") -> Figure:
         What the picture is (the drawing, its cell, its speed ...).
     subtitle : str
         A second, smaller line (the seed, the run).
+    grid_mm : bool
+        Millimetre paper under the ink (1, 5 and 10 mm lines), as the thesis' figs. 3.19-3.20.
+    desired : sequence of ndarray, shape (n, 2)
+        Desired pen-down paths (x, y in m), drawn as thin black lines over the ink (the thesis' black
+        lines beside the drawn red ones).
 
     Returns
     -------
@@ -110,7 +117,7 @@ def board_figure(board: Whiteboard, title: str, subtitle: str = "") -> Figure:
     res = board.resolution_m
     # a quarter pixel inside the pixel-aligned crop: render takes exactly those raster pixels
     image = board.render(px_per_mm=PX_PER_MM, region=(x0 + res / 4, x1 - res / 4, y0 + res / 4, y1 - res / 4),
-                         view="above")
+                         view="above", grid_mm=grid_mm)
     h_px, w_px = image.shape[:2]
     left_in, right_in, bottom_in, top_in = 0.75, 0.25, 1.15, 0.75
     fig = Figure(figsize=(w_px / DPI + left_in + right_in, h_px / DPI + bottom_in + top_in), dpi=DPI)
@@ -139,6 +146,9 @@ def board_figure(board: Whiteboard, title: str, subtitle: str = "") -> Figure:
             ax.text(cx0 + 1.2, cy1 - 1.2, f"({row}, {column})", ha="left", va="top", fontsize=8,
                     color=LABEL_RGB, zorder=3, gid=f"cell_{row}_{column}")
 
+    for run in desired:
+        ax.plot(run[:, 0] * 1e3, run[:, 1] * 1e3, color="k", lw=0.6, zorder=3.5)
+
     # scale bar in the bottom left margin, on a white ground so it reads over any ink
     sx, sy = mm[0] + 3.0, mm[2] + 3.0
     ax.plot([sx, sx + SCALE_BAR_MM], [sy, sy], color="k", lw=3, solid_capstyle="butt", zorder=4, gid="scale_bar")
@@ -160,6 +170,10 @@ def board_figure(board: Whiteboard, title: str, subtitle: str = "") -> Figure:
         handles.append(Patch(color=_rgb(ROBOT_INK_BGR), label="the robot's ink (where the true pen tip touched)"))
     if "hand" in authors:
         handles.append(Patch(color=_rgb(HAND_INK_BGR), label="the person's ink"))
+    if len(desired):
+        handles.append(Line2D([], [], color="k", lw=0.6, label="the desired paths (pen down)"))
+    if grid_mm:
+        handles.append(Patch(facecolor="white", edgecolor="0.6", label="millimetre paper: lines every 1, 5, 10 mm"))
     base_mm = y0 * 1e3  # the base axis stands at y = 0 (docs/kinematics.md)
     fig.legend(handles=handles, loc="lower left", bbox_to_anchor=(left_in / fw, 0.01), ncol=2, fontsize=8,
                frameon=False,
@@ -169,11 +183,12 @@ def board_figure(board: Whiteboard, title: str, subtitle: str = "") -> Figure:
     return fig
 
 
-def save_board_picture(board: Whiteboard, path: str | Path, title: str, subtitle: str = "") -> Path:
+def save_board_picture(board: Whiteboard, path: str | Path, title: str, subtitle: str = "", grid_mm: bool = False,
+                       desired: Sequence[np.ndarray] = ()) -> Path:
     """Write :func:`board_figure` to a PNG file; returns the path."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    return save_figure(board_figure(board, title, subtitle), p)
+    return save_figure(board_figure(board, title, subtitle, grid_mm, desired), p)
 
 
 __all__ = ["crop_region", "board_figure", "save_board_picture", "PX_PER_MM", "SCALE_BAR_MM"]

@@ -62,18 +62,10 @@ class CascadeController:
         self.cg, self.cgs, self.act = self.buffer[layout.CR_CG], self.buffer[layout.CR_CGS], self.buffer[layout.CR_ACT]
         self.modes = np.full(3, layout.MODE_CLOSED, dtype=np.int64)
         alpha = speed_filter_alpha(params.control)
-        for d, (p, g) in enumerate(zip(params.drives, gains.drives, strict=True)):
-            row = self.cp[d]
-            row[layout.CP_RPC] = p.rad_per_count
-            row[layout.CP_KP_POS] = g.kp_pos
-            row[layout.CP_KI_POS] = g.ki_pos
-            row[layout.CP_KD_POS] = g.kd_pos
-            row[layout.CP_KFF] = g.kff_speed
-            row[layout.CP_WMAX] = g.max_speed_rad_s
-            row[layout.CP_KP_SPD] = g.kp_speed
-            row[layout.CP_KI_SPD] = g.ki_speed
-            row[layout.CP_KD_SPD] = g.kd_speed
-            row[layout.CP_ALPHA_W] = alpha
+        for d, p in enumerate(params.drives):
+            self.cp[d, layout.CP_RPC] = p.rad_per_count
+            self.cp[d, layout.CP_ALPHA_W] = alpha
+        self.set_gains(gains)
         c, s, cg = params.control, params.servo, self.cg
         cg[layout.CG_DT] = c.dt
         cg[layout.CG_SF_NORMAL:layout.CG_SF_NORMAL + 6] = setpoint_filter_row(c.setpoint_cutoff_hz, c.dt)
@@ -90,6 +82,19 @@ class CascadeController:
         n = layout.CONTROLLER_WIDTH
         self._i_raw = (layout.CS_R_RAW, n + layout.CS_R_RAW, 2 * n + layout.CS_R_RAW)
         self._i_offset = (layout.CS_OFFSET, n + layout.CS_OFFSET, 2 * n + layout.CS_OFFSET)
+
+    def set_gains(self, gains: Gains) -> None:
+        """Run the cascades with `gains` from the next step on; states and integrators are kept (no bump)."""
+        for d, g in enumerate(gains.drives):
+            row = self.cp[d]
+            row[layout.CP_KP_POS] = g.kp_pos
+            row[layout.CP_KI_POS] = g.ki_pos
+            row[layout.CP_KD_POS] = g.kd_pos
+            row[layout.CP_KFF] = g.kff_speed
+            row[layout.CP_WMAX] = g.max_speed_rad_s
+            row[layout.CP_KP_SPD] = g.kp_speed
+            row[layout.CP_KI_SPD] = g.ki_speed
+            row[layout.CP_KD_SPD] = g.kd_speed
 
     # ---- the step -------------------------------------------------------------
 

@@ -14,7 +14,7 @@ the controller step and the tuning model use the very same numbers.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.linalg import expm
@@ -124,5 +124,21 @@ def filter_cutoff_hz(params: ArmParams, fr_sw: bool) -> float:
 __all__ = [
     "MAX_SPEED_FRACTION", "SETPOINT_FILTER_ZETA", "DriveGains", "Gains", "DriveNumberError",
     "check_drive", "max_joint_speed", "speed_filter_alpha", "setpoint_filter_matrices",
-    "setpoint_filter_row", "filter_cutoff_hz",
+    "setpoint_filter_row", "filter_cutoff_hz", "THESIS_SAFETY", "preset_params",
 ]
+
+
+#: The Safety chart's thresholds the "thesis" preset needs at least: its loops answer a command later
+#: (a stall would read after 30 ms) and trail a moving setpoint further (docs/tuning.md).
+THESIS_SAFETY = {"silent_s": 0.2, "max_following_error_rad": 0.08}
+
+
+def preset_params(params: ArmParams) -> ArmParams:
+    """`params` with what the file's tuning preset needs of the rest: the "thesis" preset's slower loops
+    need a longer stall window and a wider following error in the Safety chart (:data:`THESIS_SAFETY`),
+    and the thesis fed no gear play forward (``gear_play_compensation = 0``)."""
+    if params.tuning.preset != "thesis":
+        return params
+    s = params.safety
+    wider = {k: max(v, getattr(s, k)) for k, v in THESIS_SAFETY.items()}
+    return replace(params, safety=replace(s, **wider), control=replace(params.control, gear_play_compensation=0.0))

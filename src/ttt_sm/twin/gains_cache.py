@@ -81,29 +81,32 @@ def _write(path: Path, gains: Gains) -> None:
         pass  # a read-only or full cache: the next process designs again
 
 
-def kept_gains(params: ArmParams, cache: Path | None = None) -> Gains:
-    """The gains :func:`ttt_sm.twin.tuning.design_gains` designs for `params`: from the cache when kept there.
+def kept_gains(params: ArmParams, preset: str = "ours", cache: Path | None = None) -> Gains:
+    """The gains of a tuning preset for `params` (:func:`ttt_sm.twin.tuning.gains_for`): from the cache when kept.
 
-    Raises what the design raises (:class:`ttt_sm.twin.tuning.TuningError`)
-    for parameters it cannot design for; nothing is kept then.
+    ``"ours"`` (the default, what the drives initialise with) is designed by
+    :func:`ttt_sm.twin.tuning.design_gains`; ``"thesis"`` holds the thesis'
+    hand-set gains with their margins measured.  Raises what the design raises
+    (:class:`ttt_sm.twin.tuning.TuningError`) for parameters it cannot design
+    for, or an unknown preset; nothing is kept then.
     """
     if cache is None:
-        return _kept_default(params)
-    return _kept(params, cache)
+        return _kept_default(params, preset)
+    return _kept(params, preset, cache)
 
 
 @lru_cache(maxsize=8)
-def _kept_default(params: ArmParams) -> Gains:
-    return _kept(params, user_cache("gains"))
+def _kept_default(params: ArmParams, preset: str) -> Gains:
+    return _kept(params, preset, user_cache("gains"))
 
 
-def _kept(params: ArmParams, cache: Path) -> Gains:
-    path = cache / f"{cache_key(params)}.json"
+def _kept(params: ArmParams, preset: str, cache: Path) -> Gains:
+    path = cache / f"{preset}-{cache_key(params)}.json"
     gains = _read(path)
     if gains is None:
-        from .tuning import design_gains  # python-control is imported only when a design is needed
+        from .tuning import gains_for  # python-control is imported only when a design is needed
 
-        gains = design_gains(params)
+        gains = gains_for(params, preset)
         _write(path, gains)
     return gains
 

@@ -77,7 +77,7 @@ def gear_play(tau: float, clearance: float, stiffness: float) -> float:
 
 def gravity_coefficients(params: ArmParams) -> tuple[float, float]:
     """(g2, g23), N m: gravity torques are -g2 sin q2 - g23 sin(q2 + q3) on joint 2, -g23 sin(q2 + q3) on 3."""
-    m, geo = params.masses, params.geometry
+    m, geo = params.masses, params.true_geometry  # the arm as built
     g2 = G * (m.link2_kg * m.link2_com + (m.link3_kg + m.tool_kg) * geo.L2)
     g23 = G * (m.link3_kg * m.link3_com + m.tool_kg * geo.L3)
     return g2, g23

@@ -275,6 +275,11 @@ class ArmSim:
         for d, off in enumerate(self.truth.offsets):
             self.set_offset_estimate(d + 1, float(off))
 
+    def set_gains(self, gains: Gains) -> None:
+        """Run the cascades with `gains` from now on (a tuning preset switched in after the init charts)."""
+        self.gains = gains
+        self.controller.set_gains(gains)
+
     def set_enabled(self, drive: int, enabled: bool) -> None:
         """Switch a drive's controller on (holding where the drive is) or off (bridge off)."""
         mode = layout.MODE_CLOSED if enabled else layout.MODE_OFF

@@ -21,7 +21,7 @@ from ..files import save_figure
 from ..params import ArmParams
 from .gains import Gains, check_drive
 from .sim import ArmSim
-from .tuning import design_gains, plot_loops
+from .tuning import gains_for, plot_loops
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -211,22 +211,25 @@ def plot_step(m: StepMetrics, path: Path) -> Path:
 LOOPS_PNG = "loops_bode.png"
 
 
-def tune_report(params: ArmParams, out_dir: Path | str) -> list[dict[str, Any]]:
-    """Design the gains, step every drive on the twin, write one PNG per drive and the Bode plot (``LOOPS_PNG``).
+def tune_report(params: ArmParams, out_dir: Path | str, preset: str = "ours") -> list[dict[str, Any]]:
+    """Take a tuning preset's gains, step every drive on the twin, write one PNG per drive and the Bode plot.
 
+    ``preset``: "ours" (:func:`~.tuning.design_gains`, the files ``step_drive{1,2,3}.png`` and
+    ``LOOPS_PNG``) or "thesis" (:func:`~.tuning.thesis_gains`, the same names with ``_thesis``).
     Returns one dict per drive with exactly the keys ``drive``, ``step_rad``,
     ``rise_time_s``, ``settling_time_s``, ``overshoot_pct``,
     ``error_at_0_5s_rad``, ``static_error_rad``, ``inner_phase_margin_deg``,
     ``outer_phase_margin_deg``, ``outer_gain_margin_db`` and ``plot``.
     """
     out = Path(out_dir)
-    gains = design_gains(params)
-    plot_loops(params, gains, out / LOOPS_PNG)
+    gains = gains_for(params, preset)
+    tag = "" if preset == "ours" else f"_{preset}"
+    plot_loops(params, gains, out / LOOPS_PNG.replace(".png", f"{tag}.png"))
     rows = []
     for drive in (1, 2, 3):
         m = step_response(params, gains, drive, STEP_RAD[drive])
         g = gains.drive(drive)
-        png = plot_step(m, out / f"step_drive{drive}.png")
+        png = plot_step(m, out / f"step_drive{drive}{tag}.png")
         rows.append({
             "drive": drive, "step_rad": m.step_rad, "rise_time_s": m.rise_time_s,
             "settling_time_s": m.settling_time_s, "overshoot_pct": m.overshoot_pct,
@@ -264,7 +267,9 @@ def report_text(rows: list[dict[str, Any]]) -> str:
               *(f"  {name:<{width}}  {meaning}" for _, name, _, _, meaning in REPORT_COLUMNS)]
     plots = [f"step plot (every column but the margins drawn): {r['plot']}" for r in rows if r.get("plot")]
     if plots:
-        plots.append(f"open loops (Bode, the margins drawn): {Path(rows[0]['plot']).parent / LOOPS_PNG}")
+        first = Path(rows[0]["plot"])
+        tag = first.stem.removeprefix("step_drive1")
+        plots.append(f"open loops (Bode, the margins drawn): {first.parent / LOOPS_PNG.replace('.png', tag + '.png')}")
     return "\n".join([header, *body, *legend, "", *plots])
 
 

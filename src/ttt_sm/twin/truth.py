@@ -85,7 +85,7 @@ class ArmTruth:
 
     def tool_pose(self) -> np.ndarray:
         """The true tool pose x, y, z (m), phi (rad): forward kinematics of :attr:`q` (eqs. 3.17-3.25)."""
-        return fk(self.q, self.params.geometry)
+        return fk(self.q, self.params.true_geometry)
 
     @property
     def offsets(self) -> np.ndarray:

@@ -27,7 +27,7 @@ import control as ct
 import numpy as np
 
 from ..files import save_figure
-from ..params import ArmParams, ParameterError
+from ..params import TUNING_PRESETS, ArmParams, ParameterError
 from .gains import DriveGains, Gains, check_drive, max_joint_speed, speed_filter_alpha
 
 if TYPE_CHECKING:
@@ -272,6 +272,59 @@ def design_gains(params: ArmParams) -> Gains:
     return Gains(drives=(out[0], out[1], out[2]))
 
 
+#: The tuning presets of ``[tuning] preset`` (docs/tuning.md): "ours", designed by :func:`design_gains`;
+#: "thesis", the thesis' structure with gains set by hand to reproduce its step responses (:func:`thesis_gains`).
+PRESETS = TUNING_PRESETS
+
+#: The "thesis" preset's gains per drive, set by hand on the twin as the thesis set its own on the arm
+#: (section 3.2, note: "tuning the controllers has been done experimentally"): position PID (kp 1/s, ki
+#: 1/s^2, kd), speed PID (kp s/rad, ki 1/rad, kd), no speed feedforward (the thesis' fig. 3.6 has none).
+#: Chosen so that the 1 rad (drives 1, 2) and 0.5 rad (drive 3) steps of ``step_response`` leave
+#: |error| at 0.5 s of the order of the thesis' 0.007, 0.0035 and 0.003 rad.
+THESIS_GAINS: tuple[tuple[float, float, float, float, float, float], ...] = (
+    (11.5, 0.0, 0.0, 0.67, 9.3, 0.0),
+    (16.0, 0.0, 0.0, 0.81, 10.2, 0.0),
+    (17.5, 0.0, 0.0, 0.51, 7.8, 0.0),
+)
+
+
+@lru_cache(maxsize=8)
+def thesis_gains(params: ArmParams) -> Gains:
+    """The "thesis" preset: the thesis' cascade (position PID, speed PID) with hand-set gains, margins measured.
+
+    The gains are :data:`THESIS_GAINS` whatever the parameter file (the thesis'
+    were numbers, not a design); the speed clamp is the drive's, as in
+    :func:`design_gains`; the margins are those of the same sampled loop models.
+    """
+    out = []
+    for drive in (1, 2, 3):
+        kp_q, ki_q, kd_q, kp_w, ki_w, kd_w = THESIS_GAINS[drive - 1]
+        g = DriveGains(kp_pos=kp_q, ki_pos=ki_q, kd_pos=kd_q, kff_speed=0.0,
+                       max_speed_rad_s=max_joint_speed(params.drives[drive - 1]), kp_speed=kp_w, ki_speed=ki_w,
+                       kd_speed=kd_w, inner_crossover_hz=0.0, inner_phase_margin_deg=0.0, inner_gain_margin_db=0.0,
+                       outer_crossover_hz=0.0, outer_phase_margin_deg=0.0, outer_gain_margin_db=0.0)
+        inner, outer = loop_models(params, drive, g)
+        pm_i, gm_i, fc_i = loop_margins(inner)
+        pm_o, gm_o, fc_o = loop_margins(outer)
+        out.append(DriveGains(**{**asdict(g), "inner_crossover_hz": fc_i, "inner_phase_margin_deg": pm_i,
+                                 "inner_gain_margin_db": gm_i, "outer_crossover_hz": fc_o,
+                                 "outer_phase_margin_deg": pm_o, "outer_gain_margin_db": gm_o}))
+    return Gains(drives=(out[0], out[1], out[2]))
+
+
+def gains_for(params: ArmParams, preset: str | None = None) -> Gains:
+    """The gains of a tuning preset (default: the parameter file's ``[tuning] preset``).
+
+    Raises :class:`TuningError` naming the presets for an unknown one.
+    """
+    name = params.tuning.preset if preset is None else preset
+    if name == "ours":
+        return design_gains(params)
+    if name == "thesis":
+        return thesis_gains(params)
+    raise TuningError(f"unknown tuning preset {name!r}; choose from {', '.join(PRESETS)}")
+
+
 def loops_figure(params: ArmParams, gains: Gains) -> Figure:
     """Bode plots of every drive's inner and outer open loop, with the margins drawn where they are read.
 
@@ -351,6 +404,7 @@ def plot_loops(params: ArmParams, gains: Gains, path: Path) -> Path:
 
 
 __all__ = [
+    "PRESETS", "THESIS_GAINS", "thesis_gains", "gains_for",
     "TuningError", "drive_plant", "speed_estimator", "loop_models", "loop_margins", "margin_points", "design_gains",
     "loops_figure", "plot_loops",
 ]

@@ -73,7 +73,7 @@ def arm_view(robot: Robot) -> dict[str, Any] | None:
     truth = robot.truth
     if truth is None:
         return None
-    g = robot.params.geometry
+    g = robot.params.true_geometry  # the true arm, as built
     q1, q2, q3, q4 = truth.angles()
     points = arm_points((q1, q2, q3, q4), g)
     x, y, z, _, s1, c1, s_phi, c_phi = arm_chain_py(q1, q2, q3, q4, g.L1, g.L2, g.L3, g.L4, g.l_f)

@@ -22,13 +22,15 @@ from ttt_sm.twin._ink import ink_capsule, wipe_sweep
 from ttt_sm.twin.kinematics import arm_chain_py
 
 from .errors import WhiteboardError
+from .pen_deviation import THESIS_CLEARANCE_M, THESIS_HOLDER, pen_deviation
 from .raster import InkRaster
 from .strokes import StrokeData, StrokeLog
 
 #: Line width of the robot's whiteboard marker (m).
 INK_WIDTH_M = 0.8e-3
-#: Largest tip deviation over the holder clearance: 0.35 mm for 0.4 mm (eqs. 3.11-3.13).
-TIP_DEVIATION_PER_CLEARANCE = 0.35 / 0.4
+#: Largest tip deviation over the holder clearance: L_s computed by eqs. 3.1-3.13 for the thesis' holder
+#: (0.35 mm) over the clearance section 3.3.1 names for it (0.4 mm); :mod:`.pen_deviation`.
+TIP_DEVIATION_PER_CLEARANCE = pen_deviation(THESIS_HOLDER).deviation_m / THESIS_CLEARANCE_M
 #: Beyond this tilt of the tool axis the spring cannot push the pen back along it:
 #: a tip below the surface is then a jam, counted as an overpress.
 PEN_MAX_TILT_RAD = math.radians(60.0)
@@ -112,7 +114,7 @@ class BoardContact:
     """
 
     def __init__(self, params: ArmParams, raster: InkRaster, log: StrokeLog) -> None:
-        g, b = params.geometry, params.board
+        g, b = params.true_geometry, params.board  # the true pen: the arm as built
         self._L1, self._L2, self._L3, self._L4, self._lf = g.L1, g.L2, g.L3, g.L4, g.l_f
         self._surface = b.surface_z
         self._raster, self._log = raster, log

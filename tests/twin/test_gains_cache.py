@@ -19,10 +19,10 @@ P = load_params()
 
 def test_kept_gains_are_the_designed_ones_cold_and_warm(tmp_path: Path) -> None:
     designed = design_gains(P)
-    cold = kept_gains(P, tmp_path)
+    cold = kept_gains(P, cache=tmp_path)
     files = list(tmp_path.glob("*.json"))
     assert [f.name for f in files] == [f"ours-{cache_key(P)}.json"]
-    warm = kept_gains(P, tmp_path)
+    warm = kept_gains(P, cache=tmp_path)
     # equal as frozen dataclasses of floats: every field bit for bit (NaN margins would break ==: none here)
     assert cold == designed and warm == designed
     assert list(tmp_path.glob(".tmp-*")) == []  # written whole, then renamed
@@ -38,13 +38,13 @@ def test_another_parameter_is_another_key() -> None:
 def test_a_broken_cache_file_is_designed_again_and_replaced(tmp_path: Path, content: str) -> None:
     path = tmp_path / f"ours-{cache_key(P)}.json"
     path.write_text(content)
-    assert kept_gains(P, tmp_path) == design_gains(P)
-    assert kept_gains(P, tmp_path) == design_gains(P) and path.read_text() != content
+    assert kept_gains(P, cache=tmp_path) == design_gains(P)
+    assert kept_gains(P, cache=tmp_path) == design_gains(P) and path.read_text() != content
 
 
 def test_a_cache_that_cannot_be_written_still_gives_the_gains() -> None:
     # sysfs refuses new entries even to root: the write fails, the gains are designed in the process
-    assert kept_gains(P, Path("/sys/ttt-sm-no-cache")) == design_gains(P)
+    assert kept_gains(P, cache=Path("/sys/ttt-sm-no-cache")) == design_gains(P)
 
 
 def test_a_process_with_the_gains_kept_builds_a_robot_without_python_control(tmp_path: Path) -> None:

@@ -15,6 +15,7 @@ import cv2
 import numpy as np
 import pytest
 
+from ttt_sm.files import RecordWriteError
 from ttt_sm.params import load_params
 from ttt_sm.twin._ink import ink_polyline
 from ttt_sm.twin.kinematics import fk, ik_closed_form
@@ -429,8 +430,10 @@ def test_save_png_round_trips_through_cv2(tmp_path):
     path = board.save_png(tmp_path / "board.png", px_per_mm=2, grid_mm=True)
     back = cv2.imread(str(path))
     assert np.array_equal(back, board.render(px_per_mm=2, grid_mm=True))
-    with pytest.raises(WhiteboardError, match="could not write"):
+    # a folder that is not there: the error names the picture (not the temporary file it was written to first)
+    with pytest.raises(RecordWriteError, match="No such file or directory") as refused:
         board.save_png(tmp_path / "missing" / "board.png")
+    assert refused.value.filename == str(tmp_path / "missing" / "board.png")
 
 
 # --------------------------------------------------------------------------- tails

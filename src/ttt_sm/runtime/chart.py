@@ -40,7 +40,7 @@ from statemachine.transition import Transition
 
 from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, buffers, check_values, collect_declarations, make_slot
 from .engine import EarlyReturn, Execution
-from .errors import ChartDefinitionError, TemporalLogicError, UnknownEventError
+from .errors import ChartDefinitionError, EventDataError, TemporalLogicError, UnknownEventError
 from .guards import Guard, compile_condition, compile_guard
 from .program import Node, Seg, build_program
 from .structure import (
@@ -51,6 +51,12 @@ from .structure import (
     tag_tick_transitions,
 )
 from .temporal import DurationSpec, Temporal
+
+#: Names an event's data may not take: python-statemachine gives the chart's guards and actions these
+#: keyword arguments itself (``self`` is the callback's own), so a datum so named would clash or be
+#: silently replaced.
+RESERVED_EVENT_DATA = frozenset({"self", "event", "event_data", "machine", "model", "transition", "state",
+                                 "source", "target"})
 
 _NO_PLAN = object()
 #: The key of the chart's own clock in ``_entered_at``: temporal logic on a junction outside every state.
@@ -450,7 +456,7 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
         """Tick ``n`` times; return how many ticks took a transition."""
         return sum(self.tick() is not None for _ in range(n))
 
-    def post(self, event: str, **data: Any) -> None:
+    def post(self, event: str, /, **data: Any) -> None:
         """Queue an event from outside, with its data; it is handled at the next tick.
 
         The data are passed as keyword arguments to the transition's guards and actions.
@@ -460,6 +466,7 @@ class TickChart(Execution, StateChart, metaclass=TickChartMeta):
                 f"{self.chart_name}: no transition handles event {event!r};"
                 f" events: {', '.join(self._structure.user_events) or '(none)'}"
             )
+        check_event_data(self.chart_name, event, data)
         self._queue.append((event, data))
 
     def handles(self, event: str) -> bool:
@@ -751,3 +758,15 @@ class _BufferedData(MutableMapping[str, Any]):
 
     def __len__(self) -> int:
         return len(self._chart._slots) + sum(k not in self._chart._slots for k in self._d)
+
+
+def check_event_data(chart: str, event: str, data: Mapping[str, Any]) -> None:
+    """Refuse event data a chart's callbacks cannot take: names of :data:`RESERVED_EVENT_DATA`, or not
+    identifiers (:class:`~.errors.EventDataError`, one line)."""
+    for name in data:
+        if not (isinstance(name, str) and name.isidentifier()):
+            raise EventDataError(f"{chart}: the data of event {event!r} must be named by identifiers, got {name!r}")
+        if name in RESERVED_EVENT_DATA:
+            raise EventDataError(f"{chart}: event {event!r} may not carry a datum named {name!r}: python-statemachine"
+                                 f" gives the chart's guards and actions {', '.join(sorted(RESERVED_EVENT_DATA))}"
+                                 " itself; choose another name")

@@ -213,6 +213,8 @@ class CoverageRuns:
         self._generated: dict[str, Generated] = {}  # by chart name; read and written on the worker only
         #: The limit of one run, wall seconds (:data:`COVERAGE_LIMIT_S`).
         self.limit_s = COVERAGE_LIMIT_S
+        #: Whether a job runs on the worker now.
+        self.running = False
         self._jobs: queue.Queue[Callable[[], None] | None] = queue.Queue(maxsize=8)
         self._closing = threading.Event()
         self._deadline = 0.0
@@ -226,10 +228,13 @@ class CoverageRuns:
             if job is None or self._closing.is_set():
                 return
             self._deadline = time.perf_counter() + self.limit_s
+            self.running = True
             try:
                 job()
             except BaseException:  # a job reports its own errors; nothing ends the worker but close()
                 log.exception("coverage job failed")
+            finally:
+                self.running = False
 
     def check(self) -> None:
         """Raise :class:`CoverageStopped` if the session stops or the run has had its time (on the worker)."""

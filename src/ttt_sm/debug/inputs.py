@@ -61,6 +61,10 @@ class Inputs:
         """
         if isinstance(value, str):
             value = self.parse_value(chart, name, value)
+        limits = self.datum_decl(chart, name).limits
+        if limits is not None and not (isinstance(value, (int, float)) and limits[0] <= value <= limits[1]):
+            raise DebugError(f"{chart}.{name} takes {limits[0]:g} to {limits[1]:g}, not {value!r}: the chart"
+                             " could not draw there (it would wait for a move that never ends)")
         self._do(Action(self._robot().steps, "force" if force else "set", chart, name, value))
         return value
 

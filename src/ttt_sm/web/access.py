@@ -33,6 +33,15 @@ def cookie_name(port: int | None) -> str:
     return "ttt_sm_token" if not port else f"ttt_sm_token_{port}"
 
 
+def port_of(host_header: str) -> int:
+    """The port a ``Host`` header names (``127.0.0.1:8765``, ``[::1]:8765``), 80 when it names none."""
+    if host_header.startswith("["):
+        rest = host_header[host_header.find("]") + 1:]
+        return int(rest[1:]) if rest.startswith(":") and rest[1:].isdigit() else 80
+    head, colon, tail = host_header.rpartition(":")
+    return int(tail) if colon and ":" not in head and tail.isdigit() else 80
+
+
 def is_wildcard(host: str) -> bool:
     """``0.0.0.0``, ``::`` or empty: every interface."""
     return host in ("", "0.0.0.0", "::")

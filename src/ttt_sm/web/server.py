@@ -54,7 +54,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from ..debug.debugger import Debugger
 from ..runtime.errors import GraphvizMissingError
-from .access import PUBLIC_PREFIXES, cookie_name
+from .access import PUBLIC_PREFIXES, cookie_name, port_of
 from .arm_view import ink_picture, png
 from .camera_feed import feed_png
 from .diagrams import DiagramError, Diagrams
@@ -101,8 +101,7 @@ class Guard:
         if self.token is None or str(scope.get("path", "")).startswith(PUBLIC_PREFIXES):
             await self.app(scope, receive, send)
             return
-        server = scope.get("server")
-        cookie = cookie_name(server[1] if server else None)
+        cookie = cookie_name(port_of(host))
         given = conn.query_params.get("token") or conn.cookies.get(cookie)
         if not (given and hmac.compare_digest(given.encode(), self.token.encode())):
             await self._refuse(scope, receive, send, "this cockpit needs its token: open the URL that"

@@ -287,3 +287,35 @@ def test_a_request_that_needs_a_busy_session_gets_503_and_other_routes_are_serve
         assert ink.status_code == 503 and "did not answer within 0.3 s" in ink.text
         assert client.get("/api/diagram/Control?view=overview").status_code == 200  # never waits for the session
     assert client.get("/api/arm/ink.png").status_code == 200
+
+
+def test_the_servers_own_commands_are_not_bounded_as_a_pages(session: Session) -> None:
+    """``cid`` 0 is no page (the bench sends its commands so): never refused, never dropped."""
+    for value in (2.0, "max"):
+        session.submit(0, parse_command(json.dumps({"type": "speed", "value": value})))
+    session.call(lambda d: None)
+    assert session.speed is None
+
+
+def test_a_page_that_has_used_its_share_of_the_session_is_refused_and_another_is_not(
+        session: Session, monkeypatch: pytest.MonkeyPatch) -> None:
+    from ttt_sm.web import session as session_module
+
+    monkeypatch.setattr(session_module, "PAGE_BURST_S", 0.0)  # no burst: any use at all is over the share
+    monkeypatch.setattr(session_module, "PAGE_SHARE", 1e-9)  # ... and it does not fall back during the test
+    greedy: list[dict[str, Any]] = []
+    other: list[dict[str, Any]] = []
+    a = session.connect(lambda text: greedy.append(json.loads(text)))
+    b = session.connect(lambda text: other.append(json.loads(text)))
+    try:
+        session.submit(a, parse_command('{"type": "tick", "id": 1}'))
+        session.call(lambda d: None)
+        session.submit(a, parse_command('{"type": "tick", "id": 2}'))
+        session.submit(b, parse_command('{"type": "pause", "id": 3}'))
+        session.call(lambda d: None)
+    finally:
+        session.disconnect(a)
+        session.disconnect(b)
+    assert [(m["type"], m["id"]) for m in greedy] == [("reply", 1), ("error", 2)]
+    assert "used the session more than one page may" in greedy[1]["error"]
+    assert [(m["type"], m["id"]) for m in other] == [("reply", 3)]

@@ -65,6 +65,10 @@ from .session import Session
 
 #: Messages queued for one page at most; a page that falls further behind gets a full frame again.
 CLIENT_QUEUE = 64
+#: Messages one page's WebSocket is read at, at most, a second (in bursts of as many): past it the server
+#: reads that page's socket no faster, so a flood waits in its own connection and never takes the server's
+#: thread (and with it the simulation's share of the interpreter) from the other pages.
+MESSAGE_RATE = 500
 #: How long a request that needs the session (``/api/arm/ink.png``) waits for it, seconds; then 503.
 SESSION_WAIT_S = 5.0
 #: Such requests waiting for the session at once, at most; one more gets 503 at once.
@@ -298,8 +302,16 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                     session.submit(cid, parse_command('{"type": "hello"}'))
 
         sender = asyncio.create_task(pump())
+        allowance, checked = float(MESSAGE_RATE), loop.time()
         try:
             while True:
+                now = loop.time()
+                allowance = min(float(MESSAGE_RATE), allowance + (now - checked) * MESSAGE_RATE)
+                checked = now
+                if allowance < 1.0:  # this page sends faster than it may: read it no faster (its TCP waits)
+                    await asyncio.sleep((1.0 - allowance) / MESSAGE_RATE)
+                    continue
+                allowance -= 1.0
                 message = await websocket.receive()
                 if message["type"] == "websocket.disconnect":
                     break

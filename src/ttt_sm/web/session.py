@@ -73,6 +73,12 @@ PAGE_QUEUE = 16
 #: Wall time one command may hold the simulation thread: a ``step``, ``tick`` or ``next`` that runs longer
 #: pauses after it (the reply says how far it came; send it again to go on).
 COMMAND_BUDGET_S = run_commands.COMMAND_BUDGET_S
+#: One page's commands take at most this share of the simulation thread's time, sustained, after a burst
+#: of :data:`PAGE_BURST_S`: past it the page's commands are refused until its use has fallen back (a flood
+#: of ``hello``s, each a full frame, or of replays, each seconds long, no longer takes the robot's time).
+PAGE_SHARE = 0.25
+#: Seconds of the simulation thread a page may use at once before :data:`PAGE_SHARE` holds it back.
+PAGE_BURST_S = 2.0
 #: While the robot runs, the commands take at most this share of the simulation thread's time (a flood of
 #: them is handled between longer stretches of the run, whose pace they do not take).
 COMMAND_SHARE = 0.3
@@ -87,8 +93,17 @@ class _Client:
     page: str = ""
     #: Commands of this page queued and not yet handled (at most :data:`PAGE_QUEUE`).
     queued: int = 0
-    #: Commands refused because the page had :data:`PAGE_QUEUE` waiting.
+    #: Commands refused because the page had :data:`PAGE_QUEUE` waiting, or had used its share.
     refused: int = 0
+    #: Seconds of the simulation thread this page's commands have used, less PAGE_SHARE of the time since.
+    used_s: float = 0.0
+    used_at: float = 0.0
+
+    def use(self, now: float, spent: float = 0.0) -> float:
+        """The page's use of the simulation thread now (``spent`` added): it falls by PAGE_SHARE a second."""
+        self.used_s = max(0.0, self.used_s - (now - self.used_at) * PAGE_SHARE) + spent
+        self.used_at = now
+        return self.used_s
 
 
 class _SessionClock:
@@ -228,16 +243,25 @@ class Session:
             return
         with self._lock:
             client = self._clients.get(cid)
-            if client is None:
+            if client is None and cid != 0:  # a page gone (cid 0: the server's own, the bench's: not bounded)
                 return
-            full = client.queued >= PAGE_QUEUE
-            if full:
-                client.refused += 1
-            else:
-                client.queued += 1
+            full = client is not None and client.queued >= PAGE_QUEUE
+            used = client.use(time.perf_counter()) if client is not None else 0.0
+            greedy = used > PAGE_BURST_S
+            if client is not None:
+                if full or greedy:
+                    client.refused += 1
+                else:
+                    client.queued += 1
         if full:
             self.reply_error(cid, f"{command.type}: refused: this page has {PAGE_QUEUE} commands waiting for the"
                                   " session already (the most one page may have); wait for their replies", command)
+            return
+        if greedy:
+            wait = (used - PAGE_BURST_S) / PAGE_SHARE
+            self.reply_error(cid, f"{command.type}: refused: this page's commands have used the session more than"
+                                  f" one page may ({PAGE_SHARE:.0%} of its time, after a burst of {PAGE_BURST_S:g}"
+                                  f" s); send it again in {max(wait, 0.1):.1f} s", command)
             return
         self._queue.put((cid, command))
         self._wake = True
@@ -563,7 +587,8 @@ class Session:
             self.reply_error(cid, f"{cmd.type}: not handled by this session", cmd)
             return
         robot, steps = self.debugger.robot, self.debugger.robot.steps
-        self._command_deadline = time.perf_counter() + COMMAND_BUDGET_S
+        started = time.perf_counter()
+        self._command_deadline = started + COMMAND_BUDGET_S
         try:
             result = spec.handler(self, cid, **cmd.args)
         except (DebugError, CoverageError, ValueError) as exc:
@@ -581,6 +606,9 @@ class Session:
                 self.send_to(cid, {"type": "reply", "id": cmd.id, "command": cmd.type, "ok": True, **result})
         finally:
             self._command_deadline = None
+            if client is not None:
+                with self._lock:
+                    client.use(time.perf_counter(), time.perf_counter() - started)
         self._dirty = True
 
 

@@ -319,3 +319,16 @@ def test_a_page_that_has_used_its_share_of_the_session_is_refused_and_another_is
     assert [(m["type"], m["id"]) for m in greedy] == [("reply", 1), ("error", 2)]
     assert "used the session more than one page may" in greedy[1]["error"]
     assert [(m["type"], m["id"]) for m in other] == [("reply", 3)]
+
+
+def test_a_warning_reaches_every_page_and_the_session_runs_on(session: Session) -> None:
+    heard: list[dict[str, Any]] = []
+    cid = session.connect(lambda text: heard.append(json.loads(text)))
+    try:
+        session.join(cid, "charts")
+        session.warn_pages("tracing stopped: out/gui/trace.jsonl: No space left on device")
+    finally:
+        session.disconnect(cid)
+    assert heard[-1] == {"type": "error", "id": None, "command": None, "fatal": False,
+                         "error": "tracing stopped: out/gui/trace.jsonl: No space left on device"}
+    assert session.error is None and session.call(lambda d: True)

@@ -474,6 +474,13 @@ class Session:
         finally:
             self.ended.set()
 
+    def warn_pages(self, text: str) -> None:
+        """Tell every page something went wrong that does not end the session (any thread): an ``error``
+        with no command, ``fatal`` false.  The hook for a trace that stops being written (a full disk
+        under ``ttt-sm gui --trace``): the session runs on, its pages are told."""
+        log.warning("%s", text)
+        self.broadcast({"type": "error", "id": None, "command": None, "error": text, "fatal": False})
+
     def died(self, why: str) -> None:
         """The simulation thread cannot go on: every page is told (an ``error`` marked ``fatal``), the
         commands still queued are refused, and :attr:`death_listeners` hear it (``ttt-sm gui`` then stops

@@ -332,3 +332,17 @@ def test_a_warning_reaches_every_page_and_the_session_runs_on(session: Session) 
     assert heard[-1] == {"type": "error", "id": None, "command": None, "fatal": False,
                          "error": "tracing stopped: out/gui/trace.jsonl: No space left on device"}
     assert session.error is None and session.call(lambda d: True)
+
+
+def test_the_streamed_trace_is_served_as_written_so_far(tmp_path: Any) -> None:
+    dbg = Debugger.build(load_params(), seed=0, trace_path=tmp_path / "trace.jsonl")
+    s = Session(dbg, speed=None, running=False)
+    s.start()
+    try:
+        s.call(lambda d: d.step(3000))
+        with TestClient(create_app(s, manage_session=False)) as c:
+            got = c.get("/api/trace.jsonl")
+        written = (tmp_path / "trace.jsonl").read_bytes()
+        assert got.status_code == 200 and written.startswith(got.content) and got.content.count(b"\n") >= 2
+    finally:
+        s.stop()

@@ -46,7 +46,7 @@ from urllib.parse import urlsplit
 
 from starlette.applications import Starlette
 from starlette.requests import HTTPConnection, Request
-from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
+from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response, StreamingResponse
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Receive, Scope, Send
@@ -260,13 +260,25 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
 
     async def trace(request: Request) -> Response:
         streamed = session.debugger.trace_file
-        if streamed is not None and not streamed.closed:  # the whole trace, as written so far
-            body = await asyncio.to_thread(streamed.path.read_text, encoding="utf-8")
-        else:  # the transitions kept in memory
-            records = list(session.debugger.trace.records)
-            body = "".join(r.to_json() + "\n" for r in records)
-        return Response(body, media_type="application/x-ndjson",
-                        headers={"Content-Disposition": 'attachment; filename="trace.jsonl"'})
+        headers = {"Content-Disposition": 'attachment; filename="trace.jsonl"'}
+        if streamed is not None and not streamed.closed:  # the whole trace, as written so far, a MB at a time
+            path = streamed.path
+            size = await asyncio.to_thread(lambda: path.stat().st_size)
+
+            async def chunks() -> AsyncIterator[bytes]:
+                with open(path, "rb") as f:
+                    left = size
+                    while left > 0:
+                        data = await asyncio.to_thread(f.read, min(1 << 20, left))
+                        if not data:
+                            return
+                        left -= len(data)
+                        yield data
+
+            return StreamingResponse(chunks(), media_type="application/x-ndjson", headers=headers)
+        records = list(session.debugger.trace.records)  # the transitions kept in memory
+        body = "".join(r.to_json() + "\n" for r in records)
+        return Response(body, media_type="application/x-ndjson", headers=headers)
 
     async def ws(websocket: WebSocket) -> None:
         host = websocket.headers.get("host", "")

@@ -122,10 +122,22 @@ async def still_answers(host: str, token: str) -> bool:
     return False
 
 
-async def flood(host: str, token: str, messages: list[str]) -> tuple[float, float, Counter[str]]:
-    """Send ``messages`` from one page as fast as its socket takes them; how they were answered."""
+async def flood(host: str, token: str, messages: list[str], rate: float | None = None,
+                answers: Counter[str] | None = None) -> tuple[float, float, Counter[str]]:
+    """Send ``messages`` from one page as fast as its socket takes them (or ``rate`` a second); how they were
+    answered.  A server that closes the page (its keep-alive ping unanswered behind the flood) ends it."""
+    try:
+        return await _flood(host, token, messages, rate, answers if answers is not None else Counter())
+    except websockets.ConnectionClosed as exc:
+        now = time.perf_counter()
+        counted = answers if answers is not None else Counter()
+        counted[f"closed by the server: {exc.rcvd.reason if exc.rcvd else exc}"] += 1
+        return now, now, counted
+
+
+async def _flood(host: str, token: str, messages: list[str], rate: float | None,
+                 answers: Counter[str]) -> tuple[float, float, Counter[str]]:
     ws = await connect(host, token)
-    answers: Counter[str] = Counter()
 
     async def read() -> None:
         async for text in ws:
@@ -140,8 +152,10 @@ async def flood(host: str, token: str, messages: list[str]) -> tuple[float, floa
 
     reader = asyncio.create_task(read())
     t0 = time.perf_counter()
-    for text in messages:
+    for i, text in enumerate(messages):
         await ws.send(text)
+        if rate is not None and i % 50 == 49:
+            await asyncio.sleep(max(0.0, t0 + (i + 1) / rate - time.perf_counter()))
     # the server reads a page at most MESSAGE_RATE messages a second: the rest waits in this page's TCP
     # connection; the flood is over when the server has read the last message (answered, or refused)
     # (asked again every 2 s: a page that floods also overflows its own outbox, and an answer may be dropped)
@@ -175,11 +189,15 @@ async def probe(n_flood: int, n_posts: int) -> dict[str, Any]:
             out["flood"] = {"messages": n_flood, "read_in_s": round(t1 - t0, 2), **viewer.between(t0, t1),
                             "answers": dict(answers)}
             out["flood"]["session_alive"] = proc.poll() is None and await still_answers(host, token)
-            p0, p1, answers = await flood(host, token, [json.dumps({"type": "post", "chart": "Control",
-                                                                   "event": "button", "id": i})
-                                                       for i in range(n_posts)])
+            # four pages, each at 450 a second (the server reads a page at 500): all are read, none is closed
+            pages = 4
+            share = [[json.dumps({"type": "post", "chart": "Control", "event": "button", "id": i})
+                      for i in range(k, n_posts, pages)] for k in range(pages)]
+            spans = await asyncio.gather(*(flood(host, token, part, rate=450.0) for part in share))
+            p0, p1 = min(a for a, _, _ in spans), max(b for _, b, _ in spans)
+            answers = sum((c for _, _, c in spans), Counter())
             await asyncio.sleep(5)
-            out["posts"] = {"messages": n_posts, "read_in_s": round(p1 - p0, 2),
+            out["posts"] = {"messages": n_posts, "pages": pages, "read_in_s": round(p1 - p0, 2),
                             "rss_after_mb": round(rss_mb(proc.pid), 1),
                             "rss_above_idle_mb": round(rss_mb(proc.pid) - idle, 1),
                             **viewer.between(p0, p1), "answers": dict(answers)}

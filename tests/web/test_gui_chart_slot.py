@@ -37,14 +37,14 @@ def test_gui_runs_the_chart_given_with_chart_in_its_slot(tmp_path: Path) -> None
         assert proc.stdout is not None
         url = None
         for _ in range(10):  # the address is among the first lines it prints
-            found = re.search(r"(http://127\.0\.0\.1:\d+)/charts", proc.stdout.readline())
+            found = re.search(r"(http://127\.0\.0\.1:\d+)/charts\?token=([\w-]+)", proc.stdout.readline())
             if found:
-                url = found.group(1)
+                url, token = found.group(1), found.group(2)
                 break
         assert url is not None, "no address printed"
-        svg = _get(f"{url}/api/diagram/DriveInit3", proc)
+        svg = _get(f"{url}/api/diagram/DriveInit3?token={token}", proc)
         assert 'data-state="DriveInit3.creep"' in svg and 'data-state="DriveInit3.approach"' not in svg
-        thesis = _get(f"{url}/api/diagram/DriveInit1", proc)
+        thesis = _get(f"{url}/api/diagram/DriveInit1?token={token}", proc)
         assert 'data-state="DriveInit1.' in thesis  # the other slots keep the thesis' charts
     finally:
         proc.terminate()

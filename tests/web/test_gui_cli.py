@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from ttt_sm.cli.gui import needs_token
+from ttt_sm.cli.gui import beyond_this_machine
 
 
 def test_gui_serves_the_printed_address_and_ctrl_c_saves_the_trace(tmp_path: Path) -> None:
@@ -23,7 +23,7 @@ def test_gui_serves_the_printed_address_and_ctrl_c_saves_the_trace(tmp_path: Pat
         url = None
         for _ in range(10):
             line = proc.stdout.readline()
-            found = re.search(r"(http://127\.0\.0\.1:\d+/charts)", line)
+            found = re.search(r"(http://127\.0\.0\.1:\d+/charts\?token=[\w-]+)", line)
             if found:
                 url = found.group(1)
                 break
@@ -36,7 +36,7 @@ def test_gui_serves_the_printed_address_and_ctrl_c_saves_the_trace(tmp_path: Pat
                 import time
                 time.sleep(0.1)
         assert 'data-role="sim-time"' in page
-        index = urllib.request.urlopen(url.replace("/charts", "/"), timeout=5).read().decode()
+        index = urllib.request.urlopen(url.replace("/charts", "/"), timeout=5).read().decode()  # the token too
         assert 'href="/charts"' in index
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=60)
@@ -48,7 +48,7 @@ def test_gui_serves_the_printed_address_and_ctrl_c_saves_the_trace(tmp_path: Pat
     assert trace.is_file()
 
 
-@pytest.mark.parametrize("host, token", [("127.0.0.1", False), ("localhost", False), ("::1", False),
-                                         ("0.0.0.0", True), ("192.168.1.5", True), ("robot.lab", True)])
-def test_every_host_but_loopback_needs_the_token(host: str, token: bool) -> None:
-    assert needs_token(host) is token
+@pytest.mark.parametrize("host, beyond", [("127.0.0.1", False), ("localhost", False), ("::1", False),
+                                          ("0.0.0.0", True), ("192.168.1.5", True), ("robot.lab", True)])
+def test_every_host_but_loopback_is_said_to_reach_beyond_this_machine(host: str, beyond: bool) -> None:
+    assert beyond_this_machine(host) is beyond

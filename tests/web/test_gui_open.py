@@ -27,7 +27,7 @@ def test_gui_open_gives_the_printed_address_to_the_browser_named_in_BROWSER(tmp_
         assert proc.stdout is not None
         url = None
         for _ in range(10):
-            found = re.search(r"(http://127\.0\.0\.1:\d+/charts)", proc.stdout.readline())
+            found = re.search(r"(http://127\.0\.0\.1:\d+/charts\?token=[\w-]+)", proc.stdout.readline())
             if found:
                 url = found.group(1)
                 break
@@ -36,7 +36,7 @@ def test_gui_open_gives_the_printed_address_to_the_browser_named_in_BROWSER(tmp_
         while not (opened.exists() and opened.read_text().endswith("\n")) and time.monotonic() < deadline \
                 and proc.poll() is None:
             time.sleep(0.05)
-        assert opened.read_text().splitlines() == [url]  # once, the address printed
+        assert opened.read_text().splitlines() == [url]  # once, the address printed, its token too
         page = urllib.request.urlopen(url, timeout=10).read().decode()  # and it serves the cockpit
         assert 'data-role="sim-time"' in page
         proc.send_signal(signal.SIGINT)

@@ -191,15 +191,22 @@ def test_frames_carry_every_transition_once_and_in_order(client: TestClient, ses
         page = Page(ws)
         page.join()
         first = session.call(lambda d: len(d.trace.records))
-        page.answer(page.send(type="step", n=12_000))  # the init charts' first transitions
+        start = session.call(lambda d: d.robot.steps)
         seen: list[dict[str, Any]] = []
+        while (done := session.call(lambda d: d.robot.steps)) < start + 12_000:  # the init charts' first transitions
+            msg_id = page.send(type="step", n=start + 12_000 - done)  # a long one pauses after 1 s of wall time
+            while (m := ws.receive_json())["type"] != "reply" or m["id"] != msg_id:
+                if m["type"] == "frame":
+                    assert m["transitions_total"] == len(m["transitions"])
+                    seen += m["transitions"]
+        steps_end = done
         while True:
             frame = page.frame()
             seen += frame["transitions"]
             assert frame["transitions_total"] == len(frame["transitions"])  # none left out here
-            if frame["steps"] >= 12_000 and not frame["transitions"]:
+            if frame["steps"] >= steps_end and not frame["transitions"]:
                 break
-            if len(seen) and frame["steps"] >= 12_000:
+            if len(seen) and frame["steps"] >= steps_end:
                 break
         records = session.call(lambda d: list(d.trace.records))[first:]
     assert [(t["chart"], t["source"], t["target"], t["tick"]) for t in seen] == \

@@ -311,7 +311,7 @@ class Robot:
             return self.safety_stage.overrides, name
         return self.init_stage.overrides, (self._init_index(chart), name)
 
-    def post(self, chart: str, event: str, **data: Any) -> None:
+    def post(self, chart: str, event: str, /, **data: Any) -> None:
         """Send an event to a chart; it is handled at the chart's next tick."""
         self.chart(chart).post(event, **data)
 

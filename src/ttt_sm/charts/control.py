@@ -73,8 +73,8 @@ class Control(TickChart):
     ignored_buttons: int
 
     inputs = (
-        Data("row", "1", 1, "row of the cell to draw in, 1..5 (eq. 3.38)"),
-        Data("column", "1", 1, "column of the cell to draw in, 1..5 (eq. 3.37)"),
+        Data("row", "1", 1, "row of the cell to draw in, 1..5 (eq. 3.38)", limits=(1, 5)),
+        Data("column", "1", 1, "column of the cell to draw in, 1..5 (eq. 3.37)", limits=(1, 5)),
         Data("symbol", "1", 1, "symbol the button draws: 1 = X, 0 = O"),
         Data("finish", "bool", False, "1: finish the application, return to the start pose"),
         Data("erase", "bool", False, "erasing flag: erase the board at the next wait"),

@@ -29,7 +29,8 @@ def register(sub: Any) -> argparse.ArgumentParser:
     sp: argparse.ArgumentParser = sub.add_parser("gui", help=help_, description=help_)
     sp.set_defaults(func=cmd_gui)
     sp.add_argument("--host", default="127.0.0.1",
-                    help="address to listen on (default 127.0.0.1; any other needs the printed token)")
+                    help="address to listen on (default 127.0.0.1; 0.0.0.0: every interface, for other machines);"
+                         " every request needs the token in the printed URL")
     sp.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"port (default {DEFAULT_PORT}; 0: any free one)")
     sp.add_argument("--seed", type=seed, default=0, help="seed of the simulated arm (default 0)")
     add_arm_option(sp)
@@ -74,7 +75,7 @@ def parse_speed(text: str) -> float | None:
     return value
 
 
-def needs_token(host: str) -> bool:
+def beyond_this_machine(host: str) -> bool:
     """Whether a listening address is reachable from other machines (everything but loopback)."""
     if host in LOOPBACK:
         return False
@@ -94,6 +95,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
     from ..debug.debugger import Debugger
     from ..runtime.recordfile import ending_of
     from ..twin.workspace import load_arm
+    from ..web.access import allowed_hosts, bracket, reachable_host
     from ..web.camera_feed import CameraFeedError, open_feed
     from ..web.coverage import scenario_dir_files
     from ..web.server import create_app
@@ -115,7 +117,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
     trace = trace_file(args.trace)  # refused now if it cannot be written, not when the cockpit stops
     params = load_arm(getattr(args, "params", None))
     lab = lab_watch(args) if args.lab is not None else None
-    token = secrets.token_urlsafe(24) if needs_token(args.host) else None
+    token = secrets.token_urlsafe(24)  # on every start, loopback included: any local process or user could drive
     try:
         sock = socket.socket(socket.AF_INET6 if ":" in args.host else socket.AF_INET, socket.SOCK_STREAM)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -131,10 +133,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
     try:
         session = Session(dbg, speed=speed, running=not args.paused, scenarios=scenario_dir_files(folder),
                           camera_feed=feed)
-        shown = f"[{args.host}]" if ":" in args.host else args.host
-        hosts = [f"{h}:{port}" for h in ("127.0.0.1", "localhost", "[::1]", shown)]
-        app = create_app(session, token=token, hosts=hosts, lab=lab)
-        url = f"http://{shown}:{port}/charts" + (f"?token={token}" if token else "")
+        shown = bracket(reachable_host(args.host))
+        app = create_app(session, token=token, hosts=allowed_hosts(args.host, port), lab=lab)
+        url = f"http://{shown}{'' if port == 80 else f':{port}'}/charts?token={token}"
         print(f"ttt-sm gui: the chart cockpit is at {url}", flush=True)
         if lab is not None:
             print(f"ttt-sm gui: your chart, live while you write it, is at {url.replace('/charts', '/lab', 1)}"
@@ -145,9 +146,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
             print(f"ttt-sm gui: each game's record goes to {record_root}/game-N/game.jsonl", flush=True)
         if feed is not None:
             print(f"ttt-sm gui: the {feed.kind} camera {feed.name} is shown in the /game page", flush=True)
-        if token:
-            print("ttt-sm gui: listening beyond this machine: the token in that URL is needed; keep it to yourself",
-                  flush=True)
+        if beyond_this_machine(args.host):
+            print("ttt-sm gui: listening beyond this machine: the token in that URL is what lets a browser in;"
+                  " keep it to yourself", flush=True)
         print("ttt-sm gui: Ctrl-C stops it (the trace is written to " + args.trace + " as it happens)", flush=True)
         if args.open:  # the game's page when you play there, the lab's with --lab, else the chart cockpit
             shown_url = (url.replace("/charts", "/game", 1) if args.game and args.person == "page" else
@@ -163,10 +164,17 @@ def cmd_gui(args: argparse.Namespace) -> int:
             handle_exit(sig, frame)
 
         server.handle_exit = stop_on  # type: ignore[method-assign]  # uvicorn installs it for SIGINT, SIGTERM
+
+        def session_died(why: str) -> None:  # not a corpse that serves pages: the server stops, the status says so
+            server.should_exit = True
+
+        session.death_listeners.append(session_died)
         try:
             server.run(sockets=[sock])
         except KeyboardInterrupt:
             pass  # uvicorn shut down (the session stopped, the trace saved), then passed the Ctrl-C on
+        if session.error is not None:
+            raise CliError(session.error)
     except BaseException as exc:  # before the server ran, or it broke: the trace's last line says so
         how, data = ending_of(exc)
         dbg.end_trace(how, **data)  # nothing if the session ended it already

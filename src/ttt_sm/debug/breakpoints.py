@@ -35,6 +35,13 @@ from ..runtime.structure import TICK_EVENT_NAME, TICK_EVENT_PREFIX, ChartStructu
 from .errors import DebugError
 from .expr import Condition, Names, parse_condition
 
+#: Breakpoints a session holds at most.
+MAX_BREAKPOINTS = 50
+#: Characters of ``when`` conditions, all together, at most: each is evaluated after every chart tick
+#: (about 10 us a comparison in Python, 500 chart ticks a simulated second), so this keeps them to a few
+#: tenths of a millisecond a tick and a run at its pace.
+MAX_CONDITIONS_CHARS = 2000
+
 Kind = Literal["enter", "exit", "transition", "event", "when"]
 KINDS: tuple[Kind, ...] = ("enter", "exit", "transition", "event", "when")
 
@@ -265,8 +272,15 @@ class BreakpointTable:
         """Add a breakpoint from its command text, e.g. ``"enter DriveInit1.turn_back"``,
         ``"transition DriveInit1 turn_fwd->turn_back"``, ``"event DriveInit1.tick"``,
         ``"when DriveInit1.pos_Encoder > 1.0"``."""
+        if len(self.items) >= MAX_BREAKPOINTS:
+            raise DebugError(f"at most {MAX_BREAKPOINTS} breakpoints: delete some first (delete N, or delete all)")
         bp = parse_breakpoint(self._next_id, text, self._index(), self._names)
         if bp.condition is not None:
+            total = sum(len(b.spec) for b in self.items if b.condition is not None) + len(bp.spec)
+            if total > MAX_CONDITIONS_CHARS:
+                raise DebugError(f"the 'when' breakpoints would hold {total} characters of conditions, more than the"
+                                 f" {MAX_CONDITIONS_CHARS} that are checked after every chart tick; delete some"
+                                 " first")
             bp.last_value = bp.condition.evaluate(self._names)
         self._next_id += 1
         self.items.append(bp)

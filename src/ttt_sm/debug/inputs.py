@@ -19,6 +19,14 @@ from .names import RobotNames, datum_decl, parse_input_value
 from .records import Action
 from .replay import game_of
 
+#: Events posted to one chart and not yet handled, at most: the chart handles them at its next tick, one
+#: wake-up each, so a paused session that is posted to without end would hold them all (and every replay
+#: fingerprint a copy).  One more is refused until the chart ticks.
+MAX_PENDING_EVENTS = 100
+#: Inputs recorded for replay, at most, since power-on (or the last new game): a replay applies every one
+#: again.  Past it an input is refused; a replay to an earlier tick drops those after it.
+MAX_ACTIONS = 10_000
+
 
 class Inputs:
     """The inputs set, forced and released, the events posted and a GUI person's clicks, as :class:`Action`\\ s.
@@ -53,6 +61,10 @@ class Inputs:
         """
         if isinstance(value, str):
             value = self.parse_value(chart, name, value)
+        limits = self.datum_decl(chart, name).limits
+        if limits is not None and not (isinstance(value, (int, float)) and limits[0] <= value <= limits[1]):
+            raise DebugError(f"{chart}.{name} takes {limits[0]:g} to {limits[1]:g}, not {value!r}: the chart"
+                             " could not draw there (it would wait for a move that never ends)")
         self._do(Action(self._robot().steps, "force" if force else "set", chart, name, value))
         return value
 
@@ -69,8 +81,14 @@ class Inputs:
             self._do(Action(self._robot().steps, "release", c, n))
         return keys
 
-    def post(self, chart: str, event: str, **data: Any) -> None:
-        """Post an event to a chart; it is handled at the chart's next tick."""
+    def post(self, chart: str, event: str, /, **data: Any) -> None:
+        """Post an event to a chart; it is handled at the chart's next tick (at most
+        :data:`MAX_PENDING_EVENTS` wait for it)."""
+        target = self._robot().charts.get(chart)
+        waiting = target.pending_events if target is not None else []
+        if len(waiting) >= MAX_PENDING_EVENTS:
+            raise DebugError(f"post: {chart} has {len(waiting)} events waiting for its next chart tick already, the"
+                             f" most it holds; step or run so it handles them, then post again")
         self._do(Action(self._robot().steps, "post", chart, event, data=dict(data)))
 
     def game_input(self, name: str, **data: Any) -> None:
@@ -107,6 +125,10 @@ class Inputs:
 
     def _do(self, action: Action) -> None:
         """Apply an action and record it (a refused one raises and is not recorded)."""
+        if len(self.actions) >= MAX_ACTIONS:
+            raise DebugError(f"{action.kind}: this run has recorded {len(self.actions)} inputs, the most a replay"
+                             " repeats; replay to an earlier tick (it drops the inputs after it) or start the"
+                             " session again")
         self.apply(action)
         self.actions.append(action)
         # The future after this step is no longer what the session saw.

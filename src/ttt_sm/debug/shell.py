@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import cmd
 import inspect
+import os
 import shlex
 import sys
+import traceback
 from collections.abc import Iterable
 from typing import IO, Any
 
@@ -97,8 +99,12 @@ class DebugShell(cmd.Cmd):
             done = bool(super().onecmd(line))
         except USER_ERRORS as exc:
             self.error(str(exc))
-        except Exception as exc:  # a bug in a chart action: say it, keep the session
-            self.error(f"{type(exc).__name__}: {exc}")
+        except Exception as exc:  # a bug in a chart action (or of ttt_sm): say it in words, keep the session
+            said = " ".join(str(exc).split()) or "no message"
+            self.error(f"{line.split()[0]}: it failed inside ({said}): a chart's action raised, or a bug of ttt_sm"
+                       " (TTT_SM_TRACEBACK=1 shows where); the session goes on")
+            if os.environ.get("TTT_SM_TRACEBACK"):
+                traceback.print_exc()
         self.command = None
         failure = self.dbg.trace_failure
         if failure is not None and not self._trace_failure_told:  # once: the trace file stopped (a full disk)
@@ -146,6 +152,9 @@ class DebugShell(cmd.Cmd):
         for raw in lines:
             line = raw.rstrip("\r\n")
             self.say(PROMPT + line)
+            if line.split("#", 1)[0].strip() == "EOF":  # cmd's word for the end of typed input: not a command here
+                self.default(line)
+                continue
             if self.onecmd(line):
                 return
         self.say("(end of commands)")

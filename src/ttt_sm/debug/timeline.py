@@ -122,7 +122,8 @@ class Timeline:
     def window(self, chart: str, now: int, period_s: float, seconds: float | None = None) -> TimelineWindow:
         """The intervals overlapping the last ``seconds`` of chart time before chart tick ``now``
         (None: everything kept)."""
-        first = 0 if seconds is None else max(0, now - int(round(seconds / period_s)))
+        # a window longer than the run is the whole run (and 1e308 s is no overflow)
+        first = 0 if seconds is None or seconds / period_s >= now else max(0, now - int(round(seconds / period_s)))
         kept = [iv for iv in self.intervals(chart)
                 if (iv.left is None or iv.left >= first) and iv.entered <= now]
         if seconds is None and kept and self._dropped.get(chart, 0):

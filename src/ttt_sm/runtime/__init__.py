@@ -10,6 +10,7 @@ from .data import Data
 from .errors import (
     ChartDefinitionError,
     ChartExecutionError,
+    EventDataError,
     GraphvizMissingError,
     TemporalLogicError,
     UnknownDataError,
@@ -29,6 +30,7 @@ __all__ = [
     "before",
     "duration",
     "every",
+    "EventDataError",
     "ChartStructure",
     "Data",
     "GraphvizMissingError",

@@ -42,7 +42,7 @@ from .chart_clock import ChartClock
 from .chart_data import ChartData
 from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, buffers, check_values, collect_declarations, make_slot
 from .engine import EarlyReturn, Execution
-from .errors import ChartDefinitionError, TemporalLogicError, UnknownEventError
+from .errors import ChartDefinitionError, EventDataError, TemporalLogicError, UnknownEventError
 from .guards import Guard, compile_condition, compile_guard
 from .program import Node, Seg, build_program
 from .structure import (
@@ -53,6 +53,12 @@ from .structure import (
     tag_tick_transitions,
 )
 from .temporal import DurationSpec
+
+#: Names an event's data may not take: python-statemachine gives the chart's guards and actions these
+#: keyword arguments itself (``self`` is the callback's own), so a datum so named would clash or be
+#: silently replaced.
+RESERVED_EVENT_DATA = frozenset({"self", "event", "event_data", "machine", "model", "transition", "state",
+                                 "source", "target"})
 
 _NO_PLAN = object()
 #: The key of the chart's own clock in ``_entered_at``: temporal logic on a junction outside every state.
@@ -452,7 +458,7 @@ class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChar
         """Tick ``n`` times; return how many ticks took a transition."""
         return sum(self.tick() is not None for _ in range(n))
 
-    def post(self, event: str, **data: Any) -> None:
+    def post(self, event: str, /, **data: Any) -> None:
         """Queue an event from outside, with its data; it is handled at the next tick.
 
         The data are passed as keyword arguments to the transition's guards and actions.
@@ -462,6 +468,7 @@ class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChar
                 f"{self.chart_name}: no transition handles event {event!r};"
                 f" events: {', '.join(self._structure.user_events) or '(none)'}"
             )
+        check_event_data(self.chart_name, event, data)
         self._queue.append((event, data))
 
     def handles(self, event: str) -> bool:
@@ -585,3 +592,15 @@ class _Engine(SyncEngine):
 def entered_states(chart: StateChart, transition: Transition) -> list[State]:
     """Alias of :func:`.structure.states_entered_by`, for listeners written by users."""
     return states_entered_by(chart, transition)
+
+
+def check_event_data(chart: str, event: str, data: Mapping[str, Any]) -> None:
+    """Refuse event data a chart's callbacks cannot take: names of :data:`RESERVED_EVENT_DATA`, or not
+    identifiers (:class:`~.errors.EventDataError`, one line)."""
+    for name in data:
+        if not (isinstance(name, str) and name.isidentifier()):
+            raise EventDataError(f"{chart}: the data of event {event!r} must be named by identifiers, got {name!r}")
+        if name in RESERVED_EVENT_DATA:
+            raise EventDataError(f"{chart}: event {event!r} may not carry a datum named {name!r}: python-statemachine"
+                                 f" gives the chart's guards and actions {', '.join(sorted(RESERVED_EVENT_DATA))}"
+                                 " itself; choose another name")

@@ -63,6 +63,10 @@ class Data:
         One line saying what the datum means.
     kind : {"input", "output", "local"}
         Filled in by the chart class from the attribute the datum is listed in.
+    limits : (low, high), optional
+        The values an input may be given from outside (the debugger's ``set`` and
+        ``force``, the cockpit's): one beyond them is refused, not taken to a state
+        the chart cannot leave (a cell's row of 1e12).  The wiring is not checked.
     """
 
     name: str
@@ -70,6 +74,7 @@ class Data:
     default: Any = 0.0
     doc: str = ""
     kind: Kind | Literal[""] = field(default="", compare=False)
+    limits: tuple[float, float] | None = field(default=None, compare=False)
 
     def fresh_default(self) -> Any:
         """The default value, copied when it is mutable."""

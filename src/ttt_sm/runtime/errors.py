@@ -36,6 +36,11 @@ class UnknownEventError(KeyError):
         return str(self.args[0]) if self.args else ""
 
 
+class EventDataError(UnknownEventError):
+    """An event's data under a name the chart's callbacks cannot take (one python-statemachine gives them
+    itself: :data:`~ttt_sm.runtime.chart.RESERVED_EVENT_DATA`)."""
+
+
 class UnknownDataError(KeyError):
     """A data name was given that the chart does not declare."""
 

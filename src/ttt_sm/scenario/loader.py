@@ -29,8 +29,9 @@ from pathlib import Path
 from typing import Any, Literal, cast
 
 from ..runtime import TickChart
+from ..runtime.chart import check_event_data
 from ..runtime.conditions import KEYWORDS, ExprError, Expression, parse
-from ..runtime.errors import suggest
+from ..runtime.errors import EventDataError, suggest
 from .errors import ScenarioError, ScenarioErrors
 from .model import (
     DEFAULT_MAX_STEP_S,
@@ -361,6 +362,10 @@ class _Checker:
         data = value.get("data", {})
         if not isinstance(data, dict) or not all(isinstance(k, str) and k.isidentifier() for k in data):
             raise self.error(value.line_of("data"), "post: data expected a mapping of names to values")
+        try:
+            check_event_data(chart, str(event), data)
+        except EventDataError as exc:
+            raise self.error(value.line_of("data"), f"post: {exc}") from None
         return PostStep(where, chart, str(event), dict(data))
 
     def step_run(self, value: Any, line: int, where: Where, item: MarkedDict) -> Step:

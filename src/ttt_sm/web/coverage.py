@@ -20,10 +20,13 @@ once per chart and kept), or the generator's reason why none does.
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import queue
 import re
+import threading
+import time
 from collections.abc import Callable, Mapping, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -38,9 +41,20 @@ from ..scenario.suite import coverage_dict, run_scenarios
 
 log = logging.getLogger(__name__)
 
+#: Wall time one coverage run (its scenarios) or one suggestion search may take; past it the run stops and
+#: the page is told.  A stop of the session ends it too, within a few simulated seconds of its run.
+COVERAGE_LIMIT_S = 300.0
+
 
 class CoverageError(ValueError):
     """A coverage report that does not fit the session's charts, or scenarios that cannot run."""
+
+
+class CoverageStopped(BaseException):
+    """A coverage run ended from outside: the session stops, or the run had its :data:`COVERAGE_LIMIT_S`.
+
+    A ``BaseException``, so the scenario runner, which reports a step's ``Exception`` as the step's
+    failure and goes on, lets it through."""
 
 
 def colouring(report: Mapping[str, Any], charts: Mapping[str, type[TickChart]]) -> dict[str, Any]:
@@ -127,9 +141,20 @@ def scenario_from_text(name: str, text: str) -> Scenario:
 
 
 def run_for_coverage(scenarios: Sequence[Scenario], params: ArmParams, charts: Mapping[str, type[TickChart]],
-                     progress: Callable[[ScenarioResult], None] | None = None) -> dict[str, Any]:
-    """Run scenarios with coverage, as ``ttt-sm scenario run --coverage``; the colouring and the verdicts."""
-    report = run_scenarios(scenarios, params, coverage=True, progress=progress)
+                     progress: Callable[[ScenarioResult], None] | None = None,
+                     check: Callable[[], None] | None = None) -> dict[str, Any]:
+    """Run scenarios with coverage, as ``ttt-sm scenario run --coverage``; the colouring and the verdicts.
+
+    ``check()`` is called between scenarios and every few simulated seconds of a long step; it raises
+    (:class:`CoverageStopped`) to end the run."""
+    def each(result: ScenarioResult) -> None:
+        if check is not None:
+            check()
+        if progress is not None:
+            progress(result)
+
+    report = run_scenarios(scenarios, params, coverage=True, progress=each,
+                           step_progress=None if check is None else lambda *_: check())
     assert report.coverage is not None
     result = colouring(coverage_dict(report.coverage), charts)
     result["scenarios"] = [{"name": r.name, "file": r.file, "passed": r.passed,
@@ -186,30 +211,76 @@ class CoverageRuns:
         self._broadcast = broadcast
         self._busy = False
         self._generated: dict[str, Generated] = {}  # by chart name; read and written on the worker only
-        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="ttt-sm-coverage")
+        #: The limit of one run, wall seconds (:data:`COVERAGE_LIMIT_S`).
+        self.limit_s = COVERAGE_LIMIT_S
+        #: Whether a job runs on the worker now.
+        self.running = False
+        self._jobs: queue.Queue[Callable[[], None] | None] = queue.Queue(maxsize=8)
+        self._closing = threading.Event()
+        self._deadline = 0.0
+        # a daemon thread: a run under way never keeps the process alive after a stop (SIGTERM)
+        self._worker = threading.Thread(target=self._serve, name="ttt-sm-coverage", daemon=True)
+        self._worker.start()
 
-    def start(self, cid: int, cmd: str, job: Callable[[], dict[str, Any]]) -> dict[str, Any]:
-        """Run ``job`` (scenarios, for their colouring) on the worker; its end is sent to every page, or its
-        error to page ``cid``.  The reply to command ``cmd`` now."""
+    def _serve(self) -> None:
+        while True:
+            job = self._jobs.get()
+            if job is None or self._closing.is_set():
+                return
+            self._deadline = time.perf_counter() + self.limit_s
+            self.running = True
+            try:
+                job()
+            except BaseException:  # a job reports its own errors; nothing ends the worker but close()
+                log.exception("coverage job failed")
+            finally:
+                self.running = False
+
+    def check(self) -> None:
+        """Raise :class:`CoverageStopped` if the session stops or the run has had its time (on the worker)."""
+        if self._closing.is_set():
+            raise CoverageStopped("the session stopped")
+        if time.perf_counter() > self._deadline:
+            raise CoverageStopped(f"stopped after {self.limit_s:g} s of wall time, the most one coverage run may"
+                                  " take; run fewer scenarios, or shorter ones (ttt-sm scenario run --coverage"
+                                  " has no such limit)")
+
+    def _submit(self, work: Callable[[], None]) -> None:
+        try:
+            self._jobs.put_nowait(work)
+        except queue.Full:
+            raise CoverageError("the coverage worker has 8 jobs waiting already; wait for them") from None
+
+    def start(self, cid: int, cmd: str, job: Callable[[Callable[[], None]], dict[str, Any]]) -> dict[str, Any]:
+        """Run ``job(check)`` (scenarios, for their colouring; it calls ``check()`` as it goes, which ends it at a
+        stop or past the limit) on the worker; its end is sent to every page, or its error to page ``cid``.
+        The reply to command ``cmd`` now."""
         if self._busy:
             raise CoverageError("scenarios are running already; wait for their coverage")
         self._busy = True
 
         def work() -> None:
             try:
-                result = job()
+                result = job(self.check)
+            except CoverageStopped as exc:
+                self._send_to(cid, {"type": "error", "id": None, "command": cmd, "error": f"{cmd}: {exc}"})
             except (CoverageError, ValueError) as exc:
                 self._send_to(cid, {"type": "error", "id": None, "command": cmd, "error": f"{cmd}: {exc}"})
-            except Exception as exc:  # a scenario run that broke: say so, keep the session
+            except Exception:  # a scenario run that broke: say so, keep the session
                 log.exception("coverage run failed")
                 self._send_to(cid, {"type": "error", "id": None, "command": cmd,
-                                    "error": f"{cmd}: {type(exc).__name__}: {exc}"})
+                                    "error": f"{cmd}: the scenarios could not be run (a bug of ttt_sm, written to"
+                                             " the server's log); the session goes on"})
             else:
                 self.show(result)
             finally:
                 self._busy = False
 
-        self._worker.submit(work)
+        try:
+            self._submit(work)
+        except CoverageError:
+            self._busy = False
+            raise
         return {"text": "running the scenarios; the diagrams are coloured when they are done"}
 
     def suggest(self, cid: int, chart: str, index: int) -> dict[str, Any]:
@@ -229,12 +300,13 @@ class CoverageRuns:
                 if generated is None:
                     generated = self._generated[chart] = generate(cls, dt, "shortest")
                 self._send_to(cid, suggestion(generated, chart, index))
-            except Exception as exc:  # a search that broke: say so, keep the session
+            except Exception:  # a search that broke: say so, keep the session
                 log.exception("coverage suggestion failed")
                 self._send_to(cid, {"type": "error", "id": None, "command": "coverage_suggest",
-                                    "error": f"coverage_suggest: {type(exc).__name__}: {exc}"})
+                                    "error": "coverage_suggest: the search failed (a bug of ttt_sm, written to the"
+                                             " server's log); the session goes on"})
 
-        self._worker.submit(work)
+        self._submit(work)
         return {"text": f"searching {chart} for the shortest scenario that takes {transitions[index].label}"}
 
     def show(self, colouring: dict[str, Any]) -> None:
@@ -247,6 +319,15 @@ class CoverageRuns:
         self.shown = None
         self._broadcast({"type": "coverage", "charts": {}, "ignored": [], "cleared": True})
 
-    def close(self) -> None:
-        """Stop the worker; a run under way is left to end on its own, one waiting is dropped."""
-        self._worker.shutdown(wait=False, cancel_futures=True)
+    def close(self, timeout_s: float = 5.0) -> None:
+        """Stop the worker: a run under way ends at its next check (a few simulated seconds of its run), one
+        waiting is dropped; waits ``timeout_s`` at most (the thread is a daemon: it never holds the process)."""
+        self._closing.set()
+        while True:
+            try:
+                self._jobs.get_nowait()
+            except queue.Empty:
+                break
+        with contextlib.suppress(queue.Full):
+            self._jobs.put_nowait(None)
+        self._worker.join(timeout_s)

@@ -33,7 +33,13 @@ SPEEDS = (0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0)
 
 
 class ProtocolError(ValueError):
-    """A message that is not a command the session takes; the text names what is wrong."""
+    """A message that is not a command the session takes; the text names what is wrong.
+
+    ``msg_id`` and ``command``: the message's ``id`` and ``type``, when it had them well formed (the error
+    reply echoes them)."""
+
+    msg_id: int | str | None = None
+    command: str | None = None
 
 
 #: A field's check: ``check(command type, field name, value)`` -> the value the handler gets.

@@ -72,9 +72,27 @@ def _no_constant(name: str) -> Any:
 
 
 def check_command(data: Any) -> Command:
-    """Check a decoded message (see :func:`parse_command`)."""
+    """Check a decoded message (see :func:`parse_command`).  The :class:`ProtocolError` carries the message's
+    ``id`` (``.msg_id``) and ``type`` (``.command``) when they are well formed, for the error reply to echo."""
     if not isinstance(data, dict):
         raise ProtocolError(f"a command is a JSON object with a \"type\", got {describe(data)}")
+    msg_id = data.get("id")
+    known_id = msg_id if _good_id(msg_id) else None
+    kind = data.get("type")
+    try:
+        return _check_fields(data)
+    except ProtocolError as exc:
+        exc.msg_id = known_id
+        exc.command = kind if isinstance(kind, str) and kind in COMMANDS else None
+        raise
+
+
+def _good_id(msg_id: Any) -> bool:
+    return not isinstance(msg_id, bool) and (
+        (isinstance(msg_id, int) and abs(msg_id) < 2**53) or (isinstance(msg_id, str) and len(msg_id) <= 64))
+
+
+def _check_fields(data: dict[str, Any]) -> Command:
     kind = data.get("type")
     if not isinstance(kind, str):
         raise ProtocolError(f"a command needs a \"type\" (text): one of {', '.join(COMMANDS)}")
@@ -82,8 +100,7 @@ def check_command(data: Any) -> Command:
     if fields is None:
         raise ProtocolError(f"unknown command type {describe(kind)}; commands: {', '.join(COMMANDS)}")
     msg_id = data.get("id")
-    if msg_id is not None and (isinstance(msg_id, bool) or not (
-            (isinstance(msg_id, int) and abs(msg_id) < 2**53) or (isinstance(msg_id, str) and len(msg_id) <= 64))):
+    if msg_id is not None and not _good_id(msg_id):
         raise ProtocolError(f"{kind}: 'id' must be a whole number or a text of at most 64 characters,"
                             f" got {describe(msg_id)}")
     unknown = [k for k in data if k not in fields and k not in ("type", "id")]

@@ -16,16 +16,21 @@ Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
 SVG, :mod:`.diagrams`), ``/api/trace.jsonl`` (the trace so far), ``/ws``.
 
-Safe by default:
+Safe by default (:mod:`.access`; docs/gui.md, "Threat model"):
 
-* the server binds 127.0.0.1; any other host needs the session's token,
+* the server binds 127.0.0.1; every start, loopback included, makes a token,
   printed in the URL at start (``?token=...``, as Jupyter does); a request
-  with it gets a cookie, one without it gets 403;
-* the ``Host`` header must name this server (no DNS rebinding), and a
-  WebSocket's ``Origin``, when a browser sends one, must be this server's;
+  with it gets a cookie, one without it gets 403 (a WebSocket: closed, 1008),
+  except the pages' scripts and styles under ``/static/``;
+* the ``Host`` header must name this server by an address or name of the
+  interfaces it listens on (no DNS rebinding), and a WebSocket's ``Origin``,
+  when a browser sends one, must be this server's;
 * every WebSocket message is checked by :mod:`.protocol` before the session
-  sees it; a bad one gets an ``error`` reply naming what was wrong and the
-  connection goes on.
+  sees it; a bad one gets an ``error`` reply naming what was wrong (and
+  echoing its ``id``) and the connection goes on;
+* a request that needs the session (``/api/arm/ink.png``) waits for it
+  :data:`SESSION_WAIT_S` at most, holding no thread, then gets 503; the
+  other routes never wait for it.
 """
 
 from __future__ import annotations
@@ -33,20 +38,23 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import hmac
-from collections.abc import AsyncIterator, Iterable
+import threading
+from collections.abc import AsyncIterator, Callable, Iterable
 from importlib import resources
 from typing import Any
 from urllib.parse import urlsplit
 
 from starlette.applications import Starlette
 from starlette.requests import HTTPConnection, Request
-from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
+from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response, StreamingResponse
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Receive, Scope, Send
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
+from ..debug.debugger import Debugger
 from ..runtime.errors import GraphvizMissingError
+from .access import PUBLIC_PREFIXES, cookie_name, port_of
 from .arm_view import ink_picture, png
 from .camera_feed import feed_png
 from .diagrams import DiagramError, Diagrams
@@ -55,10 +63,20 @@ from .lab_watch import LabWatch
 from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
 from .session import Session
 
-TOKEN_COOKIE = "ttt_sm_token"
 #: Messages queued for one page at most; a page that falls further behind gets a full frame again.
 CLIENT_QUEUE = 64
-LOOPBACK = ("127.0.0.1", "localhost", "::1")
+#: Messages one page's WebSocket is read at, at most, a second (in bursts of as many): past it the server
+#: reads that page's socket no faster, so a flood waits in its own connection and never takes the server's
+#: thread (and with it the simulation's share of the interpreter) from the other pages.
+MESSAGE_RATE = 500
+#: How long a request that needs the session (``/api/arm/ink.png``) waits for it, seconds; then 503.
+SESSION_WAIT_S = 5.0
+#: Such requests waiting for the session at once, at most; one more gets 503 at once.
+SESSION_WAITERS = 8
+
+
+class SessionBusy(Exception):
+    """The session did not answer a request in time (or no longer runs): the route answers 503."""
 
 
 def static_dir() -> str:
@@ -67,7 +85,8 @@ def static_dir() -> str:
 
 
 class Guard:
-    """ASGI middleware: the token (when there is one) and the Host header, for HTTP and WebSocket."""
+    """ASGI middleware: the token (when there is one) and the Host header, for HTTP and WebSocket
+    (:mod:`.access`).  The pages' scripts and styles (``/static/``) need the Host only."""
 
     def __init__(self, app: ASGIApp, token: str | None, hosts: Iterable[str]) -> None:
         self.app = app
@@ -83,18 +102,22 @@ class Guard:
         if self.hosts and host not in self.hosts:
             await self._refuse(scope, receive, send, f"host {host!r} is not this server")
             return
-        given = conn.query_params.get("token") or conn.cookies.get(TOKEN_COOKIE)
-        if self.token is not None and not (given and hmac.compare_digest(given, self.token)):
+        if self.token is None or str(scope.get("path", "")).startswith(PUBLIC_PREFIXES):
+            await self.app(scope, receive, send)
+            return
+        cookie = cookie_name(port_of(host))
+        given = conn.query_params.get("token") or conn.cookies.get(cookie)
+        if not (given and hmac.compare_digest(given.encode(), self.token.encode())):
             await self._refuse(scope, receive, send, "this cockpit needs its token: open the URL that"
                                                      " `ttt-sm gui` printed (it ends in ?token=...)")
             return
-        if self.token is not None and conn.query_params.get("token") and scope["type"] == "http":
+        if conn.query_params.get("token") and scope["type"] == "http":
             token = self.token
 
             async def send_with_cookie(message: Any) -> None:
                 if message["type"] == "http.response.start":
                     headers = list(message.get("headers", []))
-                    headers.append((b"set-cookie", f"{TOKEN_COOKIE}={token}; Path=/; HttpOnly;"
+                    headers.append((b"set-cookie", f"{cookie}={token}; Path=/; HttpOnly;"
                                                    f" SameSite=Strict".encode()))
                     message = {**message, "headers": headers}
                 await send(message)
@@ -114,7 +137,7 @@ class Guard:
 def origin_ok(origin: str | None, host: str) -> bool:
     """A WebSocket's Origin must be this server (a page of another site may not drive the robot)."""
     if origin is None:
-        return True  # not a browser: the token and the Host check apply
+        return True  # not a browser: the token (checked before, by Guard) and the Host check apply
     parts = urlsplit(origin)
     return parts.scheme in ("http", "https") and parts.netloc.lower() == host.lower()
 
@@ -123,9 +146,9 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                manage_session: bool = True, lab: LabWatch | None = None) -> Starlette:
     """The cockpit's ASGI app over ``session``.
 
-    ``token``: required on every request when given (``ttt-sm gui`` sets one
-    for any host but 127.0.0.1).  ``hosts``: the ``host[:port]`` values the Host
-    header may take (empty: any).  ``manage_session``: start the session with
+    ``token``: required on every request but ``/static/`` when given (``ttt-sm
+    gui`` always sets one).  ``hosts``: the ``host[:port]`` values the Host
+    header may take (empty: any; :func:`.access.allowed_hosts`).  ``manage_session``: start the session with
     the app and stop it (saving the trace) when the app shuts down.
     ``lab``: a student's chart watched and reloaded into the session (the
     ``/lab`` page), started and stopped with the app.
@@ -168,9 +191,51 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
             return PlainTextResponse("no photo yet: the camera looks after each move\n", status_code=404)
         return Response(png, media_type="image/png", headers={"Cache-Control": "no-store"})
 
+    waiting = 0
+
+    async def in_session(fn: Callable[[Debugger], Any]) -> Any:
+        """``fn(debugger)`` in the simulation thread, between two control steps; :class:`SessionBusy` if the
+        session does not answer within :data:`SESSION_WAIT_S` (no thread is held while it waits)."""
+        nonlocal waiting
+        if session.error is not None:
+            raise SessionBusy(session.error)
+        if waiting >= SESSION_WAITERS:
+            raise SessionBusy(f"{waiting} requests wait for the session already")
+        loop = asyncio.get_running_loop()
+        answer: asyncio.Future[Any] = loop.create_future()
+        gave_up = threading.Event()
+
+        def settle(value: Any, error: BaseException | None) -> None:
+            if answer.done():
+                return
+            if error is not None:
+                answer.set_exception(error)
+            else:
+                answer.set_result(value)
+
+        def answered(value: Any, error: BaseException | None) -> None:  # in the simulation thread
+            loop.call_soon_threadsafe(settle, value, error)
+
+        waiting += 1
+        try:
+            session.call_soon(fn, answered, wanted=lambda: not gave_up.is_set())
+            return await asyncio.wait_for(answer, SESSION_WAIT_S)
+        except TimeoutError:
+            gave_up.set()
+            raise SessionBusy(f"the session did not answer within {SESSION_WAIT_S:g} s") from None
+        finally:
+            waiting -= 1
+
+    def busy(exc: SessionBusy) -> Response:
+        return PlainTextResponse(f"503 Service Unavailable: {exc}; try again\n", status_code=503,
+                                 headers={"Retry-After": "1", "Cache-Control": "no-store"})
+
     async def arm_ink(request: Request) -> Response:
         # drawn in the simulation thread, between two control steps (never a half-inked stroke), encoded here
-        image = await asyncio.to_thread(session.call, lambda d: ink_picture(d.robot))
+        try:
+            image = await in_session(lambda d: ink_picture(d.robot))
+        except SessionBusy as exc:
+            return busy(exc)
         data = await asyncio.to_thread(png, image)
         return Response(data, media_type="image/png", headers={"Cache-Control": "no-store"})
 
@@ -195,13 +260,25 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
 
     async def trace(request: Request) -> Response:
         streamed = session.debugger.trace_file
-        if streamed is not None and not streamed.closed:  # the whole trace, as written so far
-            body = await asyncio.to_thread(streamed.path.read_text, encoding="utf-8")
-        else:  # the transitions kept in memory
-            records = list(session.debugger.trace.records)
-            body = "".join(r.to_json() + "\n" for r in records)
-        return Response(body, media_type="application/x-ndjson",
-                        headers={"Content-Disposition": 'attachment; filename="trace.jsonl"'})
+        headers = {"Content-Disposition": 'attachment; filename="trace.jsonl"'}
+        if streamed is not None and not streamed.closed:  # the whole trace, as written so far, a MB at a time
+            path = streamed.path
+            size = await asyncio.to_thread(lambda: path.stat().st_size)
+
+            async def chunks() -> AsyncIterator[bytes]:
+                with open(path, "rb") as f:
+                    left = size
+                    while left > 0:
+                        data = await asyncio.to_thread(f.read, min(1 << 20, left))
+                        if not data:
+                            return
+                        left -= len(data)
+                        yield data
+
+            return StreamingResponse(chunks(), media_type="application/x-ndjson", headers=headers)
+        records = list(session.debugger.trace.records)  # the transitions kept in memory
+        body = "".join(r.to_json() + "\n" for r in records)
+        return Response(body, media_type="application/x-ndjson", headers=headers)
 
     async def ws(websocket: WebSocket) -> None:
         host = websocket.headers.get("host", "")
@@ -237,8 +314,16 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                     session.submit(cid, parse_command('{"type": "hello"}'))
 
         sender = asyncio.create_task(pump())
+        allowance, checked = float(MESSAGE_RATE), loop.time()
         try:
             while True:
+                now = loop.time()
+                allowance = min(float(MESSAGE_RATE), allowance + (now - checked) * MESSAGE_RATE)
+                checked = now
+                if allowance < 1.0:  # this page sends faster than it may: read it no faster (its TCP waits)
+                    await asyncio.sleep((1.0 - allowance) / MESSAGE_RATE)
+                    continue
+                allowance -= 1.0
                 message = await websocket.receive()
                 if message["type"] == "websocket.disconnect":
                     break
@@ -248,7 +333,8 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                 try:
                     command = parse_command(raw)
                 except ProtocolError as exc:
-                    session.reply_error(cid, str(exc))
+                    session.send_to(cid, {"type": "error", "id": exc.msg_id, "command": exc.command,
+                                          "error": str(exc)})
                     continue
                 session.submit(cid, command)
         except WebSocketDisconnect:

@@ -56,6 +56,7 @@ from .arm_view import arm_scene
 from .camera_feed import CameraFeed
 from .catalogue import describe_session
 from .commands import SPECS
+from .commands import run as run_commands
 from .coverage import CoverageError, CoverageRuns
 from .frames import Frames, Status
 from .operate import Operate
@@ -67,6 +68,20 @@ log = logging.getLogger(__name__)
 FRAME_HZ = 30.0
 #: One ``Debugger.run`` call while running: the run goes on after it (it is not a stop).
 RUN_CHUNK_S = 60.0
+#: Commands of one page waiting for the simulation thread at most; one more is refused with an error reply.
+PAGE_QUEUE = 16
+#: Wall time one command may hold the simulation thread: a ``step``, ``tick`` or ``next`` that runs longer
+#: pauses after it (the reply says how far it came; send it again to go on).
+COMMAND_BUDGET_S = run_commands.COMMAND_BUDGET_S
+#: One page's commands take at most this share of the simulation thread's time, sustained, after a burst
+#: of :data:`PAGE_BURST_S`: past it the page's commands are refused until its use has fallen back (a flood
+#: of ``hello``s, each a full frame, or of replays, each seconds long, no longer takes the robot's time).
+PAGE_SHARE = 0.25
+#: Seconds of the simulation thread a page may use at once before :data:`PAGE_SHARE` holds it back.
+PAGE_BURST_S = 2.0
+#: While the robot runs, the commands take at most this share of the simulation thread's time (a flood of
+#: them is handled between longer stretches of the run, whose pace they do not take).
+COMMAND_SHARE = 0.3
 
 Send = Callable[[str], None]
 
@@ -76,6 +91,19 @@ class _Client:
     send: Send
     joined: bool = False
     page: str = ""
+    #: Commands of this page queued and not yet handled (at most :data:`PAGE_QUEUE`).
+    queued: int = 0
+    #: Commands refused because the page had :data:`PAGE_QUEUE` waiting, or had used its share.
+    refused: int = 0
+    #: Seconds of the simulation thread this page's commands have used, less PAGE_SHARE of the time since.
+    used_s: float = 0.0
+    used_at: float = 0.0
+
+    def use(self, now: float, spent: float = 0.0) -> float:
+        """The page's use of the simulation thread now (``spent`` added): it falls by PAGE_SHARE a second."""
+        self.used_s = max(0.0, self.used_s - (now - self.used_at) * PAGE_SHARE) + spent
+        self.used_at = now
+        return self.used_s
 
 
 class _SessionClock:
@@ -92,9 +120,13 @@ class _SessionClock:
     def wait_period(self, k: int) -> None:
         s = self._session
         if not s._running_slice:
+            if s._command_deadline is not None and time.perf_counter() > s._command_deadline:
+                s._command_deadline = None
+                s.debugger.pause()  # a command has had its COMMAND_BUDGET_S: it stops after this step
             return
         s.clock.wait_period(k)
-        if s._wake or time.perf_counter() >= s._next_frame_at:
+        now = time.perf_counter()
+        if (s._wake and now >= s._next_drain_at) or now >= s._next_frame_at:
             s.debugger.pause()
 
 
@@ -145,6 +177,14 @@ class Session:
         self._lock = threading.Lock()
         self._queue: queue.Queue[tuple[int, Command] | None] = queue.Queue()
         self._wake = False
+        self._next_drain_at = 0.0
+        #: While a command runs: when it has had its :data:`COMMAND_BUDGET_S` (perf_counter), else None.
+        self._command_deadline: float | None = None
+        #: Set when the simulation thread has ended for good (stopped, or died: then :attr:`error` says why).
+        self.ended = threading.Event()
+        #: Called (in the simulation thread) if it dies of an error: ``ttt-sm gui`` stops the server then,
+        #: and exits non-zero, rather than serve pages a session that no longer runs.
+        self.death_listeners: list[Callable[[str], None]] = []
         self._running_slice = False
         self._stopping = False
         self._next_frame_at = 0.0
@@ -189,10 +229,41 @@ class Session:
             self._clients.pop(cid, None)
 
     def submit(self, cid: int, command: Command) -> None:
-        """Queue a checked command; the simulation thread handles it between two control steps."""
+        """Queue a checked command; the simulation thread handles it between two control steps.
+
+        A page with :data:`PAGE_QUEUE` commands waiting gets this one refused (an ``error`` reply at once);
+        a session that no longer runs refuses every command."""
         spec = SPECS.get(command.type)
+        if self.error is not None:
+            self.reply_error(cid, f"{command.type}: {self.error}", command)
+            return
         if spec is not None and not spec.queued:
-            spec.handler(self, cid, **command.args)
+            try:
+                spec.handler(self, cid, **command.args)
+            except Exception:  # noted in the server's thread: a bug there must not end the connection
+                log.exception("command %s failed", command.type)
+            return
+        with self._lock:
+            client = self._clients.get(cid)
+            if client is None and cid != 0:  # a page gone (cid 0: the server's own, the bench's: not bounded)
+                return
+            full = client is not None and client.queued >= PAGE_QUEUE
+            used = client.use(time.perf_counter()) if client is not None else 0.0
+            greedy = used > PAGE_BURST_S
+            if client is not None:
+                if full or greedy:
+                    client.refused += 1
+                else:
+                    client.queued += 1
+        if full:
+            self.reply_error(cid, f"{command.type}: refused: this page has {PAGE_QUEUE} commands waiting for the"
+                                  " session already (the most one page may have); wait for their replies", command)
+            return
+        if greedy:
+            wait = (used - PAGE_BURST_S) / PAGE_SHARE
+            self.reply_error(cid, f"{command.type}: refused: this page's commands have used the session more than"
+                                  f" one page may ({PAGE_SHARE:.0%} of its time, after a burst of {PAGE_BURST_S:g}"
+                                  f" s); send it again in {max(wait, 0.1):.1f} s", command)
             return
         self._queue.put((cid, command))
         self._wake = True
@@ -262,6 +333,24 @@ class Session:
         if "error" in box:
             raise box["error"]
         return box.get("value")
+
+    def call_soon(self, fn: Callable[[Debugger], Any], done: Callable[[Any, BaseException | None], None],
+                  wanted: Callable[[], bool] = lambda: True) -> None:
+        """Queue ``fn(debugger)`` for the simulation thread without waiting: ``done(value, error)`` is called
+        there with its result (the server's routes, which must not hold a thread while the session is busy).
+        ``wanted()`` False when its turn comes (the route gave up waiting): it is not run."""
+        def job(dbg: Debugger) -> None:
+            if not wanted():
+                return
+            try:
+                value = fn(dbg)
+            except Exception as exc:  # handed back to the caller
+                done(None, exc)
+            else:
+                done(value, None)
+
+        self._queue.put((0, Command("_call", {"fn": job})))
+        self._wake = True
 
     def plot_latency_ms(self) -> list[float]:
         """Plot-latency samples so far: a graph's sample taken -> the Operational page has drawn it, ms."""
@@ -374,8 +463,8 @@ class Session:
     # -- the simulation thread ----------------------------------------------------------------
 
     def _main(self) -> None:
-        _freeze_heap()
         try:
+            _freeze_heap()
             while not self._stopping:
                 self._drain()
                 if self._stopping:
@@ -385,21 +474,63 @@ class Session:
                 else:
                     self._idle()
                 self._flush()
-        except Exception as exc:  # the session cannot go on: say so to every page
+        except BaseException as exc:  # the session cannot go on: say so to every page, and to whoever serves them
             log.exception("the session stopped")
-            self.error = f"the session stopped: {type(exc).__name__}: {exc}"
-            self.broadcast({"type": "error", "id": None, "command": None, "error": self.error})
+            self.died(f"the session stopped ({' '.join(str(exc).split()) or type(exc).__name__}); restart"
+                      " ttt-sm gui")
+        finally:
+            self.ended.set()
 
-    def _drain(self) -> None:
-        self._wake = False
+    def warn_pages(self, text: str) -> None:
+        """Tell every page something went wrong that does not end the session (any thread): an ``error``
+        with no command, ``fatal`` false.  The hook for a trace that stops being written (a full disk
+        under ``ttt-sm gui --trace``): the session runs on, its pages are told."""
+        log.warning("%s", text)
+        self.broadcast({"type": "error", "id": None, "command": None, "error": text, "fatal": False})
+
+    def died(self, why: str) -> None:
+        """The simulation thread cannot go on: every page is told (an ``error`` marked ``fatal``), the
+        commands still queued are refused, and :attr:`death_listeners` hear it (``ttt-sm gui`` then stops
+        the server and exits non-zero)."""
+        self.error = why
+        self.mode = "paused"
+        try:
+            self.broadcast({"type": "error", "id": None, "command": None, "error": why, "fatal": True})
+        except Exception:  # the pages may be gone; the listeners must still hear it
+            log.exception("the pages could not be told the session stopped")
         while True:
             try:
                 item = self._queue.get_nowait()
             except queue.Empty:
-                return
-            if item is None:
-                return
-            self._handle(*item)
+                break
+            if item is not None and item[0]:
+                self.reply_error(item[0], f"{item[1].type}: {why}", item[1])
+        for tell in list(self.death_listeners):
+            try:
+                tell(why)
+            except Exception:
+                log.exception("a listener of the session's end failed")
+
+    def _drain(self) -> None:
+        """Handle the commands waiting; while the robot runs, at most :data:`COMMAND_SHARE` of the time."""
+        self._wake = False
+        started = time.perf_counter()
+        budget = self.frame_period if self.mode == "running" else COMMAND_BUDGET_S
+        try:
+            while True:
+                try:
+                    item = self._queue.get_nowait()
+                except queue.Empty:
+                    return
+                if item is None:
+                    return
+                self._handle(*item)
+                if self.mode == "running" and time.perf_counter() - started > budget and not self._queue.empty():
+                    self._wake = True  # the rest after a stretch of the run
+                    return
+        finally:
+            spent = time.perf_counter() - started
+            self._next_drain_at = time.perf_counter() + spent * (1 - COMMAND_SHARE) / COMMAND_SHARE
 
     def _idle(self) -> None:
         timeout = None
@@ -413,6 +544,7 @@ class Session:
             return
         if item is not None:
             self._handle(*item)
+            self._wake = True  # the others waiting, at once
 
     def _run_slice(self) -> None:
         dbg = self.debugger
@@ -458,24 +590,49 @@ class Session:
         return Status(self.mode, self.speed, self.last_stop, self.clients, self.error)
 
     def _handle(self, cid: int, cmd: Command) -> None:
+        """One command, in the simulation thread: its reply, or its failure as an error reply to its page.
+
+        Whatever a handler raises ends here, never the thread: a refusal
+        (``ValueError``, ``DebugError``, ``CoverageError``) is sent as it says; anything else
+        is a bug, logged with its traceback, and the page is told in words, without the
+        exception's name.  If the robot moved (or was rebuilt) before it broke, it
+        may be half way through a step: :meth:`robot_raised` holds it.
+        """
         if cmd.type == "_call":
             cmd.args["fn"](self.debugger)
             self._dirty = True
             return
+        with self._lock:
+            client = self._clients.get(cid)
+            if client is not None:
+                client.queued = max(0, client.queued - 1)
         spec = SPECS.get(cmd.type)
         if spec is None:
             self.reply_error(cid, f"{cmd.type}: not handled by this session", cmd)
             return
+        robot, steps = self.debugger.robot, self.debugger.robot.steps
+        started = time.perf_counter()
+        self._command_deadline = started + COMMAND_BUDGET_S
         try:
             result = spec.handler(self, cid, **cmd.args)
         except (DebugError, CoverageError, ValueError) as exc:
             self.reply_error(cid, f"{cmd.type}: {exc}" if not str(exc).startswith(cmd.type) else str(exc), cmd)
-        except Exception as exc:  # broke off in the middle (a replay through a chart that raises, say)
-            self.robot_raised(exc)
-            self.reply_error(cid, f"{cmd.type}: {self.fault}", cmd)
+        except Exception as exc:
+            log.error("command %s failed", cmd.type, exc_info=exc)
+            if self.debugger.robot is not robot or self.debugger.robot.steps != steps:
+                self.robot_raised(exc)  # broke off in the middle (a replay through a chart that raises, say)
+                self.reply_error(cid, f"{cmd.type}: {self.fault}", cmd)
+            else:
+                self.reply_error(cid, f"{cmd.type}: it failed inside the session before it changed anything (a"
+                                      " bug of ttt_sm, written to the server's log); the session goes on", cmd)
         else:
             if result is not None:
                 self.send_to(cid, {"type": "reply", "id": cmd.id, "command": cmd.type, "ok": True, **result})
+        finally:
+            self._command_deadline = None
+            if client is not None:
+                with self._lock:
+                    client.use(time.perf_counter(), time.perf_counter() - started)
         self._dirty = True
 
 

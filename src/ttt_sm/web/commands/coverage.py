@@ -15,7 +15,8 @@ def run(session: Cockpit, cid: int, files: list[str]) -> Reply:
     """Run the session's scenario files ``files`` (names) and colour what they covered."""
     cov = session.coverage
     scenarios = load_scenarios(files, cov.scenarios)
-    return cov.start(cid, "coverage_run", lambda: run_for_coverage(scenarios, cov.params, cov.charts))
+    return cov.start(cid, "coverage_run", lambda check: run_for_coverage(scenarios, cov.params, cov.charts,
+                                                                          check=check))
 
 
 @command("coverage_scenario", name=text(200), text=text(MAX_SCENARIO_BYTES))
@@ -23,7 +24,8 @@ def run_text(session: Cockpit, cid: int, name: str, text: str) -> Reply:
     """Run a scenario file's ``text`` (sent from the page, file ``name``) and colour what it covered."""
     cov = session.coverage
     scenario = scenario_from_text(name, text)
-    return cov.start(cid, "coverage_scenario", lambda: run_for_coverage([scenario], cov.params, cov.charts))
+    return cov.start(cid, "coverage_scenario", lambda check: run_for_coverage([scenario], cov.params, cov.charts,
+                                                                               check=check))
 
 
 @command("coverage_load", report=report)

@@ -9,6 +9,10 @@ from ...debug.records import StopReason
 from ..fields import MAX_COUNT, integer, number, optional, speed
 from .spec import Cockpit, Reply, command
 
+#: The wall time one command may hold the simulation thread (the session pauses it after that;
+#: ``ttt_sm.web.session.COMMAND_BUDGET_S`` is the same number).
+COMMAND_BUDGET_S = 1.0
+
 
 @command("run")
 def run(session: Cockpit, cid: int) -> Reply:
@@ -47,6 +51,9 @@ def _stepping(session: Cockpit, go: Callable[[], StopReason]) -> Reply:
         session.robot_raised(exc)
         raise ValueError(str(session.fault)) from None
     session.note_stop(reason)
+    if reason.kind == "paused":  # only the session's budget pauses a command (a page's pause waits for it)
+        return {"text": f"{reason.describe()}: the most one command may hold the session is {COMMAND_BUDGET_S:g} s"
+                        " of wall time; send it again to go on", "budget": True}
     return {"text": reason.describe()}
 
 

@@ -11,10 +11,10 @@ samples (JSON, a sensor reading out of range is ``null``) into ``--out``.
 from __future__ import annotations
 
 import argparse
-import json
 from typing import Any
 
 from ..files import write_atomic
+from ..runtime.jsonable import dumps
 from .common import CliError, add_command, emit, out_dir, progress, whole_number
 
 
@@ -54,7 +54,7 @@ def cmd_staircase(args: argparse.Namespace) -> int:
     png = save_staircase_plot(r, out / f"{name}.png")
     samples = out / f"{name}.json"
     sensor = [None if v != v else round(float(v), 7) for v in r.series["sensor"]]
-    write_atomic(samples, json.dumps({
+    write_atomic(samples, dumps({
         "t_s": [round(float(v), 4) for v in r.t], "desired_m": [round(float(v), 7) for v in r.series["desired"]],
         "fk_m": [round(float(v), 7) for v in r.series["fk"]], "sensor_m": sensor,
         "axis": r.axis, "stair_times_s": [round(v, 4) for v in r.stair_times]}) + "\n")

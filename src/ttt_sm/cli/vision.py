@@ -86,13 +86,17 @@ def _picture_path(path: str, what: str) -> Path:
 
 
 def _write_picture(path: Path, image: Any, what: str) -> None:
-    from ..files import write_png
+    import errno
+
+    from ..files import RecordWriteError, write_png
 
     try:
         write_png(path, image)  # whole, or not there (a full disk: the error names the file)
     except (ValueError, cv2.error):
         raise VisionError(f"{what} {str(path)!r}: could not encode the picture") from None
-    except FileNotFoundError:
+    except RecordWriteError as exc:
+        if exc.errno != errno.ENOENT:
+            raise  # a full disk, say: its one line names the file and what to do
         raise VisionError(f"{what} {str(path)!r}: could not write the picture (does the folder exist?)") from None
 
 

@@ -8,8 +8,8 @@ and of the code and library versions that compute it, so its result is kept in
 ``$XDG_CACHE_HOME/ttt_sm/gains/<key>.json`` (``~/.cache`` by default) under a key
 made of all of them: a changed parameter, a changed ``tuning.py`` or ``gains.py``,
 another python-control, SciPy or NumPy gives another key, and the gains are
-designed again.  The numbers are the design's to the last bit (JSON keeps a
-float's shortest round-tripping text).  A cache that cannot be read or written
+designed again.  The numbers are the design's to the last bit (each float is
+kept as its hexadecimal text, ``float.hex``).  A cache that cannot be read or written
 is passed by, never an error: the gains are then designed in the process.
 
 ``ttt-sm tune`` designs afresh (it is the design's own view).
@@ -58,7 +58,7 @@ def cache_key(params: ArmParams) -> str:
 def _read(path: Path) -> Gains | None:
     try:
         drives = json.loads(path.read_text(encoding="utf-8"))["drives"]
-        kept = tuple(DriveGains(**{k: float(v) for k, v in d.items()}) for d in drives)
+        kept = tuple(DriveGains(**{k: float.fromhex(v) for k, v in d.items()}) for d in drives)
     except (OSError, ValueError, KeyError, TypeError):
         return None  # missing, half written by a killed process, or of another layout: design again
     return Gains(drives=kept) if len(kept) == 3 else None  # type: ignore[arg-type]
@@ -66,7 +66,9 @@ def _read(path: Path) -> Gains | None:
 
 def _write(path: Path, gains: Gains) -> None:
     """Write `gains` whole or not at all (a temporary file renamed over the name)."""
-    text = json.dumps({"drives": [asdict(d) for d in gains.drives]})
+    # each float as its hexadecimal text: exact, and a margin that is not there (NaN) stays one
+    text = json.dumps({"drives": [{k: float(v).hex() for k, v in asdict(d).items()} for d in gains.drives]},
+                      allow_nan=False)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".json")

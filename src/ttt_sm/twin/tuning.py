@@ -18,7 +18,7 @@ gains here), so the two import one way.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict
+from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -248,6 +248,20 @@ def _design_outer(params: ArmParams, drive: int, kp_w: float, ki_w: float) -> tu
                       "[control] outer_crossover_hz below the speed loop's crossover")
 
 
+#: A drive's margins before they are measured (:func:`_with_margins` fills them in).
+_NO_MARGINS = {"inner_crossover_hz": 0.0, "inner_phase_margin_deg": 0.0, "inner_gain_margin_db": 0.0,
+               "outer_crossover_hz": 0.0, "outer_phase_margin_deg": 0.0, "outer_gain_margin_db": 0.0}
+
+
+def _with_margins(params: ArmParams, drive: int, g: DriveGains) -> DriveGains:
+    """`g` with the margins and crossovers of its sampled loop models (:func:`loop_margins`)."""
+    inner, outer = loop_models(params, drive, g)
+    pm_i, gm_i, fc_i = loop_margins(inner)
+    pm_o, gm_o, fc_o = loop_margins(outer)
+    return replace(g, inner_crossover_hz=fc_i, inner_phase_margin_deg=pm_i, inner_gain_margin_db=gm_i,
+                   outer_crossover_hz=fc_o, outer_phase_margin_deg=pm_o, outer_gain_margin_db=gm_o)
+
+
 @lru_cache(maxsize=8)
 def design_gains(params: ArmParams) -> Gains:
     """Design every drive's cascade from the parameter file; margins with control.margin.
@@ -261,14 +275,8 @@ def design_gains(params: ArmParams) -> Gains:
         kp_q, ki_q = _design_outer(params, drive, kp_w, ki_w)
         g = DriveGains(kp_pos=kp_q, ki_pos=ki_q, kd_pos=0.0, kff_speed=SPEED_FEEDFORWARD,
                        max_speed_rad_s=max_joint_speed(p), kp_speed=kp_w, ki_speed=ki_w, kd_speed=0.0,
-                       inner_crossover_hz=0.0, inner_phase_margin_deg=0.0, inner_gain_margin_db=0.0,
-                       outer_crossover_hz=0.0, outer_phase_margin_deg=0.0, outer_gain_margin_db=0.0)
-        inner, outer = loop_models(params, drive, g)
-        pm_i, gm_i, fc_i = loop_margins(inner)
-        pm_o, gm_o, fc_o = loop_margins(outer)
-        out.append(DriveGains(**{**asdict(g), "inner_crossover_hz": fc_i, "inner_phase_margin_deg": pm_i,
-                                 "inner_gain_margin_db": gm_i, "outer_crossover_hz": fc_o,
-                                 "outer_phase_margin_deg": pm_o, "outer_gain_margin_db": gm_o}))
+                       **_NO_MARGINS)
+        out.append(_with_margins(params, drive, g))
     return Gains(drives=(out[0], out[1], out[2]))
 
 
@@ -301,14 +309,8 @@ def thesis_gains(params: ArmParams) -> Gains:
         kp_q, ki_q, kd_q, kp_w, ki_w, kd_w = THESIS_GAINS[drive - 1]
         g = DriveGains(kp_pos=kp_q, ki_pos=ki_q, kd_pos=kd_q, kff_speed=0.0,
                        max_speed_rad_s=max_joint_speed(params.drives[drive - 1]), kp_speed=kp_w, ki_speed=ki_w,
-                       kd_speed=kd_w, inner_crossover_hz=0.0, inner_phase_margin_deg=0.0, inner_gain_margin_db=0.0,
-                       outer_crossover_hz=0.0, outer_phase_margin_deg=0.0, outer_gain_margin_db=0.0)
-        inner, outer = loop_models(params, drive, g)
-        pm_i, gm_i, fc_i = loop_margins(inner)
-        pm_o, gm_o, fc_o = loop_margins(outer)
-        out.append(DriveGains(**{**asdict(g), "inner_crossover_hz": fc_i, "inner_phase_margin_deg": pm_i,
-                                 "inner_gain_margin_db": gm_i, "outer_crossover_hz": fc_o,
-                                 "outer_phase_margin_deg": pm_o, "outer_gain_margin_db": gm_o}))
+                       kd_speed=kd_w, **_NO_MARGINS)
+        out.append(_with_margins(params, drive, g))
     return Gains(drives=(out[0], out[1], out[2]))
 
 

@@ -29,8 +29,8 @@ def test_render_then_detect_as_json(tmp_path: Path, capsys):
     assert rendered["board"] == board and rendered["view"] == "far_edge" and rendered["dim"] == 0.3
     assert cv2.imread(str(photo)).shape == (480, 640, 3)
     overlay = tmp_path / "overlay.png"
-    assert run(["vision", "detect", str(photo), "--overlay", str(overlay), "--robot-marks", "X..../...../..X../...../....X",
-                "--json"]) == 0
+    assert run(["vision", "detect", str(photo), "--overlay", str(overlay),
+                "--robot-marks", "X..../...../..X../...../....X", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["board"] == board
     assert len(data["cells"]) == 25 and len(data["percentages"]) == 25 and len(data["corners_px"]) == 4

@@ -351,8 +351,8 @@ def establish_orientation(grid: object, cells: str, view: str, robot_marks: str 
                 f" side) is at the {side} of the picture, where a camera {_WHERE[view]} sees it at the {near}"
                 f" (the photo is {turn}); {_TURN_BACK[side]}, or give the --view of the camera")
         raise OrientationError(
-            f"{what}: the robot's marks show the photo {' or '.join(others)}: read as it is, every symbol would be in the"
-            f" wrong cell; fix the camera (a mirror setting?) or the photo")
+            f"{what}: the robot's marks show the photo {' or '.join(others)}: read as it is, every symbol would be"
+            f" in the wrong cell; fix the camera (a mirror setting?) or the photo")
     as_read = board_text(cells, view)
     differ = [n for n in others if board_text(_undo(cells, ways[n]), view) != as_read]
     if differ:

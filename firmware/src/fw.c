@@ -129,6 +129,32 @@ static void start(ttt_fw *fw)
     send_status(fw); /* the PC learns at once that the drives run, and from which step */
 }
 
+/* Whether one block of gains is sane: speeds, filter shares and periods positive and within bounds
+ * (every value already finite and within +-TTT_GAIN_MAX).  A control step of 0 divides by zero;
+ * one of seconds is no control loop. */
+static int gains_in_range(uint8_t block, const double *v)
+{
+    if (block < TTT_DRIVES)
+        return v[TTT_CP_RPC] != 0.0 && v[TTT_CP_RPC] < 1.0 && v[TTT_CP_RPC] > -1.0
+            && v[TTT_CP_WMAX] > 0.0 && v[TTT_CP_ALPHA_W] > 0.0 && v[TTT_CP_ALPHA_W] <= 1.0;
+    return v[TTT_CG_DT] >= TTT_DT_MIN_S && v[TTT_CG_DT] <= TTT_DT_MAX_S
+        && v[TTT_CG_SV_MIN] < v[TTT_CG_SV_MAX]
+        && v[TTT_CG_SV_PMIN] > 0.0 && v[TTT_CG_SV_PMAX] > v[TTT_CG_SV_PMIN]
+        && v[TTT_CG_SV_PERIOD] >= v[TTT_CG_SV_PMAX] && v[TTT_CG_SV_PERIOD] <= TTT_SV_PERIOD_MAX_S;
+}
+
+/* Whether setpoint k (drives 0..2: encoder coordinates, rad; 3: the servo, rad) is one the arm can
+ * take.  The servo's must lie in its range.  A drive's coordinates are the joint's once its offset
+ * is set, and differ from them by less than the joint's span before (it starts between its
+ * stops): so a setpoint more than one span beyond a limit is never a place the joint can reach. */
+static int setpoint_in_range(const ttt_board *bd, int k, float v)
+{
+    float span;
+    if (k == 3) return v >= bd->servo_min_rad && v <= bd->servo_max_rad;
+    span = bd->limit_max_rad[k] - bd->limit_min_rad[k];
+    return v >= bd->limit_min_rad[k] - span && v <= bd->limit_max_rad[k] + span;
+}
+
 /* Act on one decoded frame whose sequence number was accepted; returns a rejection reason or -1. */
 static int handle(ttt_fw *fw, uint8_t type, const uint8_t *b, size_t n)
 {
@@ -146,8 +172,9 @@ static int handle(ttt_fw *fw, uint8_t type, const uint8_t *b, size_t n)
         dst = gains_block(fw, b[0], &count);
         for (k = 0; k < count; k++) {
             v[k] = ttt_get_f64(b + 1 + 8 * k);
-            if (!finite(v[k])) return TTT_REJ_VALUE;
+            if (!finite(v[k]) || v[k] > TTT_GAIN_MAX || v[k] < -TTT_GAIN_MAX) return TTT_REJ_VALUE;
         }
+        if (!gains_in_range(b[0], v)) return TTT_REJ_VALUE;
         for (k = 0; k < count; k++) dst[k] = (ttt_real)v[k];
         fw->gains_loaded = (uint8_t)(fw->gains_loaded | (1u << b[0]));
         send_gains(fw, b[0]);
@@ -164,7 +191,7 @@ static int handle(ttt_fw *fw, uint8_t type, const uint8_t *b, size_t n)
         if ((uint32_t)(fw->step - at) < 0x80000000u && fw->step - at > fw->board.late_steps) return TTT_REJ_LATE;
         for (k = 0; k < 4; k++) {
             float v = ttt_get_f32(b + 4 + 4 * k);
-            if (!finite((double)v)) return TTT_REJ_VALUE;
+            if (!finite((double)v) || !setpoint_in_range(&fw->board, k, v)) return TTT_REJ_VALUE;
             q[k] = (ttt_real)v;
         }
         ttt_cascade_set_setpoints(&fw->cascade, q, b[20] & 1);

@@ -364,3 +364,57 @@ def test_the_documented_examples_are_the_bytes_on_both_sides(firmware_libs):
     assert len(L.Sender().frame(L.Setpoints(123456, (0.1, 0.2, 0.3, 0.4), True))) == wire[L.Msg.SETPOINTS]
     assert len(L.Sender().frame(L.Status(1000, 1, 5, 21, (100000, -5, 7), (1, 2, 3), (1, 0, 2),
                                          (100, -200, 30), 2048))) == wire[L.Msg.STATUS]
+
+
+# -- issue 28: the firmware checks every field against its range (docs/hardware.md) --------------
+
+def _bad_gains(pc_row, index, value):
+    row = list(pc_row)
+    row[index] = value
+    return tuple(row)
+
+
+@pytest.mark.parametrize("block, index, value", [
+    (3, layout.CG_DT, 0.0),  # a control step of 0
+    (3, layout.CG_DT, 1e308),
+    (3, layout.CG_DT, -1e-3),
+    (3, layout.CG_SV_PERIOD, 0.0),
+    (3, layout.CG_SV_MAX, -10.0),  # servo range upside down
+    (3, layout.CG_SF_NORMAL, 1e308),
+    (0, layout.CP_KP_POS, 1e308),
+    (1, layout.CP_KP_SPD, -1e308),
+    (2, layout.CP_RPC, 0.0),
+    (0, layout.CP_WMAX, -1.0),
+    (1, layout.CP_ALPHA_W, 2.0),
+])
+def test_gains_out_of_range_are_rejected_counted_and_not_taken(lib, gains, block, index, value):
+    s = Session(lib)
+    pc = CascadeController(P, gains, servo_angle=0.0)
+    good = tuple(pc.cp[block, :layout.N_CP]) if block < 3 else tuple(pc.cg[:layout.N_CG])
+    assert s.send(L.Hello(), L.Gains(block, _bad_gains(good, index, value)))[1:] == []  # no read-back
+    assert s.fw.rejections()[R.VALUE] == 1
+    s.configure(gains)  # the good ones are taken: the check is no blanket refusal
+    assert s.fw.state == 1 and s.fw.rejections()[R.VALUE] == 1
+    (hb,) = s.send(L.Heartbeat(7))
+    assert hb.rejections[R.VALUE] == 1  # the PC sees the count by reason
+
+
+@pytest.mark.parametrize("setpoints", [
+    (1e30, -1e30, 3e38, 1e30),  # the issue's: drive 1 into its hard stop at stall current
+    (0.0, 0.0, 0.0, 1e30),  # the servo beyond its range
+    (0.0, 0.0, 0.0, P.servo.max_rad + 0.05),
+    (0.0, 0.0, 0.0, P.servo.min_rad - 0.05),
+    (2 * P.drives[0].limit_max_rad - P.drives[0].limit_min_rad + 0.01, 0.0, 0.0, 0.0),
+    (0.0, P.drives[1].limit_min_rad - (P.drives[1].limit_max_rad - P.drives[1].limit_min_rad) - 0.01, 0.0, 0.0),
+    (0.0, 0.0, 1e6, 0.0),
+])
+def test_setpoints_out_of_range_are_rejected_counted_and_not_taken(lib, gains, setpoints):
+    s = Session(lib)
+    s.configure(gains)
+    s.send(L.Setpoints(0, (0.2, 0.1, -0.2, 0.4)))
+    s.send(L.Setpoints(1, setpoints))
+    assert s.fw.rejections()[R.VALUE] == 1
+    cs = np.ctypeslib.as_array(s.fw.cascade.cs)
+    assert cs[:, layout.CS_R_RAW] == pytest.approx([0.2, 0.1, -0.2])  # the last good ones hold
+    (hb,) = s.send(L.Heartbeat(8))
+    assert hb.rejections[R.VALUE] == 1

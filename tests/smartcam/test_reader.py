@@ -214,7 +214,27 @@ def test_a_noisy_line_does_not_bury_the_log(camera, open_reader, values, caplog)
     garbage = [r for r in caplog.records if "rejected garbage" in r.getMessage()]
     assert len(garbage) == 25 and reader.stats.rejected == {"garbage": 25}
     assert sum(r.levelno == logging.WARNING for r in garbage) == 10
-    assert "every 100th" in garbage[9].getMessage()
+    assert "counted in one line when the burst ends" in garbage[9].getMessage()
+    summary = [r.getMessage() for r in caplog.records if "more 'garbage' message(s)" in r.getMessage()]
+    assert len(summary) == 1 and "15 more 'garbage' message(s)" in summary[0]
+
+
+def test_a_flood_of_dollars_is_a_dozen_warning_lines_with_the_count(camera, open_reader, values, caplog):
+    # issue 28: 1 MB of `$` on the camera link logged 10,012 warning lines (every 100th of each kind)
+    caplog.set_level(logging.WARNING, logger=LOGGER)
+    reader = open_reader(camera.port)
+    reader._now = lambda: 0.0  # one burst, however long the machine takes over it
+    reader._consume(b"$" * 200_000)  # 1 MB takes ~15 s here; 200 kB is the same burst
+    camera.send_frame(values(0))
+    assert reader.read_frame().seq == 0
+    warnings = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    rejected = sum(reader.stats.rejected.values())
+    assert rejected > 1000, reader.stats.rejected  # a burst, not one line
+    assert len(warnings) <= 10 + len(reader.stats.rejected) + 1, warnings[-3:]
+    for kind, count in reader.stats.rejected.items():
+        if count > 10:
+            summary = [m for m in warnings if f"more '{kind}' message(s)" in m]
+            assert len(summary) == 1 and f": {count - 10} more '{kind}'" in summary[0], summary
 
 
 def test_a_serial_instance_or_a_factory_can_be_given(camera, open_reader, values):

@@ -202,7 +202,7 @@ def test_vision_detect_refuses_a_turned_and_a_mirrored_photo_naming_it(photo, tm
     assert run_cli(["vision", "detect", str(upright), "--robot-marks", ROBOT_MARKS, "--json"]) == 0
     out = capsys.readouterr().out
     assert '"orientation": "orientation checked: the field\'s near side is at the bottom' in out
-    assert "the robot's marks are where it drew them" in out
+    assert "the robot's marks ((1, 1), (3, 3), (5, 5)) are where it drew them" in out
 
 
 @pytest.mark.parametrize("argv, message", [

@@ -29,7 +29,8 @@ def test_render_then_detect_as_json(tmp_path: Path, capsys):
     assert rendered["board"] == board and rendered["view"] == "far_edge" and rendered["dim"] == 0.3
     assert cv2.imread(str(photo)).shape == (480, 640, 3)
     overlay = tmp_path / "overlay.png"
-    assert run(["vision", "detect", str(photo), "--overlay", str(overlay), "--json"]) == 0
+    assert run(["vision", "detect", str(photo), "--overlay", str(overlay),
+                "--robot-marks", "X..../...../..X../...../....X", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["board"] == board
     assert len(data["cells"]) == 25 and len(data["percentages"]) == 25 and len(data["corners_px"]) == 4
@@ -50,9 +51,13 @@ def test_a_board_may_be_written_in_rows_as_the_other_commands_take_it(tmp_path: 
 
 def test_detect_prints_the_cells_both_ways(tmp_path: Path, capsys):
     photo = tmp_path / "p.png"
-    assert run(["vision", "render", str(photo), "--seed", "5"]) == 0
-    truth = capsys.readouterr().out.split("the board:\n")[1].split()
-    assert run(["vision", "detect", str(photo)]) == 0
+    assert run(["vision", "render", str(photo), "--seed", "5", "--json"]) == 0
+    rendered = json.loads(capsys.readouterr().out)
+    truth = [rendered["board"][5 * k:5 * k + 5] for k in range(5)]
+    marks = "".join(ch if ch == rendered["robot_symbol"] else "." for ch in rendered["board"])
+    assert run(["vision", "detect", str(photo)]) == 2  # without the robot's marks a mirror cannot be told
+    assert "cannot tell whether the photo is mirrored left-right" in capsys.readouterr().err
+    assert run(["vision", "detect", str(photo), "--robot-marks", marks]) == 0
     out = capsys.readouterr().out
     assert "field found" in out
     rows = [line.split()[-1] for line in out.splitlines()[2:7]]

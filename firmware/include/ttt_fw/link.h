@@ -46,7 +46,7 @@
 #define TTT_REJ_OUT_OF_ORDER 8  /* sequence number behind the last one */
 #define TTT_REJ_LATE 9          /* setpoints for a step already past */
 #define TTT_REJ_REFUSED 10      /* valid, but not in this state (setpoints before START, gains while running) */
-#define TTT_REJ_VALUE 11        /* a field out of range (drive, block, op, a non-finite number) */
+#define TTT_REJ_VALUE 11        /* a field out of range (drive, block, op, non-finite, a setpoint, gain or period beyond its range) */
 #define TTT_N_REJ 12
 
 /* CRC-16/CCITT-FALSE: polynomial 0x1021, init 0xFFFF, no reflection, no final xor ("123456789" -> 0x29B1). */

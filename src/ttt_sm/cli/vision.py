@@ -4,7 +4,9 @@
 locates the field in a photo and prints the cells (as the image shows them
 and in board order) with their ink percentages.  A photo turned against the
 view (its perspective shows it) or mirrored (the robot's marks, when given,
-show it) is refused: read, it would put every symbol in the wrong cell.
+show it) is refused: read, it would put every symbol in the wrong cell.  So is
+a photo whose handedness nothing establishes (no robot marks, or marks that a
+mirror leaves in place) when a mirror would read another board.
 
 ``ttt-sm vision render OUT.png [--seed N] [--board TEXT] [--robot X|O]
 [--shadow] [--dim D] [--json]`` saves a simulated camera photo of a random
@@ -27,7 +29,7 @@ from typing import Any
 import cv2
 
 from ..vision.errors import VisionError
-from ..vision.orientation import VIEW_NAMES, board_text, board_values, check_orientation, check_robot_marks
+from ..vision.orientation import VIEW_NAMES, board_text, board_values, establish_orientation
 from .common import board_cells, print_json, seed
 
 
@@ -115,13 +117,8 @@ def cmd_vision_detect(args: argparse.Namespace) -> int:
         out = _picture_path(args.overlay, "--overlay") if args.overlay else None
         image = read_image(args.image)
         det = detect(image)
-        note = check_orientation(det.grid, args.view, str(args.image))
-        if args.robot_marks is not None:
-            try:
-                check_robot_marks(det.cells, args.view, args.robot_marks.upper(), str(args.image))
-            except VisionError as exc:
-                raise VisionError(f"--robot-marks: {exc}") from None
-            note += "; the robot's marks are where it drew them"
+        marks = None if args.robot_marks is None else args.robot_marks.upper()
+        note = establish_orientation(det.grid, det.cells, args.view, marks, str(args.image))
         if out is not None:
             _write_picture(out, overlay(image, det), "--overlay")
     except VisionError as exc:

@@ -47,7 +47,9 @@ symlink, ``socket://host:port``, ``spy:///dev/pts/3``), a ``serial.Serial``
 
 _CHUNK = 4096
 _LOUD_PER_KIND = 10
-"""Log this many messages of one kind at WARNING, then only every 100th (the rest at DEBUG)."""
+"""Log this many messages of one kind per burst at WARNING; the rest at DEBUG, summed up in one line."""
+_SUMMARY_EVERY_S = 10.0
+"""A burst that goes on this long gets its summary line now, and again after as long."""
 _LOG = logging.getLogger(__name__)
 
 
@@ -187,6 +189,8 @@ class SerialCameraReader:
         self._last_seq: int | None = None
         self._n = _Counters()
         self._loud: dict[str, int] = {}
+        self._quiet: dict[str, tuple[int, float]] = {}  # kind -> messages kept at DEBUG, since when
+        self._now = time.monotonic  # a test may set its own clock
         self.last_status: Status | None = None
         """The latest status line from the camera, if any."""
 
@@ -202,6 +206,7 @@ class SerialCameraReader:
     def close(self) -> None:
         """Close the port; the reader cannot be used afterwards."""
         self._closed = True
+        self._end_bursts()
         self._close_port()
 
     def __enter__(self) -> SerialCameraReader:
@@ -450,6 +455,7 @@ class SerialCameraReader:
                 self._status(message)
 
     def _accept(self, frame: Frame) -> None:
+        self._end_bursts()  # a good frame ends every burst of bad lines
         now = time.monotonic()
         if self._last_seq is not None:
             step = (frame.seq - self._last_seq) % SEQ_MODULUS
@@ -499,15 +505,33 @@ class SerialCameraReader:
                               " cable pulled?", self.port_name, self._silence_s, self._summary())
 
     def _say(self, kind: str, msg: str, *args: Any) -> None:
-        # Loud for the first few of a kind, then every 100th: a noisy line must
-        # not bury the log, and the counts in `stats` keep the full tally.
+        # Loud for the first few of a kind in a burst, the rest at DEBUG and summed
+        # up in one WARNING line when the burst ends (a good frame, close) or every
+        # _SUMMARY_EVERY_S while it lasts: 1 MB of noise is a dozen lines, not
+        # ten thousand, and the counts in `stats` keep the full tally.
         n = self._loud[kind] = self._loud.get(kind, 0) + 1
-        loud = n <= _LOUD_PER_KIND or n % 100 == 0
-        if n == _LOUD_PER_KIND:
-            msg += f" (further '{kind}' messages: every 100th at WARNING, the rest at DEBUG)"
-        elif n > _LOUD_PER_KIND and loud:
-            msg += f" ({n} so far)"
-        self._log.log(logging.WARNING if loud else logging.DEBUG, "camera %s: " + msg, self.port_name, *args)
+        if n <= _LOUD_PER_KIND:
+            if n == _LOUD_PER_KIND:
+                msg += f" (further '{kind}' messages at DEBUG, counted in one line when the burst ends)"
+            self._log.warning("camera %s: " + msg, self.port_name, *args)
+            return
+        self._log.debug("camera %s: " + msg, self.port_name, *args)
+        now = self._now()
+        count, since = self._quiet.get(kind, (0, now))
+        self._quiet[kind] = (count + 1, since)
+        if now - since >= _SUMMARY_EVERY_S:
+            self._summarise(kind, now)
+
+    def _summarise(self, kind: str, now: float) -> None:
+        count, since = self._quiet.pop(kind)
+        self._log.warning("camera %s: %d more '%s' message(s) in %.1f s, logged at DEBUG (%s)",
+                          self.port_name, count, kind, now - since, self._summary())
+
+    def _end_bursts(self) -> None:
+        now = self._now()
+        for kind in list(self._quiet):
+            self._summarise(kind, now)
+        self._loud.clear()
 
     def _summary(self) -> str:
         n = self._n

@@ -34,6 +34,7 @@ from .orientation import (
     board_values,
     check_orientation,
     check_robot_marks,
+    establish_orientation,
     image_cell,
     image_text,
 )
@@ -43,6 +44,7 @@ __all__ = [
     "Camera", "ImageFileCamera", "OpenCVCamera", "check_image", "read_image",
     "Detection", "detect", "Grid", "locate_grid",
     "board_cell", "board_text", "board_values", "image_cell", "image_text", "check_orientation", "check_robot_marks",
+    "establish_orientation",
     "PersonMoves", "percent_process", "read_moves", "robot_ink_after_move",
     "VisionError", "ImageError", "GridNotFoundError", "CameraError",
     "MoveError", "TooManyMovesError", "RobotCellMarkedError", "SymbolVanishedError", "OrientationError",

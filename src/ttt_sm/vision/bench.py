@@ -15,6 +15,7 @@ import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
+import cv2
 import numpy as np
 
 from ttt_sm.params import ArmParams, Geometry, load_params
@@ -23,7 +24,7 @@ from ttt_sm.twin.kinematics import arm_points, ik_closed_form
 from .detection import detect
 from .errors import VisionError
 from .orientation import board_text
-from .scenes import Scene, random_scene
+from .scenes import Scene, random_scene, scene_from_text
 from .simulated import LAMP_M, SHADOW_DEPTH, CameraJitter, Shadow, SimulatedCamera
 
 #: Each photo is detected this many times; its time is the fastest run.
@@ -148,3 +149,88 @@ def bench_vision(seed: int = 0, photos: int = BENCH_PHOTOS, params: ArmParams | 
         "vision_max_roll_deg": float(max(rolls)),
         "vision_wrong": wrong,
     }
+
+
+#: The ways a photo may come turned or mirrored, as OpenCV makes them (docs/vision.md, "What a single
+#: photo can tell"); "as it is" first.
+PHOTO_CHANGES: dict[str, Callable[[np.ndarray], np.ndarray]] = {
+    "as it is": lambda im: im,
+    "mirrored left-right": lambda im: cv2.flip(im, 1),
+    "mirrored top-bottom": lambda im: cv2.flip(im, 0),
+    "turned 90 deg clockwise": lambda im: cv2.rotate(im, cv2.ROTATE_90_CLOCKWISE),
+    "turned 90 deg counter-clockwise": lambda im: cv2.rotate(im, cv2.ROTATE_90_COUNTERCLOCKWISE),
+    "turned 180 deg": lambda im: cv2.rotate(im, cv2.ROTATE_180),
+    "transposed": lambda im: cv2.transpose(im),
+    "transposed across the other diagonal": lambda im: cv2.flip(cv2.transpose(im), -1),
+}
+
+#: Robot marks that some turn or mirror leaves in place (board cells, 1-based): the hard cases.
+SYMMETRIC_MARKS: tuple[tuple[tuple[int, int], ...], ...] = (
+    ((3, 3),),  # every turn and mirror
+    ((1, 1), (2, 2), (3, 3), (4, 4), (5, 5)),  # the diagonal: transposes
+    ((2, 3), (3, 3), (4, 3)),  # the middle column: the far-edge camera's left-right mirror
+    ((1, 1), (1, 5), (5, 1), (5, 5)),  # the corners: all of them
+)
+
+
+def _probe_scene(params: ArmParams, k: int, rng: np.random.Generator) -> Scene:
+    """Board `k` of the probe: even ones random, odd ones robot marks of :data:`SYMMETRIC_MARKS` + the person's."""
+    if k % 2 == 0:
+        return random_scene(params, seed=1000 + k)
+    robot = SYMMETRIC_MARKS[(k // 2) % len(SYMMETRIC_MARKS)]
+    robot_symbol = "X" if k % 4 == 1 else "O"
+    text = ["."] * 25
+    for r, c in robot:
+        text[(r - 1) * 5 + c - 1] = robot_symbol
+    free = [i for i in range(25) if text[i] == "."]
+    for i in rng.choice(free, size=int(rng.integers(1, 4)), replace=False):
+        text[int(i)] = "O" if robot_symbol == "X" else "X"
+    return scene_from_text(params, "".join(text), robot_symbol, seed=1000 + k)
+
+
+def orientation_probe(boards: int = 50, seed: int = 0, params: ArmParams | None = None) -> dict[str, Any]:
+    """Photos of `boards` boards, each turned and mirrored all eight ways, read as ``vision detect`` does.
+
+    Each board is photographed by the simulated camera (view ``far_edge``); the same photo flipped
+    top-bottom is a photo in view ``field``.  Every changed photo is read in its view with the robot's
+    marks and without; a read board must be the truth.  Returns counts of ``read_right``, ``refused``
+    and ``silent_wrong`` (with the cases in ``wrong``), per change in ``by_change``.
+    """
+    from .orientation import establish_orientation
+
+    params = params or load_params()
+    rng = np.random.default_rng(seed)
+    counts = {"read_right": 0, "refused": 0, "silent_wrong": 0, "grid_failures": 0}
+    by_change: dict[str, dict[str, int]] = {n: {"read_right": 0, "refused": 0, "silent_wrong": 0}
+                                            for n in PHOTO_CHANGES}
+    wrong: list[dict[str, Any]] = []
+    upright_read = 0
+    for k in range(boards):
+        scene = _probe_scene(params, k, rng)
+        photo = SimulatedCamera(scene.board, params, seed=seed * 1000 + k, jitter=BENCH_JITTER).frame()
+        marks = "".join(ch if ch == scene.robot_symbol else "." for ch in scene.text)
+        for view, base in (("far_edge", photo), ("field", cv2.flip(photo, 0))):
+            for name, change in PHOTO_CHANGES.items():
+                try:
+                    det = detect(change(base))
+                except VisionError:
+                    counts["grid_failures"] += 1
+                    continue
+                for given in (marks, None):
+                    try:
+                        establish_orientation(det.grid, det.cells, view, given, f"board {k}")
+                    except VisionError:
+                        counts["refused"] += 1
+                        by_change[name]["refused"] += 1
+                        continue
+                    read = board_text(det.cells, view)
+                    key = "read_right" if read == scene.text else "silent_wrong"
+                    counts[key] += 1
+                    by_change[name][key] += 1
+                    if key == "read_right" and name == "as it is" and given is not None:
+                        upright_read += 1
+                    if key == "silent_wrong":
+                        wrong.append({"board": k, "truth": scene.text, "read": read, "view": view,
+                                      "change": name, "marks": given})
+    return {"boards": boards, "readings": sum(counts.values()) - counts["grid_failures"], **counts,
+            "upright_with_marks_read": upright_read, "by_change": by_change, "wrong": wrong}

@@ -35,6 +35,16 @@ every symbol in the wrong cell.  Two things tell the orientation:
   :func:`~ttt_sm.vision.percent.percent_process` in a game): the robot knows
   where it drew; if the photo shows its marks where a turn or a mirror
   would put them, the photo is turned or mirrored.
+
+A single photo cannot tell more: the drawn field is symmetric under every
+turn and mirror of the square, and so are an X and an O.  A camera beyond
+the far edge stands on the field's axis, so a left-right mirror keeps its
+perspective; only robot marks that a mirror moves tell it.
+:func:`establish_orientation` puts the two together: of the eight ways a
+photo may have been turned or mirrored, it keeps those that the perspective
+and the robot's marks allow, and reads the photo only if that leaves the
+photo as it is, or leaves ways that all read the same board.  Anything else
+is refused with the reason (docs/vision.md, "What a single photo can tell").
 """
 
 from __future__ import annotations
@@ -239,3 +249,119 @@ def check_robot_marks(cells: str, view: str, robot_marks: str, what: str = "phot
     raise VisionError(f"{what}: the robot's marks are not all seen: board cell(s) {shown} should hold"
                       f" {robot_marks[missing[0][0] * N + missing[0][1]]} and no turn or mirror of the photo"
                       f" explains it")
+
+
+AS_IS = "as it is"
+
+
+def _side_after(change: Callable[[int, int], tuple[int, int]], side: str) -> str:
+    """Where the `side` of the photo as it should be lies in a photo changed by `change`."""
+    cells = {"top": [(0, c) for c in range(N)], "bottom": [(N - 1, c) for c in range(N)],
+             "left": [(r, 0) for r in range(N)], "right": [(r, N - 1) for r in range(N)]}[side]
+    moved = [change(r, c) for r, c in cells]
+    for name, where in (("top", lambda rc: rc[0] == 0), ("bottom", lambda rc: rc[0] == N - 1),
+                        ("left", lambda rc: rc[1] == 0), ("right", lambda rc: rc[1] == N - 1)):
+        if all(where(rc) for rc in moved):
+            return name
+    raise AssertionError(f"{side} side not moved to a side")  # every change of the square moves sides to sides
+
+
+def _cell_list(marks: str) -> str:
+    return ", ".join(f"({k // N + 1}, {k % N + 1})" for k, m in enumerate(marks) if m != EMPTY) or "none"
+
+
+def establish_orientation(grid: object, cells: str, view: str, robot_marks: str | None = None,
+                          what: str = "photo") -> str:
+    """Read a photo only if which way it is turned and its handedness are established; a note of how.
+
+    Of the eight ways a photo of a square field may have been turned or
+    mirrored (:data:`CHANGES` and the photo as it is), the perspective keeps
+    those that put the field's near side where `view` has it (a view with
+    perspective: two, the photo as it is and its mirror along the camera's
+    axis), and the robot's marks keep those that show them where the robot
+    drew them.  The photo is read if the photo as it is remains and every
+    other remaining way reads the same board (a board symmetric like the
+    marks: nothing is read wrong); else it is refused.
+
+    Parameters
+    ----------
+    grid : Grid
+        The located field (``Detection.grid``); only its ``corners`` are read.
+    cells : str
+        ``Detection.cells``: 25 characters in image order.
+    view : str
+        Where the camera stands (:data:`VIEW_NAMES`).
+    robot_marks : str, optional
+        25 characters in board order: the robot's ``X`` or ``O`` where it
+        drew, ``.`` elsewhere; None if not known.
+    what : str
+        How to name the photo in messages (its file name).
+
+    Returns
+    -------
+    str
+        ``orientation checked: ...``, naming the evidence.
+
+    Raises
+    ------
+    OrientationError
+        The photo is turned or mirrored, or whether it is cannot be told and
+        the board would read differently if it were.
+    VisionError
+        The robot's marks are not all seen and no allowed turn or mirror explains it.
+    """
+    _check(view)
+    if len(cells) != N * N:
+        raise VisionError(f"{what}: expected 25 detected cells, got {len(cells)}")
+    if robot_marks is not None and (len(robot_marks) != N * N or set(robot_marks) - {"X", "O", EMPTY}):
+        raise VisionError(f"{what}: expected 25 robot marks ('X', 'O' or '.')")
+    ways: dict[str, Callable[[int, int], tuple[int, int]]] = {AS_IS: lambda r, c: (r, c), **CHANGES}
+    near = NEAR_SIDE[view]
+    evidence = []
+    if near is not None:
+        side, ratio = perspective(grid.corners)  # type: ignore[attr-defined]
+        if ratio < MIN_PERSPECTIVE:
+            raise OrientationError(
+                f"{what}: cannot tell which way the photo is turned: the field's sides differ by only"
+                f" {100 * (ratio - 1):.0f} %, where a camera {_WHERE[view]} sees its near side at least"
+                f" {100 * (MIN_PERSPECTIVE - 1):.0f} % wider; if the camera looks straight down, give --view above")
+        ways = {n: ch for n, ch in ways.items() if _side_after(ch, near) == side}
+        evidence.append(f"the field's near side is at the {side}, {ratio:.2f} times as wide as its far side")
+        no_help = "its perspective cannot tell them apart (the camera stands on the field's axis)"
+    else:
+        no_help = f"in view {view!r} no side of the field is nearer the camera"
+    if robot_marks is not None:
+        kept = {n: ch for n, ch in ways.items() if not _shows(board_text(_undo(cells, ch), view), robot_marks)}
+        if not kept:
+            missing = _shows(board_text(cells, view), robot_marks)
+            shown = ", ".join(f"({r + 1}, {c + 1})" for r, c in missing)
+            raise VisionError(
+                f"{what}: the robot's marks are not all seen: board cell(s) {shown} should hold"
+                f" {robot_marks[missing[0][0] * N + missing[0][1]]} and no turn or mirror of the photo"
+                f" {'that its perspective allows ' if near is not None else ''}explains it")
+        ways = kept
+        evidence.append(f"the robot's marks ({_cell_list(robot_marks)}) are where it drew them")
+    others = [n for n in ways if n != AS_IS]
+    if AS_IS not in ways:
+        if near is not None and robot_marks is None:
+            side = _side_after(ways[others[0]], near)
+            turn = " or ".join(others)
+            raise OrientationError(
+                f"{what}: the photo is turned: the field's near side (the widest, {ratio:.2f} times its far"
+                f" side) is at the {side} of the picture, where a camera {_WHERE[view]} sees it at the {near}"
+                f" (the photo is {turn}); {_TURN_BACK[side]}, or give the --view of the camera")
+        raise OrientationError(
+            f"{what}: the robot's marks show the photo {' or '.join(others)}: read as it is, every symbol would be"
+            f" in the wrong cell; fix the camera (a mirror setting?) or the photo")
+    as_read = board_text(cells, view)
+    differ = [n for n in others if board_text(_undo(cells, ways[n]), view) != as_read]
+    if differ:
+        marks = ("no robot marks were given (--robot-marks)" if robot_marks is None else
+                 f"the robot's marks ({_cell_list(robot_marks)}) look the same")
+        raise OrientationError(
+            f"{what}: cannot tell whether the photo is {' or '.join(differ)}: {no_help}, and {marks}"
+            f" that way; read one way or the other it shows a different board; give the robot's marks"
+            f" with one that such a mirror or turn would move")
+    if others:
+        evidence.append(f"{' or '.join(others)}, it would read the same board")
+    return "orientation checked: " + "; ".join(evidence)

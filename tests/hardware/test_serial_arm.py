@@ -170,3 +170,20 @@ def test_arm_serve_errors_are_one_line(tmp_path, capsys):
     assert err.startswith("ttt-sm arm serve: error: the folder of the link") and err.count("\n") == 1
     assert main(["arm", "serve", "--duration", "nan"]) == 2
     assert "--duration must be a finite number" in capsys.readouterr().err
+
+
+def test_the_issue_s_setpoints_over_the_link_are_rejected_and_the_arm_holds(emulator, gains):
+    # issue 28: set_setpoints([1e30, -1e30, 3e38, 1e30]) drove drive 1 into its hard stop at 5.45 A
+    arm = SerialArm(emulator.port, P, gains, servo_angle=REST_POSE[3], link_timeout_s=PATIENT_S)
+    try:
+        arm.step(2)
+        before = arm.encoder_angles()
+        for _ in range(50):
+            arm.set_setpoints([1e30, -1e30, 3e38, 1e30])
+            arm.step(P.control.chart_divider)
+        assert emulator.firmware.rejections()[L.Reason.VALUE] >= 1  # the PC sends a setpoint once per change
+        assert np.max(np.abs(np.asarray(arm.encoder_angles()) - np.asarray(before))) < 0.01
+        assert np.max(np.abs(arm.sensors().current_a)) < 1.0  # nowhere near the 5.45 A stall
+        assert abs(arm.sensors().servo_rad - REST_POSE[3]) < 0.05  # the servo stayed where it was
+    finally:
+        arm.close()

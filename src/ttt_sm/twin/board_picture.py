@@ -119,7 +119,20 @@ def board_figure(board: Whiteboard, title: str, subtitle: str = "", grid_mm: boo
     image = board.render(px_per_mm=PX_PER_MM, region=(x0 + res / 4, x1 - res / 4, y0 + res / 4, y1 - res / 4),
                          view="above", grid_mm=grid_mm)
     h_px, w_px = image.shape[:2]
-    left_in, right_in, bottom_in, top_in = 0.75, 0.25, 1.15, 0.75
+    authors = {s.author for s in board.strokes}
+    handles: list[Artist] = [Line2D([], [], color=FIELD_LINE_RGB, ls=(0, (4, 4)), lw=0.8,
+                      label="where the field's lines go: the cell edges, 3 cm apart"),
+               Line2D([], [], color=FIELD_EDGE_RGB, ls=":", lw=0.8, label="the field's outer edge (never drawn)")]
+    if "robot" in authors:
+        handles.append(Patch(color=_rgb(ROBOT_INK_BGR), label="the robot's ink (where the true pen tip touched)"))
+    if "hand" in authors:
+        handles.append(Patch(color=_rgb(HAND_INK_BGR), label="the person's ink"))
+    if len(desired):
+        handles.append(Line2D([], [], color="k", lw=0.6, label="the desired paths (pen down)"))
+    if grid_mm:
+        handles.append(Patch(facecolor="white", edgecolor="0.6", label="millimetre paper: lines every 1, 5, 10 mm"))
+    # the legend's rows (two entries each) and its title below the axes: the bottom margin grows with them
+    left_in, right_in, bottom_in, top_in = 0.75, 0.25, 0.8 + 0.175 * math.ceil(len(handles) / 2), 0.75
     fig = Figure(figsize=(w_px / DPI + left_in + right_in, h_px / DPI + bottom_in + top_in), dpi=DPI)
     fw, fh = fig.get_size_inches()
     ax = fig.add_axes((left_in / fw, bottom_in / fh, w_px / DPI / fw, h_px / DPI / fh))
@@ -162,18 +175,6 @@ def board_figure(board: Whiteboard, title: str, subtitle: str = "", grid_mm: boo
     if subtitle:
         ax.text(0.0, 1.01, subtitle, transform=ax.transAxes, ha="left", va="bottom", fontsize=8.5, color="0.3")
 
-    authors = {s.author for s in board.strokes}
-    handles: list[Artist] = [Line2D([], [], color=FIELD_LINE_RGB, ls=(0, (4, 4)), lw=0.8,
-                      label="where the field's lines go: the cell edges, 3 cm apart"),
-               Line2D([], [], color=FIELD_EDGE_RGB, ls=":", lw=0.8, label="the field's outer edge (never drawn)")]
-    if "robot" in authors:
-        handles.append(Patch(color=_rgb(ROBOT_INK_BGR), label="the robot's ink (where the true pen tip touched)"))
-    if "hand" in authors:
-        handles.append(Patch(color=_rgb(HAND_INK_BGR), label="the person's ink"))
-    if len(desired):
-        handles.append(Line2D([], [], color="k", lw=0.6, label="the desired paths (pen down)"))
-    if grid_mm:
-        handles.append(Patch(facecolor="white", edgecolor="0.6", label="millimetre paper: lines every 1, 5, 10 mm"))
     base_mm = y0 * 1e3  # the base axis stands at y = 0 (docs/kinematics.md)
     fig.legend(handles=handles, loc="lower left", bbox_to_anchor=(left_in / fw, 0.01), ncol=2, fontsize=8,
                frameon=False,

@@ -102,6 +102,15 @@ def _write_picture(path: Path, image: Any, what: str) -> None:
         raise VisionError(f"{what} {str(path)!r}: could not write the picture (does the folder exist?)") from None
 
 
+def _robot_marks(text: str) -> str:
+    """``--robot-marks``: 25 marks X, O or . in board order (rows may be split by /), or a VisionError naming it."""
+    marks = text.upper().replace("/", "")
+    if len(marks) != 25 or set(marks) - {"X", "O", "."}:
+        raise VisionError(f"--robot-marks {text[:80]!r}: expected 25 marks, X or O where the robot drew and ."
+                          " elsewhere, in board order (row 1 first; rows may be split by /)")
+    return marks
+
+
 def _fail(exc: Exception) -> int:
     print(f"ttt-sm vision: error: {exc}", file=sys.stderr)
     return 2
@@ -115,12 +124,12 @@ def cmd_vision_detect(args: argparse.Namespace) -> int:
 
     try:
         out = _picture_path(args.overlay, "--overlay") if args.overlay else None
+        marks = None if args.robot_marks is None else _robot_marks(args.robot_marks)
         image = read_image(args.image)
         det = detect(image)
-        marks = None if args.robot_marks is None else args.robot_marks.upper()
-        note = establish_orientation(det.grid, det.cells, args.view, marks, str(args.image))
-        if out is not None:
+        if out is not None:  # where the field was found, also when the board cannot be read from it
             _write_picture(out, overlay(image, det), "--overlay")
+        note = establish_orientation(det.grid, det.cells, args.view, marks, str(args.image))
     except VisionError as exc:
         return _fail(exc)
     data = det.to_dict()

@@ -135,6 +135,18 @@ def perspective(corners: Iterable[Iterable[float]]) -> tuple[str, float]:
     return widest, sides[widest] / max(sides[_OPPOSITE[widest]], 1e-9)
 
 
+def _near_side(grid: object, view: str, what: str) -> tuple[str, float]:
+    """The side of the field nearest the camera and how much wider it is than the far side; an
+    :class:`OrientationError` when the perspective is too weak to tell (a camera looking straight down)."""
+    side, ratio = perspective(grid.corners)  # type: ignore[attr-defined]
+    if ratio < MIN_PERSPECTIVE:
+        raise OrientationError(
+            f"{what}: cannot tell which way the photo is turned: the field's sides differ by only"
+            f" {100 * (ratio - 1):.0f} %, where a camera {_WHERE[view]} sees its near side at least"
+            f" {100 * (MIN_PERSPECTIVE - 1):.0f} % wider; if the camera looks straight down, give --view above")
+    return side, ratio
+
+
 def check_orientation(grid: object, view: str, what: str = "photo") -> str:
     """Check by its perspective that a photo is not turned against `view`; a note of what was checked.
 
@@ -164,12 +176,7 @@ def check_orientation(grid: object, view: str, what: str = "photo") -> str:
     if near is None:
         return (f"orientation not checked: in view {view!r} no side of the field is nearer the camera, so a"
                 f" turned or mirrored photo looks the same; the robot's marks check it (--robot-marks)")
-    side, ratio = perspective(grid.corners)  # type: ignore[attr-defined]
-    if ratio < MIN_PERSPECTIVE:
-        raise OrientationError(
-            f"{what}: cannot tell which way the photo is turned: the field's sides differ by only"
-            f" {100 * (ratio - 1):.0f} %, where a camera {_WHERE[view]} sees its near side at least"
-            f" {100 * (MIN_PERSPECTIVE - 1):.0f} % wider; if the camera looks straight down, give --view above")
+    side, ratio = _near_side(grid, view, what)
     if side != near:
         raise OrientationError(
             f"{what}: the photo is turned: the field's near side (the widest, {ratio:.2f} times its far side)"
@@ -319,12 +326,7 @@ def establish_orientation(grid: object, cells: str, view: str, robot_marks: str 
     near = NEAR_SIDE[view]
     evidence = []
     if near is not None:
-        side, ratio = perspective(grid.corners)  # type: ignore[attr-defined]
-        if ratio < MIN_PERSPECTIVE:
-            raise OrientationError(
-                f"{what}: cannot tell which way the photo is turned: the field's sides differ by only"
-                f" {100 * (ratio - 1):.0f} %, where a camera {_WHERE[view]} sees its near side at least"
-                f" {100 * (MIN_PERSPECTIVE - 1):.0f} % wider; if the camera looks straight down, give --view above")
+        side, ratio = _near_side(grid, view, what)
         ways = {n: ch for n, ch in ways.items() if _side_after(ch, near) == side}
         evidence.append(f"the field's near side is at the {side}, {ratio:.2f} times as wide as its far side")
         no_help = "its perspective cannot tell them apart (the camera stands on the field's axis)"

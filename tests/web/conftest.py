@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 import uvicorn
+from starlette.testclient import TestClient
 
 from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params
@@ -81,6 +82,23 @@ def serve(session: Session, token: str | None = None,
             raise RuntimeError("the cockpit's server did not start")
         time.sleep(0.02)
     return server, thread, f"http://127.0.0.1:{port}"
+
+
+# A paused session and a test client of its app, shared by the protocol tests of a module.
+@pytest.fixture(scope="module")
+def session() -> Iterator[Session]:
+    s = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
+    s.start()
+    try:
+        yield s
+    finally:
+        s.stop()
+
+
+@pytest.fixture(scope="module")
+def client(session: Session) -> Iterator[TestClient]:
+    with TestClient(create_app(session, manage_session=False)) as c:
+        yield c
 
 
 @pytest.fixture(scope="module")

@@ -10,29 +10,16 @@ import sys
 import time
 import urllib.error
 import urllib.request
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from starlette.testclient import TestClient
 
-from ttt_sm.debug.debugger import Debugger
-from ttt_sm.params import load_params
 from ttt_sm.web.access import allowed_hosts, is_loopback, port_of, reachable_host
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
 
 from .test_protocol import Page, refused
-
-
-@pytest.fixture(scope="module")
-def session() -> Iterator[Session]:
-    s = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
-    s.start()
-    try:
-        yield s
-    finally:
-        s.stop()
 
 
 def test_without_the_token_nothing_of_the_session_is_served_but_the_scripts_are(session: Session) -> None:

@@ -13,7 +13,6 @@ import json
 import random
 import time
 import types
-from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -28,22 +27,6 @@ from ttt_sm.web.fields import integer
 from ttt_sm.web.protocol import COMMANDS, ProtocolError, parse_command
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
-
-
-@pytest.fixture(scope="module")
-def session() -> Iterator[Session]:
-    s = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
-    s.start()
-    try:
-        yield s
-    finally:
-        s.stop()
-
-
-@pytest.fixture(scope="module")
-def client(session: Session) -> Iterator[TestClient]:
-    with TestClient(create_app(session, manage_session=False)) as c:
-        yield c
 
 
 class Page:

@@ -14,7 +14,6 @@ import json
 import queue
 import threading
 import time
-from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -34,22 +33,6 @@ from ttt_sm.web.session import PAGE_QUEUE, Session
 from .test_protocol import Page
 
 WAIT_S = 120.0
-
-
-@pytest.fixture(scope="module")
-def session() -> Iterator[Session]:
-    s = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
-    s.start()
-    try:
-        yield s
-    finally:
-        s.stop()
-
-
-@pytest.fixture(scope="module")
-def client(session: Session) -> Iterator[TestClient]:
-    with TestClient(create_app(session, manage_session=False)) as c:
-        yield c
 
 
 class Held:

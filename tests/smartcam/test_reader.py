@@ -223,7 +223,7 @@ def test_a_flood_of_dollars_is_a_dozen_warning_lines_with_the_count(camera, open
     # issue 28: 1 MB of `$` on the camera link logged 10,012 warning lines (every 100th of each kind)
     caplog.set_level(logging.WARNING, logger=LOGGER)
     reader = open_reader(camera.port)
-    reader._now = lambda: 0.0  # one burst, however long the machine takes over it
+    reader._burst.now = lambda: 0.0  # one burst, however long the machine takes over it
     reader._consume(b"$" * 200_000)  # 1 MB takes ~15 s here; 200 kB is the same burst
     camera.send_frame(values(0))
     assert reader.read_frame().seq == 0

@@ -44,6 +44,7 @@ import select
 import threading
 import time
 from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from typing import TypeVar
 
@@ -160,7 +161,7 @@ class LinkLost(SerialArmError):
     """No valid frame from the firmware within the link's timeout (while opening it, or asked for a reply)."""
 
 
-class SerialArm:
+class SerialArm(AbstractContextManager["SerialArm"]):
     """An :class:`~ttt_sm.arm.Arm` whose cascade runs in the firmware at the other end of `port`.
 
     Parameters
@@ -287,9 +288,6 @@ class SerialArm:
             keeper.join(1.0)
         with self._io:
             self._ser.close()
-
-    def __enter__(self) -> SerialArm:
-        return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()

@@ -5,6 +5,7 @@ fields over a serial port; the PC reads them.  Layers, one way:
 
 - :mod:`.protocol` -- the line format, a strict decoder, CRC-16;
 - :mod:`.framing` -- bytes to sentences, resynchronising after garbage;
+- :mod:`.burst_log` -- warnings rate-limited per kind and summed up per burst;
 - :mod:`.reader` -- :class:`SerialCameraReader` on a pyserial port, with
   rejection counts, sequence gaps and bounded reconnects;
 - :mod:`.emulator` -- :class:`CameraEmulator` on a real pseudo-terminal,

@@ -32,10 +32,11 @@ import time
 from collections import deque
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import Any, TypeAlias
+from typing import TypeAlias
 
 import serial
 
+from .burst_log import BurstLog
 from .errors import CameraSilent, FrameError, LinkLost, PortUnavailable, Reason, SerialLinkError, snippet
 from .framing import LineFramer, Rejection
 from .protocol import SEQ_MODULUS, Frame, Level, Status, decode_line
@@ -46,10 +47,6 @@ symlink, ``socket://host:port``, ``spy:///dev/pts/3``), a ``serial.Serial``
 (reopened with ``.open()``), or a callable returning an open port."""
 
 _CHUNK = 4096
-_LOUD_PER_KIND = 10
-"""Log this many messages of one kind per burst at WARNING; the rest at DEBUG, summed up in one line."""
-_SUMMARY_EVERY_S = 10.0
-"""A burst that goes on this long gets its summary line now, and again after as long."""
 _LOG = logging.getLogger(__name__)
 
 
@@ -188,9 +185,7 @@ class SerialCameraReader:
         self._silent = False
         self._last_seq: int | None = None
         self._n = _Counters()
-        self._loud: dict[str, int] = {}
-        self._quiet: dict[str, tuple[int, float]] = {}  # kind -> messages kept at DEBUG, since when
-        self._now = time.monotonic  # a test may set its own clock
+        self._burst = BurstLog(self._log, self.port_name, self._summary)
         self.last_status: Status | None = None
         """The latest status line from the camera, if any."""
 
@@ -206,7 +201,7 @@ class SerialCameraReader:
     def close(self) -> None:
         """Close the port; the reader cannot be used afterwards."""
         self._closed = True
-        self._end_bursts()
+        self._burst.end()
         self._close_port()
 
     def __enter__(self) -> SerialCameraReader:
@@ -455,22 +450,22 @@ class SerialCameraReader:
                 self._status(message)
 
     def _accept(self, frame: Frame) -> None:
-        self._end_bursts()  # a good frame ends every burst of bad lines
+        self._burst.end()  # a good frame ends every burst of bad lines
         now = time.monotonic()
         if self._last_seq is not None:
             step = (frame.seq - self._last_seq) % SEQ_MODULUS
             if step == 0:
                 self._n.duplicates += 1
-                self._say("duplicate", "duplicate frame %d dropped", frame.seq)
+                self._burst.say("duplicate", "duplicate frame %d dropped", frame.seq)
                 return
             if 1 < step < SEQ_MODULUS // 2:
                 self._n.gaps += 1
                 self._n.frames_missed += step - 1
-                self._say("gap", "sequence gap: expected %d, got %d (%d frame(s) missed)",
+                self._burst.say("gap", "sequence gap: expected %d, got %d (%d frame(s) missed)",
                           (self._last_seq + 1) % SEQ_MODULUS, frame.seq, step - 1)
             elif step >= SEQ_MODULUS // 2:
                 self._n.seq_restarts += 1
-                self._say("restart", "sequence went back from %d to %d: the camera restarted?",
+                self._burst.say("restart", "sequence went back from %d to %d: the camera restarted?",
                           self._last_seq, frame.seq)
         if self._silent:
             self._log.warning("camera %s: frames again after %.2f s of silence", self.port_name,
@@ -493,7 +488,7 @@ class SerialCameraReader:
         counts[reason.value] = counts.get(reason.value, 0) + 1
         if reason is Reason.GARBAGE:
             self._n.garbage_bytes += size
-        self._say(reason.value, "rejected %s: %s; line %s", reason.value, detail, snippet(raw))
+        self._burst.say(reason.value, "rejected %s: %s; line %s", reason.value, detail, snippet(raw))
 
     def _check_silence(self) -> None:
         if not self._expecting or self._silent:
@@ -503,35 +498,6 @@ class SerialCameraReader:
             self._n.silences += 1
             self._log.warning("camera %s: port open but no valid frame for %.1f s (%s); camera stopped or"
                               " cable pulled?", self.port_name, self._silence_s, self._summary())
-
-    def _say(self, kind: str, msg: str, *args: Any) -> None:
-        # Loud for the first few of a kind in a burst, the rest at DEBUG and summed
-        # up in one WARNING line when the burst ends (a good frame, close) or every
-        # _SUMMARY_EVERY_S while it lasts: 1 MB of noise is a dozen lines, not
-        # ten thousand, and the counts in `stats` keep the full tally.
-        n = self._loud[kind] = self._loud.get(kind, 0) + 1
-        if n <= _LOUD_PER_KIND:
-            if n == _LOUD_PER_KIND:
-                msg += f" (further '{kind}' messages at DEBUG, counted in one line when the burst ends)"
-            self._log.warning("camera %s: " + msg, self.port_name, *args)
-            return
-        self._log.debug("camera %s: " + msg, self.port_name, *args)
-        now = self._now()
-        count, since = self._quiet.get(kind, (0, now))
-        self._quiet[kind] = (count + 1, since)
-        if now - since >= _SUMMARY_EVERY_S:
-            self._summarise(kind, now)
-
-    def _summarise(self, kind: str, now: float) -> None:
-        count, since = self._quiet.pop(kind)
-        self._log.warning("camera %s: %d more '%s' message(s) in %.1f s, logged at DEBUG (%s)",
-                          self.port_name, count, kind, now - since, self._summary())
-
-    def _end_bursts(self) -> None:
-        now = self._now()
-        for kind in list(self._quiet):
-            self._summarise(kind, now)
-        self._loud.clear()
 
     def _summary(self) -> str:
         n = self._n

@@ -16,7 +16,8 @@ strict JSON output); each other module adds its subcommands with a
 ``register(subparsers)`` function, listed in :data:`SUBCOMMANDS` in the order
 ``ttt-sm --help`` shows them:
 
-- :mod:`.commands`: play, demo, draw, tune, bench, ik, init, charts, params;
+- :mod:`.commands`: play, demo, draw, tune, bench, ik, charts, params;
+- :mod:`.sweeps`: init and faults (many runs on a pool or a cluster);
 - :mod:`.precision`: precision (the thesis' staircase of section 3.5);
 - :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.arm`, :mod:`.vision`, :mod:`.ai`,
   :mod:`.lab`: the command of that name (:mod:`.lab` also the global ``--chart``).
@@ -40,11 +41,11 @@ from collections.abc import Sequence
 from ..files import ADVICE as WRITE_ADVICE
 from ..params import shown_path
 from ..runtime.recordfile import interruption
-from . import ai, arm, camera, commands, debug, gui, lab, precision, scenario, vision
+from . import ai, arm, camera, commands, debug, gui, lab, precision, scenario, sweeps, vision
 from .common import join_negative_values, terminate_interrupts
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
-SUBCOMMANDS = (commands, precision, scenario, debug, gui, camera, arm, vision, ai, lab)
+SUBCOMMANDS = (commands, sweeps, precision, scenario, debug, gui, camera, arm, vision, ai, lab)
 
 
 def build_parser() -> argparse.ArgumentParser:

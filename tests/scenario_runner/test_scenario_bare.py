@@ -15,7 +15,7 @@ from ttt_sm.params import load_params
 from ttt_sm.runtime import Data, TickChart, after_s
 from ttt_sm.runtime.listeners import Coverage
 from ttt_sm.scenario import SIGNALS, Catalog, ScenarioError, load_scenario_text, run_scenario, run_scenarios
-from ttt_sm.scenario.runner import ChartsOnly
+from ttt_sm.scenario.robots import ChartsOnly
 
 PARAMS = load_params(None)
 

@@ -35,7 +35,8 @@ from typing import Any
 from ..params import ArmParams
 from ..runtime import TickChart
 from .model import BareCharts, Scenario
-from .runner import ChartsOnly, run_scenario
+from .robots import ChartsOnly
+from .runner import run_scenario
 
 _NEGATED = {ast.Eq: ast.NotEq, ast.NotEq: ast.Eq, ast.Lt: ast.GtE, ast.GtE: ast.Lt, ast.Gt: ast.LtE, ast.LtE: ast.Gt}
 _TEXT_NEGATED = {"==": "!=", "!=": "==", "<=": ">", ">=": "<", "<": ">=", ">": "<="}

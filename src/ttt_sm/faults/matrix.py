@@ -69,7 +69,8 @@ from ..app.robot import Robot
 from ..arm import Arm
 from ..hardware.emulator import ArmEmulator
 from ..hardware.firmware import build
-from ..hardware.serial_arm import LinkTruth, SerialArm
+from ..hardware.link_truth import LinkTruth
+from ..hardware.serial_arm import SerialArm
 from ..params import ArmParams
 from ..runner import Runner, one_line, throughput
 from ..sched.scheduler import Signals

@@ -57,8 +57,8 @@ from ..twin import layout
 from ..twin.cascade import CascadeController
 from ..twin.gains import Gains, check_drive
 from ..twin.gains_cache import kept_gains
-from ..twin.kinematics import fk
 from . import link as L
+from .link_truth import LinkTruth
 
 LINK_TIMEOUT_S = 0.050
 """No valid status for this long while one is due: the link is lost."""
@@ -76,59 +76,6 @@ BAUD = 921_600
 
 
 M = TypeVar("M", bound=L.Message)
-
-
-class LinkTruth:
-    """Ground truth from an emulator (``EMU_TRUTH`` frames): the emulated plant's true joint angles.
-
-    Simulation only, for what exists in simulation alone (the PC's whiteboard
-    inked by the true pen, a drawing's precision); the charts never see it.
-    It offers what :class:`ttt_sm.twin.truth.ArmTruth` offers those parts:
-    :attr:`q`, :meth:`angles`, :meth:`tool_pose`, :attr:`offsets`, and
-    :attr:`speed_load` (from two frames in a row: the fault matrix's
-    ``time_to_safe_ms``).
-    """
-
-    def __init__(self, params: ArmParams, q: tuple[float, float, float, float], offsets: tuple[float, float, float],
-                 step: int) -> None:
-        self.params = params
-        self._q = q
-        self._offsets = offsets
-        #: The firmware step these angles are after.
-        self.step = step
-        self._speed = (0.0, 0.0, 0.0)
-
-    def update(self, q: tuple[float, float, float, float], step: int,
-               offsets: tuple[float, float, float] | None = None) -> None:
-        if step > self.step:
-            h = (step - self.step) * self.params.control.dt
-            p = self._q
-            self._speed = ((q[0] - p[0]) / h, (q[1] - p[1]) / h, (q[2] - p[2]) / h)
-        self._q, self.step = q, step
-        if offsets is not None:
-            self._offsets = offsets
-
-    @property
-    def q(self) -> np.ndarray:
-        """True joint angles q1..q4 (rad), a copy."""
-        return np.array(self._q)
-
-    def angles(self) -> tuple[float, float, float, float]:
-        return self._q
-
-    @property
-    def offsets(self) -> np.ndarray:
-        """The true encoder offsets (rad): an encoder angle plus these is the joint angle within half a count."""
-        return np.array(self._offsets)
-
-    def tool_pose(self) -> np.ndarray:
-        """The true tool pose x, y, z (m), phi (rad): forward kinematics of :attr:`q`."""
-        return fk(self.q, self.params.true_geometry)
-
-    @property
-    def speed_load(self) -> np.ndarray:
-        """True joint speeds of drives 1..3 (rad/s): the mean over the firmware steps between the last two frames."""
-        return np.array(self._speed)
 
 
 @dataclass(frozen=True)

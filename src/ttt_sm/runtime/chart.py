@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from array import array
 from collections import deque
-from collections.abc import Callable, Mapping, MutableSet, Sequence
+from collections.abc import Mapping, MutableSet, Sequence
 from functools import partial
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -44,6 +44,7 @@ from .data import KIND_ATTRS, PREVIOUS_SUFFIX, Data, buffers, check_values, coll
 from .engine import EarlyReturn, Execution
 from .errors import ChartDefinitionError, EventDataError, TemporalLogicError, UnknownEventError
 from .guards import Guard, compile_condition, compile_guard
+from .plan import Plan, Resume, plan_runner, previous_copier
 from .program import Node, Seg, build_program
 from .structure import (
     DURING_PREFIX,
@@ -63,68 +64,6 @@ RESERVED_EVENT_DATA = frozenset({"self", "event", "event_data", "machine", "mode
 _NO_PLAN = object()
 #: The key of the chart's own clock in ``_entered_at``: temporal logic on a junction outside every state.
 _CHART_CLOCK = "<chart>"
-#: Where a plan hands over to the interpreter: the states from the top down to the one whose
-#: transition held, the phase ("outer" or "inner") and the transition's place in that list.
-_Resume = tuple[tuple[Node, ...], str, int]
-
-
-class _Plan:
-    """What a quiet tick does in one configuration, as generated functions (see :func:`_plan_runner`)."""
-
-    __slots__ = ("active", "run", "run_tick", "resume")
-
-    def __init__(self, active: frozenset[str], run: Callable[[dict[str, Any]], int],
-                 run_tick: Callable[[dict[str, Any]], int], resume: Sequence[_Resume]) -> None:
-        self.active = active
-        self.run = run
-        self.run_tick = run_tick
-        self.resume = tuple(resume)
-
-
-def _plan_runner(steps: Sequence[tuple[str, Any]], prev_pairs: Sequence[tuple[str, str]] | None = None,
-                 slot_pairs: Sequence[tuple[int, int]] = ()) -> Callable[[dict[str, Any]], int]:
-    """A quiet wake-up of one configuration as straight-line code: the index of the first
-    transition whose guard holds, or -1 once every step ran.
-
-    ``steps`` are, in Stateflow's order, ``("guard", (k, fn))``: return ``k`` if
-    ``fn()`` holds (``fn`` None: always); ``("act", (node, fn))``: note the state
-    whose action runs (for an event it sends) and call ``fn()``.  A loop over the
-    steps costs about a third more, and it runs on every tick of every chart.
-
-    With ``prev_pairs`` the function first counts the tick and copies every output
-    to its previous value (the whole tick when no event is queued, in one call).
-    ``slot_pairs`` are the (output, previous) places of a buffered chart's outputs in
-    its buffer; ``prev_pairs`` then names only the outputs kept as plain attributes.
-    """
-    lines, bound = [], {}
-    if prev_pairs is not None:
-        lines.append("    d['_ticks'] += 1")
-        lines += _copy_lines(prev_pairs, slot_pairs)
-    acted = False
-    for n, (kind, item) in enumerate(steps):
-        if kind == "guard":
-            k, fn = item
-            if fn is None:
-                lines.append(f"    return {k}")
-                break
-            bound[f"g{n}"] = fn
-            lines += [f"    if g{n}():", f"        return {k}"]
-        else:
-            node, fn = item
-            bound[f"n{n}"], bound[f"a{n}"] = node, fn
-            lines += [f"    d['_cur'] = n{n}", f"    a{n}()"]
-            acted = True
-    else:
-        if acted:
-            lines.append("    d['_cur'] = None")
-        lines.append("    return -1")
-    args = ", ".join(["d"] + [f"{name}={name}" for name in bound])
-    namespace: dict[str, Any] = dict(bound)
-    exec(compile(f"def run_plan({args}):\n" + "\n".join(lines) + "\n", "<tick plan>", "exec"),  # noqa: S102
-         namespace)
-    return namespace["run_plan"]  # type: ignore[no-any-return]
-
-
 class TickChartMeta(StateMachineMetaclass):
     """Builds the library's chart, then tags tick transitions and reads data and structure."""
 
@@ -158,29 +97,7 @@ class TickChartMeta(StateMachineMetaclass):
         cls._slots = slots
         cls._slot_prev_pairs = tuple((slots[o], slots[p]) for o, p in cls._prev_pairs if o in slots)
         cls._dict_prev_pairs = tuple((o, p) for o, p in cls._prev_pairs if o not in slots)
-        cls._copy_previous = staticmethod(_previous_copier(name, cls._dict_prev_pairs, cls._slot_prev_pairs))
-
-
-def _copy_lines(pairs: Sequence[tuple[str, str]], slot_pairs: Sequence[tuple[int, int]]) -> list[str]:
-    """``X_p = X`` as lines of code: plain attributes by name, a buffered chart's numbers by place."""
-    lines = [f"    d[{prev!r}] = d[{out!r}]" for out, prev in pairs]
-    if slot_pairs:
-        lines.append("    b = d['_data_view']")
-        lines += [f"    b[{prev}] = b[{out}]" for out, prev in slot_pairs]
-    return lines
-
-
-def _previous_copier(name: str, pairs: tuple[tuple[str, str], ...],
-                     slot_pairs: tuple[tuple[int, int], ...] = ()) -> Callable[[dict[str, Any]], None]:
-    """``X_p = X`` for every output of a chart class, as straight-line code.
-
-    It runs at the start of every tick of every chart; a loop over the pairs
-    costs about a third more per output.  The names are checked identifiers.
-    """
-    body = "".join(line + "\n" for line in _copy_lines(pairs, slot_pairs)) or "    pass\n"
-    namespace: dict[str, Any] = {}
-    exec(compile("def copy_previous(d):\n" + body, f"<{name}.copy_previous>", "exec"), namespace)  # noqa: S102
-    return namespace["copy_previous"]  # type: ignore[no-any-return]
+        cls._copy_previous = staticmethod(previous_copier(name, cls._dict_prev_pairs, cls._slot_prev_pairs))
 
 
 def _check_during_names(cls: type, structure: ChartStructure) -> None:
@@ -258,9 +175,9 @@ class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChar
     _ticks: int
     _entered_at: dict[str, int]
     _queue: deque[tuple[str, dict[str, Any]]]
-    _plans: dict[Any, _Plan]
+    _plans: dict[Any, Plan]
     _plan_key: Any
-    _plan: _Plan | None
+    _plan: Plan | None
     _guards: dict[int, Guard | None]
     _taken: list[Transition]
 
@@ -391,7 +308,7 @@ class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChar
         taken = d["_taken"]
         return taken[0] if taken else None
 
-    def _resume(self, resume: _Resume) -> None:
+    def _resume(self, resume: Resume) -> None:
         """Go on with a wake-up where the plan found a transition whose guard holds."""
         chain, phase, index = resume
         d = self.__dict__
@@ -480,7 +397,7 @@ class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChar
         """Events posted and not yet handled, oldest first."""
         return [(e, dict(data)) for e, data in self._queue]
 
-    def _load_plan(self, raw: Any) -> _Plan:
+    def _load_plan(self, raw: Any) -> Plan:
         d = self.__dict__
         key = frozenset(raw) if isinstance(raw, MutableSet) else raw
         plan = d["_plans"].get(key)
@@ -491,11 +408,11 @@ class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChar
         d["_plan"] = plan
         return plan
 
-    def _build_plan(self) -> _Plan:
+    def _build_plan(self) -> Plan:
         """The quiet wake-up of the active configuration, in Stateflow's order (see :mod:`.engine`)."""
         active = self.__dict__["_active"]
         steps: list[tuple[str, Any]] = []
-        resume: list[_Resume] = []
+        resume: list[Resume] = []
         if self._program.has_durations:
             steps.append(("act", (None, self._sample_durations)))
 
@@ -533,8 +450,8 @@ class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChar
             if node.id in active:
                 walk((node,))
                 break
-        return _Plan(frozenset(active), _plan_runner(steps),
-                     _plan_runner(steps, self._dict_prev_pairs, self._slot_prev_pairs), resume)
+        return Plan(frozenset(active), plan_runner(steps),
+                     plan_runner(steps, self._dict_prev_pairs, self._slot_prev_pairs), resume)
 
     def _guard_of(self, seg: Seg) -> Guard | None:
         guards = self.__dict__["_guards"]

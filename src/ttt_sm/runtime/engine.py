@@ -43,13 +43,10 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
-from statemachine.callbacks import allways_true
-from statemachine.event import Event
-from statemachine.event_data import EventData, TriggerData
 from statemachine.orderedset import OrderedSet
 from statemachine.state import State
-from statemachine.transition import Transition
 
+from .callbacks import LibraryCallbacks, no_action
 from .errors import ChartExecutionError
 from .program import Node, Program, Seg
 
@@ -63,14 +60,7 @@ class EarlyReturn(Exception):
     """A local event made the state whose action sent it inactive: the rest of that step is skipped."""
 
 
-_Action = Callable[[Any], None]
-
-
-def _no_action(_ctx: Any) -> None:
-    return None
-
-
-class Execution:
+class Execution(LibraryCallbacks):
     """The Stateflow execution of a :class:`~.chart.TickChart` instance (a mixin of it).
 
     Instance data (all in ``__dict__``): ``_active`` (ids of the active states),
@@ -97,90 +87,6 @@ class Execution:
     def _duration_condition(self, node: Node, spec: Any) -> Callable[[], Any]:
         """A ``duration`` condition as a plain call; the chart compiles it."""
         raise NotImplementedError
-
-    # -- the library's callbacks ---------------------------------------------------------------
-
-    def _runner(self, key: str) -> _Action:
-        """What the library would call for a callback key, as one function of a context.
-
-        The chart's own methods that take no argument are called directly; anything
-        else (a listener's hook, a method asking for ``event_data``) gets the keyword
-        arguments the library passes, built once per call from the context
-        ``(transition, state, event)``.
-        """
-        runners = self.__dict__["_runners"]
-        run = runners.get(key)
-        if run is not None:
-            return run  # type: ignore[no-any-return]
-        if key not in self._callbacks:
-            runners[key] = _no_action
-            return _no_action
-        mine = f"@{id(self)}"
-        calls: list[tuple[bool, Any]] = []
-        for wrapper in self._callbacks[key]:
-            fast = None
-            name, _, owner = wrapper.unique_key.rpartition("@")
-            if wrapper.condition is allways_true and f"@{owner}" == mine and wrapper.expected_value is None:
-                bound = getattr(self, name, None)
-                if callable(bound) and _takes_no_arguments(bound):
-                    fast = bound
-            calls.append((True, fast) if fast is not None else (False, wrapper))
-        if all(fast for fast, _ in calls):
-            fns = tuple(fn for _, fn in calls)
-            if len(fns) == 1:
-                only = fns[0]
-
-                def run_one(_ctx: Any) -> None:
-                    only()
-
-                run = run_one
-            else:
-                def run_all(_ctx: Any) -> None:
-                    for fn in fns:
-                        fn()
-
-                run = run_all
-        else:
-            def run_mixed(ctx: Any) -> None:
-                kwargs = None
-                for fast_call, item in calls:
-                    if fast_call:
-                        item()
-                    else:
-                        if kwargs is None:
-                            kwargs = self._kwargs(ctx)
-                        if item.condition(**kwargs):
-                            item.call(**kwargs)
-
-            run = run_mixed
-        runners[key] = run
-        return run
-
-    def _kwargs(self, ctx: tuple[Transition | None, State | None, Any]) -> dict[str, Any]:
-        """The keyword arguments python-statemachine gives a callback, for a context."""
-        transition, state, event = ctx[:3]
-        role = ctx[3] if len(ctx) > 3 else None
-        d = self.__dict__
-        if isinstance(event, str):
-            event = self._program.events.get(event) or Event(event)
-        trigger = TriggerData(machine=self, event=event, kwargs=dict(d["_event_kwargs"]))  # type: ignore[arg-type]
-        if transition is None:
-            transition = _NO_TRANSITION
-        data = EventData(trigger_data=trigger, transition=transition)
-        # as the library does: an entered state is also the `target`, an exited one the `source`
-        if state is not None:
-            data.state = state
-            if role == "enter":
-                data.target = state
-            elif role == "exit":
-                data.source = state
-        return data.extended_kwargs
-
-    def _forget_runners(self) -> None:
-        """Listeners changed: callbacks are looked up again (and the tick plans rebuilt)."""
-        self.__dict__["_runners"].clear()
-        self.__dict__["_plans"].clear()
-        self.__dict__["_plan_key"] = object()
 
     # -- activation ----------------------------------------------------------------------------
 
@@ -328,7 +234,7 @@ class Execution:
     def _condition_action(self, node: Node | None, seg: Seg) -> None:
         key = seg.transition.before.key
         run = self._runner(key)
-        if run is _no_action:
+        if run is no_action:
             return
         frames = self.__dict__["_frames"]
         frames.append(("condition", node, None))
@@ -369,7 +275,7 @@ class Execution:
         frames = self.__dict__["_frames"]
         for seg in path:
             run = self._runner(seg.transition.on.key)
-            if run is _no_action:
+            if run is no_action:
                 continue
             frames.append(("transition", path[0].source, path))
             try:
@@ -434,7 +340,7 @@ class Execution:
         for seg in path:
             taken.append(seg.transition)
             run = self._runner(seg.transition.after.key)
-            if run is not _no_action:
+            if run is not no_action:
                 run((seg.transition, seg.transition.target, self._event_object(seg)))
 
     # -- entering and exiting -----------------------------------------------------------------------
@@ -453,7 +359,7 @@ class Execution:
             else:
                 d["_since"].pop((node.id, spec), None)
         run = self._runner(node.state.enter.key)
-        if run is not _no_action:
+        if run is not no_action:
             d["_frames"].append(("entry", node, None))
             try:
                 run((path[-1].transition if path else None, node.state,
@@ -518,7 +424,7 @@ class Execution:
                 if child.id in active:
                     self._exit(child, path)
         run = self._runner(node.state.exit.key)
-        if run is not _no_action:
+        if run is not no_action:
             d["_frames"].append(("exit", node, None))
             try:
                 run((path[0].transition if path else None, node.state,
@@ -629,29 +535,7 @@ class Execution:
         return seg.info.tick_event or event
 
 
-class _NoTransition:
-    """Stands for the transition in the callbacks of an entry or exit that belongs to none (activation)."""
-
-    source = target = None
-    internal = False
-
-    def __repr__(self) -> str:
-        return "(no transition)"
-
-
-_NO_TRANSITION: Any = _NoTransition()
 _UNSET = object()
-
-
-def _takes_no_arguments(fn: Callable[..., Any]) -> bool:
-    import inspect
-
-    try:
-        params = inspect.signature(fn).parameters.values()
-    except (TypeError, ValueError):
-        return False
-    # a parameter, even with a default, may be one the library fills (an event's data, `state`)
-    return not params
 
 
 def _by_index(node: Node) -> int:

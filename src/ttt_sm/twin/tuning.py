@@ -18,6 +18,7 @@ gains here), so the two import one way.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
@@ -202,50 +203,55 @@ def _margins(loop: ct.StateSpace) -> tuple[float, float, float, float, float]:
     return float(pm), float(gm_db), float(wgc) * hz, float(wpc) * hz, wc * hz
 
 
-def _design_inner(params: ArmParams, drive: int) -> tuple[float, float]:
-    """Speed PI (kp, ki): the highest crossover <= the target that keeps the margins."""
-    dt = params.control.dt
-    pd = ct.c2d(drive_plant(params, drive, compliant=True), dt, "zoh")
-    g = ct.series(ct.ss(ct.tf([1.0], [1.0, 0.0], dt)), pd, speed_estimator(params))
+def _highest_crossover_pi(g: ct.StateSpace, dt: float, target_hz: float,
+                          ratios: Sequence[float | None]) -> tuple[float, float] | None:
+    """The PI (kp, ki) around `g` with the highest crossover <= `target_hz` that keeps the margins.
+
+    From the target down by :data:`CROSSOVER_STEP` to 5 % of it, each of
+    `ratios` (integral corner = crossover / ratio; None: no integral) in turn;
+    the gain puts the open loop's magnitude at 1 at the crossover.  None when
+    no crossover down there keeps the margins.
+    """
     omega = _freq_grid(dt)
-    f = params.control.inner_crossover_hz
-    while f > 0.05 * params.control.inner_crossover_hz:
+    f = target_hz
+    while f > 0.05 * target_hz:
         w = 2 * math.pi * f
         zc = np.exp(1j * w * dt)
         g_c = _response(g, np.array([w]))[0]
-        for ratio in INNER_PI_RATIOS:
-            wi = w / ratio
+        for ratio in ratios:
+            wi = 0.0 if ratio is None else w / ratio
             shape = 1.0 + wi * dt * zc / (zc - 1.0)
             kp = 1.0 / abs(shape * g_c)
             pm, gm, _ = _quick_margins(ct.series(g, _pi(kp, kp * wi, dt)), omega)
             if pm >= MIN_PHASE_MARGIN_DEG and gm >= MIN_GAIN_MARGIN_DB:
                 return float(kp), float(kp * wi)
         f *= CROSSOVER_STEP
-    raise TuningError(f"{params.source}: drive {drive}: no speed PI keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
-                      f"{MIN_GAIN_MARGIN_DB:g} dB down to 5 % of inner_crossover_hz; check [drive.{drive}] "
-                      "(gear stiffness and damping, inertias) and [control] speed_filter_hz")
+    return None
+
+
+def _design_inner(params: ArmParams, drive: int) -> tuple[float, float]:
+    """Speed PI (kp, ki): the highest crossover <= the target that keeps the margins."""
+    dt = params.control.dt
+    pd = ct.c2d(drive_plant(params, drive, compliant=True), dt, "zoh")
+    g = ct.series(ct.ss(ct.tf([1.0], [1.0, 0.0], dt)), pd, speed_estimator(params))
+    gains = _highest_crossover_pi(g, dt, params.control.inner_crossover_hz, INNER_PI_RATIOS)
+    if gains is None:
+        raise TuningError(f"{params.source}: drive {drive}: no speed PI keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
+                          f"{MIN_GAIN_MARGIN_DB:g} dB down to 5 % of inner_crossover_hz; check [drive.{drive}] "
+                          "(gear stiffness and damping, inertias) and [control] speed_filter_hz")
+    return gains
 
 
 def _design_outer(params: ArmParams, drive: int, kp_w: float, ki_w: float) -> tuple[float, float]:
     """Position P (or PI, see OUTER_PI_RATIO) with the inner loop closed, same rule as the inner loop."""
-    dt = params.control.dt
     trial = DriveGains(1.0, 0.0, 0.0, 0.0, 0.0, kp_w, ki_w, 0.0, 0, 0, 0, 0, 0, 0)
     _, t_q = loop_models(params, drive, trial)  # with kp_pos = 1, ki_pos = 0: just the plant
-    omega = _freq_grid(dt)
-    f = params.control.outer_crossover_hz
-    while f > 0.05 * params.control.outer_crossover_hz:
-        w = 2 * math.pi * f
-        zc = np.exp(1j * w * dt)
-        wi = 0.0 if OUTER_PI_RATIO is None else w / OUTER_PI_RATIO
-        shape = 1.0 + wi * dt * zc / (zc - 1.0)
-        kp = 1.0 / abs(shape * _response(t_q, np.array([w]))[0])
-        pm, gm, _ = _quick_margins(ct.series(t_q, _pi(kp, kp * wi, dt)), omega)
-        if pm >= MIN_PHASE_MARGIN_DEG and gm >= MIN_GAIN_MARGIN_DB:
-            return float(kp), float(kp * wi)
-        f *= CROSSOVER_STEP
-    raise TuningError(f"{params.source}: drive {drive}: no position gain keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
-                      f"{MIN_GAIN_MARGIN_DB:g} dB down to 5 % of outer_crossover_hz; lower "
-                      "[control] outer_crossover_hz below the speed loop's crossover")
+    gains = _highest_crossover_pi(t_q, params.control.dt, params.control.outer_crossover_hz, (OUTER_PI_RATIO,))
+    if gains is None:
+        raise TuningError(f"{params.source}: drive {drive}: no position gain keeps {MIN_PHASE_MARGIN_DEG:g} deg / "
+                          f"{MIN_GAIN_MARGIN_DB:g} dB down to 5 % of outer_crossover_hz; lower "
+                          "[control] outer_crossover_hz below the speed loop's crossover")
+    return gains
 
 
 #: A drive's margins before they are measured (:func:`_with_margins` fills them in).

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..params import ArmParams
-from ..twin.kinematics import fk, jacobian
+from ..twin.kinematics import arm_points, fk, jacobian
 from ..twin.kinematics.dh import DH_COLUMNS, dh_frames, dh_table
 from ..twin.kinematics.race import race
 from ..twin.kinematics.solver import HOME_Q
@@ -89,7 +89,8 @@ def dh_view(params: ArmParams, query: Mapping[str, str]) -> dict[str, Any]:
             "q_rad": [float(v) for v in q],
             "frames": [{"origin_m": [float(v) for v in f[:3, 3]],
                         "axes": [[float(v) for v in f[:3, k]] for k in range(3)]} for f in frames],
-            "fk": [float(v) for v in fk(q, g)]}
+            "fk": [float(v) for v in fk(q, g)],
+            "arm_m": [[float(v) for v in p] for p in arm_points(q, g)]}
 
 
 def race_view(params: ArmParams, query: Mapping[str, str]) -> dict[str, Any]:
@@ -112,6 +113,7 @@ def race_view(params: ArmParams, query: Mapping[str, str]) -> dict[str, Any]:
                     "iterations": len(r.iterates) - 1, "seconds": r.seconds,
                     "errors_m": [e if math.isfinite(e) else None for e in r.errors],
                     "tips_m": [[float(v) for v in fk(q, g)[:3]] for q in finite],
+                    "arm_m": [[float(v) for v in p] for p in arm_points(finite[-1], g)] if finite else None,
                     "q_rad": [float(v) for v in r.q] if np.isfinite(r.q).all() else None,
                     "min_abs_det": min((abs(d) for d in dets), default=None)})
     return {"target": [float(v) for v in target], "max_iterations": n, "methods": out}

@@ -45,7 +45,8 @@ def main() -> int:
             n = page.evaluate("window.kinematics.redraws.length")
             page.eval_on_selector(f"[data-role={role}]",
                                   "(el, v) => { el.value = v; el.dispatchEvent(new Event('input')); }", value)
-            page.wait_for_function(f"window.kinematics.redraws.length > {n}", timeout=30_000)
+            page.wait_for_function(f"window.kinematics.redraws.length > {n} && window.kinematics.idle()",
+                                   timeout=30_000)
         times = np.array(page.evaluate(f"window.kinematics.redraws.slice({base})"))
         result = {"moves": len(times), "redraw_ms_p50": round(float(np.percentile(times, 50)), 1),
                   "redraw_ms_p95": round(float(np.percentile(times, 95)), 1),

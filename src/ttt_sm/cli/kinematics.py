@@ -11,6 +11,7 @@ Other modules add subcommands to the group through :data:`ACTIONS_HOOKS`
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Callable
 from typing import Any
@@ -128,6 +129,9 @@ def _run(view: str) -> Callable[[argparse.Namespace], int]:
         from ..twin.workspace import load_arm
         from ..web.kinematics import VIEWS, KinematicsQueryError
 
+        if args.png is not None and (not args.png.lower().endswith(".png") or os.path.isdir(args.png)):
+            print(f"ttt-sm kinematics {view}: error: --png must name a .png file, got {args.png!r}", file=sys.stderr)
+            return 2
         params = load_arm(args.params)
         try:
             data = VIEWS[view](params, _query(view, args))
@@ -150,7 +154,8 @@ def _option_names(message: str) -> str:
     """A query key in a message as the CLI's option (``q2_max_deg`` -> ``--q2-max-deg``)."""
     for key, opt in (("q2_max_deg", "--q2-max-deg"), ("q3_max_deg", "--q3-max-deg"), ("cell_m", "--cell-m"),
                      ("max_iterations", "--max-iterations"), ("phi_deg", "--phi-deg"), ("cells", "--cells"),
-                     ("L2", "--L2"), ("L3", "--L3")):
+                     ("L2", "--L2"), ("L3", "--L3"), ("q_deg", "--q-deg"), ("x", "--target X"), ("y", "--target Y"),
+                     ("z", "--z"), ("tool", "--tool")):
         if message.startswith(key + " "):
             return opt + message[len(key):]
     return message
@@ -247,5 +252,5 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
         ax2.set_title("pen tip per iteration, top view")
         ax2.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
+    fig.savefig(path, dpi=90, format="png")
     plt.close(fig)

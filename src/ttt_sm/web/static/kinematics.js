@@ -115,6 +115,7 @@ function rect(ctx, f, [x0, x1, y0, y1], colour, width) {
 // ---- workspace
 let wsPending = null, wsBusy = false, topMap = null, lastWs = null;
 const packaged = {};
+stats.idle = () => !wsBusy && wsPending === null;
 
 function wsParams() {
   return { tool: role("tool").value, L2: role("L2").value, q2_max_deg: role("q2max").value,

@@ -216,9 +216,18 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
         for k, (colour, name) in enumerate((("#d62728", "x"), ("#2ca02c", "y"), ("#1f77b4", "z"))):
             for i, f in enumerate(data["frames"]):
                 o, a = f["origin_m"], f["axes"][k]
-                ax.quiver(*o, *(0.05 * v for v in a), color=colour, label=f"{name} axis" if i == 0 else None)
+                ax.quiver(*o, *(0.04 * v for v in a), color=colour, label=f"{name} axis" if i == 0 else None)
         for i, o in enumerate(origins):
             ax.text(*o, f" {i}", fontsize=9)
+        lows = [min(o[k] for o in origins) - 0.05 for k in range(3)]
+        highs = [max(o[k] for o in origins) + 0.05 for k in range(3)]
+        ax.set_xlim(lows[0], highs[0])
+        ax.set_ylim(lows[1], highs[1])
+        ax.set_zlim(lows[2], highs[2])
+        ax.set_box_aspect([h - lo for lo, h in zip(lows, highs, strict=True)])
+        from matplotlib.ticker import MaxNLocator
+
+        ax.xaxis.set_major_locator(MaxNLocator(3))
         ax.set_xlabel("x (m)")
         ax.set_ylabel("y (m)")
         ax.set_zlabel("z (m)")
@@ -228,7 +237,9 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
         tab.axis("off")
         rows = [[str(i + 1)] + [f"{v:.4f}" for v in r] for i, r in enumerate(data["rows"])]
         tb = tab.table(cellText=rows, colLabels=["link", "theta offset (rad)", "d (m)", "a (m)", "alpha (rad)"],
-                       loc="center")
+                       colWidths=[0.1, 0.3, 0.2, 0.2, 0.2], loc="center")
+        tb.auto_set_font_size(False)
+        tb.set_fontsize(10)
         tb.scale(1, 1.6)
         tab.set_title("DH table (theta_i = q_i + offset)")
     else:

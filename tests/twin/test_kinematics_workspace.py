@@ -9,8 +9,18 @@ import pytest
 
 from ttt_sm.params import load_params
 from ttt_sm.twin.kinematics import UnreachableTargetError, ik_closed_form
-from ttt_sm.twin.kinematics.workspace import (BOTH, DOWN_ONLY, UNREACHABLE, UP_ONLY, classify, field_cells,
-                                              solve_grid, with_lengths, workspace)
+from ttt_sm.twin.kinematics.workspace import (
+    BOTH,
+    DOWN_ONLY,
+    UNREACHABLE,
+    UP_ONLY,
+    classify,
+    field_cells,
+    solve_grid,
+    solve_point,
+    with_lengths,
+    workspace,
+)
 
 P = load_params()
 
@@ -41,6 +51,23 @@ def test_the_grid_solution_is_the_closed_form_point_by_point() -> None:
                 solved += 1
                 assert np.allclose(qg, ref, atol=1e-12)
     assert solved > 300  # the sample holds reachable and unreachable points both
+
+
+def test_the_plain_float_closed_form_is_the_closed_form() -> None:
+    rng = np.random.default_rng(5)
+    g = P.geometry
+    for p in rng.uniform([-0.45, -0.45, -0.1, -1.0], [0.45, 0.45, 0.4, 1.0], size=(300, 4)):
+        for up in (True, False):
+            got = solve_point(*p, g, up)
+            try:
+                ref = ik_closed_form(p, g, elbow_up=up)
+            except UnreachableTargetError:
+                assert got is None
+                continue
+            assert got is not None
+            diff = np.array(got) - ref
+            diff[0] = math.remainder(diff[0], 2 * math.pi)
+            assert np.allclose(diff, 0.0, atol=1e-12)
 
 
 def test_a_code_is_the_closed_form_within_the_limits() -> None:

@@ -1,4 +1,6 @@
-"""The ``/kinematics`` page's JSON: the workspace, the DH table with its frames, the IK race (docs/kinematics.md, "Lab").
+"""The ``/kinematics`` page's JSON: the workspace, the DH table and its frames, the IK race.
+
+docs/kinematics.md, "Lab", describes the views.
 
 Each view is a plain function of the parameters and a query (``dict`` of
 strings, as the URL gives it) returning JSON-ready data; ``ttt-sm

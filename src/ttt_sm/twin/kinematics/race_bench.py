@@ -23,10 +23,10 @@ from .race import THESIS_LAMBDA, THESIS_TOLERANCE, race
 from .workspace import solve_point, workspace
 
 
-def _per_call_us(fn: Any, repeat: int) -> float:
+def _per_call_us(fn: Any, args: tuple[Any, ...], repeat: int, **kw: Any) -> float:
     t0 = time.perf_counter_ns()
     for _ in range(repeat):
-        fn()
+        fn(*args, **kw)
     return (time.perf_counter_ns() - t0) / repeat / 1000.0
 
 
@@ -44,12 +44,12 @@ def bench_ik_race(params: ArmParams, targets: int = 50, repeat: int = 200, seed:
     for t in pts:
         q_near = ik_closed_form(t + [0.001, 0.0, 0.0, 0.0], g)
         x, y, z, phi = (float(v) for v in t)
-        out["analytic"].append(_per_call_us(lambda: solve_point(x, y, z, phi, g, True), repeat))
-        out["closed_form"].append(_per_call_us(lambda: ik_closed_form(t, g), repeat))
-        out["lm_fixed"].append(_per_call_us(lambda: damped_least_squares(t, q_near, g, thesis, adaptive=False),
-                                            repeat // 4))
-        out["dls_adaptive"].append(_per_call_us(lambda: damped_least_squares(t, q_near, g, adaptive, adaptive=True),
-                                                repeat // 4))
+        out["analytic"].append(_per_call_us(solve_point, (x, y, z, phi, g, True), repeat))
+        out["closed_form"].append(_per_call_us(ik_closed_form, (t, g), repeat))
+        out["lm_fixed"].append(_per_call_us(damped_least_squares, (t, q_near, g, thesis), repeat // 4,
+                                            adaptive=False))
+        out["dls_adaptive"].append(_per_call_us(damped_least_squares, (t, q_near, g, adaptive), repeat // 4,
+                                                adaptive=True))
     twist = []
     for t in pts[:10]:
         q_near = ik_closed_form(t + [0.001, 0.0, 0.0, 0.0], g)

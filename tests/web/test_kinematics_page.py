@@ -16,6 +16,7 @@ from starlette.testclient import TestClient
 from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params
 from ttt_sm.twin.kinematics import fk
+from ttt_sm.web.access import allowed_hosts
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
 
@@ -99,6 +100,16 @@ def test_a_bad_query_is_a_400_naming_the_key(api: TestClient, view: str, query: 
     r = api.get(f"/api/kinematics/{view}", params=query)
     assert r.status_code == 400 and named in r.json()["error"] and "\n" not in r.json()["error"]
     assert api.get("/api/kinematics/nothing").status_code == 404
+
+
+def test_the_page_and_its_routes_want_the_token(kin_session: Session) -> None:
+    app = create_app(kin_session, token="s3cret", hosts=allowed_hosts("127.0.0.1", 8765), manage_session=False)
+    with TestClient(app, base_url="http://127.0.0.1:8765") as c:
+        for path in ("/kinematics", "/api/kinematics/workspace", "/api/kinematics/race?x=0&y=0.25"):
+            assert c.get(path).status_code == 403, path
+        assert c.get("/static/kinematics.js").status_code == 200
+        assert c.get("/kinematics?token=s3cret").status_code == 200
+        assert c.get("/api/kinematics/dh").status_code == 200  # the cookie now
 
 
 @pytest.fixture(scope="module")

@@ -196,6 +196,20 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     cases.append((["ai", "move", "--board", "XXXXX", "--symbol", "X"], "--board"))
     cases.append((["ai", "move", "--board", "." * 25, "--symbol", "Q"], "--symbol"))
     cases.append((["ai", "move", "--board", "." * 25, "--engine", "nope"], "--engine"))
+    kin_ws = ["kinematics", "workspace"]
+    for option in ("--L2", "--L3", "--q2-max-deg", "--q3-max-deg", "--cell-m"):
+        numbers(kin_ws, option, ("abc", "nan", "inf", "1e9"))
+    numbers(kin_ws, "--cells", ("abc", "0", "99"))
+    cases.append(([*kin_ws, "--tool", "brush"], "--tool"))
+    out_dirs([*kin_ws, "--png"], None)
+    cases.append(([*kin_ws, "--png", "/"], "--png"))
+    cases.append(([*kin_ws, "--png", "picture.jpg"], "--png"))
+    cases.append((["kinematics", "dh", "--q-deg", "0", "0", "0", "nan"], "--q-deg"))
+    kin_race = ["kinematics", "race", "--target", "0.07", "0.3"]
+    cases.append((["kinematics", "race", "--target", "abc", "0.3"], "--target"))
+    cases.append((["kinematics", "race", "--target", "nan", "0.3"], "--target"))
+    numbers(kin_race, "--max-iterations", ("abc", "0", "1e9"))
+    numbers(kin_race, "--phi-deg", ("nan", "1e9"))
     cases.append((["no-such-command"], "no-such-command"))
     return cases
 

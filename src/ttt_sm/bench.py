@@ -90,6 +90,13 @@ def bench_ik_section(params: ArmParams, seed: int = 0) -> dict[str, Any]:
     return bench_ik(params, seed=seed)
 
 
+def bench_ik_race_section(params: ArmParams, seed: int = 0, quick: bool = False) -> dict[str, Any]:
+    """Time per solve of the IK race's methods (see twin/kinematics/race_bench.py)."""
+    from .twin.kinematics.race_bench import bench_ik_race
+
+    return bench_ik_race(params, targets=10 if quick else 50, seed=seed)
+
+
 def bench_steps(params: ArmParams, out_dir: Path) -> dict[str, Any]:
     """Step responses of the three drives on the nonlinear plant (as `ttt-sm tune`)."""
     from .twin.step_response import tune_report
@@ -237,6 +244,7 @@ def bench_link_section(params: ArmParams, seconds: float, seed: int = 0) -> dict
 SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "steps": lambda p, a: bench_steps(p, a["out"]),
     "ik": lambda p, a: bench_ik_section(p, a["seed"]),
+    "ik_race": lambda p, a: bench_ik_race_section(p, a["seed"], a["quick"]),
     "loop": lambda p, a: bench_loop(p, a["loop_seconds"], a["seed"]),
     "pacing": lambda p, a: bench_pacing(p, a["pacing_seconds"], a["seed"]),
     "charts": lambda p, a: bench_charts(p),

@@ -20,7 +20,7 @@ strict JSON output); each other module adds its subcommands with a
 - :mod:`.sweeps`: init and faults (many runs on a pool or a cluster);
 - :mod:`.precision`: precision (the thesis' staircase of section 3.5);
 - :mod:`.scenario`, :mod:`.debug`, :mod:`.gui`, :mod:`.camera`, :mod:`.arm`, :mod:`.vision`, :mod:`.ai`,
-  :mod:`.lab`: the command of that name (:mod:`.lab` also the global ``--chart``).
+  :mod:`.lab`, :mod:`.kinematics`: the command of that name (:mod:`.lab` also the global ``--chart``).
 
 (Regenerating the repository's generated files is a development tool, ``make docs``
 (``python -m tools.docs``), not a command of the installed package.)
@@ -41,11 +41,11 @@ from collections.abc import Sequence
 from ..files import ADVICE as WRITE_ADVICE
 from ..params import shown_path
 from ..runtime.recordfile import interruption
-from . import ai, arm, camera, commands, debug, gui, lab, precision, scenario, sweeps, vision
+from . import ai, arm, camera, commands, debug, gui, kinematics, lab, precision, scenario, sweeps, vision
 from .common import join_negative_values, terminate_interrupts
 
 #: The subcommand modules, in the order of ``ttt-sm --help``.
-SUBCOMMANDS = (commands, sweeps, precision, scenario, debug, gui, camera, arm, vision, ai, lab)
+SUBCOMMANDS = (commands, sweeps, precision, scenario, debug, gui, camera, arm, vision, ai, lab, kinematics)
 
 
 def build_parser() -> argparse.ArgumentParser:

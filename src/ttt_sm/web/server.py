@@ -11,6 +11,7 @@ Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
 ``/api/arm/ink.png`` (the whiteboard's ink under the arm's top view, :mod:`.arm_view`),
 ``/api/camera/frame.png`` (the newest picture of ``--camera``, :mod:`.camera_feed`),
 ``/operate`` (the Operational page, :mod:`.operate`),
+``/kinematics`` and ``/api/kinematics/<view>`` (the kinematics lab: workspace, DH table, IK race, :mod:`.kinematics`),
 ``/lab`` and ``/api/lab`` (with ``ttt-sm gui --lab``: the student's chart live while they write it, :mod:`.lab_watch`),
 ``/static/...`` (the pages' scripts and styles, from the package: nothing from
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
@@ -59,6 +60,7 @@ from .arm_view import ink_picture, png
 from .camera_feed import feed_png
 from .diagrams import DiagramError, Diagrams
 from .game import photo_png
+from .kinematics import routes as kinematics_routes
 from .lab_watch import LabWatch
 from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
 from .session import Session
@@ -174,6 +176,9 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
 
     async def operate(request: Request) -> Response:
         return page("operate.html")
+
+    async def kinematics_page(request: Request) -> Response:
+        return page("kinematics.html")
 
     async def lab_page(request: Request) -> Response:
         if lab is None:
@@ -373,6 +378,8 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         Route("/api/camera/frame.png", camera_frame),
         Route("/operate", operate),
         Route("/lab", lab_page),
+        Route("/kinematics", kinematics_page),
+        *kinematics_routes(lambda: session.params),
         Route("/api/lab", lab_state),
         Route("/api/diagram/{chart}", diagram),
         Route("/api/trace.jsonl", trace),

@@ -39,6 +39,7 @@ import contextlib
 import gc
 import itertools
 import logging
+import os
 import queue
 import threading
 import time
@@ -63,6 +64,13 @@ from .operate import Operate
 from .protocol import Command
 
 log = logging.getLogger(__name__)
+
+#: A test-only fault hook (docs/gui.md, "When the session dies"): with this environment variable set to a
+#: command type, the simulation thread raises when it takes a command of that type, outside the handling
+#: that keeps a command's failure from ending the thread, as a bug of the session's own loop would.  The
+#: process-level test of ``ttt-sm gui``'s exit status uses it; nobody else should.
+FAULT_ENV = "TTT_SM_TEST_SESSION_FAULT"
+_FAULT_ON = os.environ.get(FAULT_ENV) or None
 
 #: Frames a second at most, to every page.
 FRAME_HZ = 30.0
@@ -524,6 +532,8 @@ class Session:
                     return
                 if item is None:
                     return
+                if item[1].type == _FAULT_ON:
+                    raise RuntimeError(f"{FAULT_ENV}={_FAULT_ON}: the test's fault in the simulation thread")
                 self._handle(*item)
                 if self.mode == "running" and time.perf_counter() - started > budget and not self._queue.empty():
                     self._wake = True  # the rest after a stretch of the run

@@ -182,6 +182,7 @@ class Session:
         self.chart_classes = {name: type(c) for name, c in robot.charts.items()}
         self.info["scenarios"] = list(scenarios or {})
         self.info["arm"] = arm_scene(self.params)
+        self._info_text: str | None = None  # the ``session`` message, once a page has joined
         self.trace_path = trace_path
         self.clock = PacedClock(self.params.control.dt, speed)
         self.speed = speed
@@ -420,7 +421,9 @@ class Session:
             client = self._clients.get(cid)
             if client is None:
                 return
-        self.send_to(cid, {"type": "session", "info": self.info})
+        if self._info_text is None:  # what the session runs does not change: serialized once, not per hello
+            self._info_text = dumps(jsonable({"type": "session", "info": self.info}))
+        client.send(self._info_text)
         self.send_to(cid, self.frames.frame(True, self._status()))
         if self.coverage.shown is not None:
             self.send_to(cid, {"type": "coverage", **self.coverage.shown})

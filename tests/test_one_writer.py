@@ -11,14 +11,13 @@ two ``ttt-sm gui``, under ``soak`` (two cockpits' start).
 
 from __future__ import annotations
 
-import re
-import signal
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+from gui_process import child_env, running_gui
 from ttt_sm.runtime.recordfile import read_lines
 
 #: A process that writes a record and holds it until its standard input closes.
@@ -63,29 +62,17 @@ def test_a_record_being_written_refuses_a_second_writer_in_one_line(tmp_path: Pa
 @pytest.mark.soak
 def test_a_second_gui_on_the_same_trace_is_refused_in_one_line(tmp_path: Path) -> None:
     trace = tmp_path / "out" / "gui" / "trace.jsonl"
-    first = subprocess.Popen([sys.executable, "-m", "ttt_sm.cli", "gui", "--port", "0", "--speed", "max",
-                              "--trace", str(trace)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        assert first.stdout is not None
-        for _ in range(20):  # the address is printed once the robot is built and the trace open
-            line = first.stdout.readline()
-            if re.search(r"http://\S+/charts", line) or not line:
-                break
-        assert first.poll() is None and trace.is_file(), "the first cockpit did not start"
+    with running_gui("--speed", "max", "--trace", str(trace)) as first:  # the address: robot built, trace open
+        assert first.proc.poll() is None and trace.is_file(), "the first cockpit did not start"
         second = subprocess.run([sys.executable, "-m", "ttt_sm.cli", "gui", "--port", "0", "--trace", str(trace)],
-                                capture_output=True, text=True, timeout=120)
+                                capture_output=True, text=True, timeout=120, env=child_env())
         assert second.returncode == 2, second.stderr
         assert second.stderr.splitlines() == [
             f"ttt-sm gui: error: --trace {trace} is being written by another ttt-sm process now: give this run"
             " another file (or folder), or stop the other one first"], second.stderr
         assert second.stdout == ""
-        first.send_signal(signal.SIGINT)
-        _, err = first.communicate(timeout=60)
-    finally:
-        if first.poll() is None:
-            first.kill()
-            first.wait()
-    assert first.returncode == 0, err[-2000:]
+        status, err = first.stop()
+    assert status == 0, err[-2000:]
     lines = read_lines(trace)  # every line parses: nobody else wrote into it
     assert lines[0]["event"] == "trace" and lines[-1]["event"] == "interrupted"
     assert sum(1 for e in lines if e.get("event") == "trace") == 1

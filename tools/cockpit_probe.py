@@ -146,7 +146,10 @@ async def _flood(host: str, token: str, messages: list[str], rate: float | None,
             if m.get("id") == "end":
                 answers["end"] += 1
                 continue
-            if kind == "error":
+            if kind == "error" and "dropped" in m:  # one notice a window for the messages dropped unread
+                answers["dropped unread: messages"] += int(m["dropped"])
+                kind = "dropped unread: notices"
+            elif kind == "error":
                 kind = "refused: page queue full" if "commands waiting" in m["error"] else "error: " + m["error"][:60]
             answers[kind] += 1
 

@@ -83,6 +83,8 @@ def test_the_strong_engine_does_not_lose_and_the_board_is_erased(serial_game):
     session, report, _ = serial_game
     assert report["winner"] in ("robot", "draw")
     assert report["erased"] is True and session.robot.board.ink_area_mm2() == 0.0
+    # the thesis' two rules (docs/thesis_map.md, section 3.6.1): a full board erases at once, a won game at its end
+    assert report["erase_cause"] == ("full board" if len(report["moves"]) == 25 else "game over")
     assert "finished" in session.robot.active("Control")
     # the robot drew every move it announced, in the cells it chose, with its own symbol
     robot_cells = [(m["row"], m["column"]) for m in report["moves"] if m["by"] == "robot"]

@@ -81,3 +81,15 @@ def test_bad_time_options_are_one_line_before_anything_runs(capsys, argv, messag
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1
+
+
+def test_a_replay_is_bounded_by_its_work_from_power_on_as_one_commands_run_is(params: ArmParams):
+    dbg = Debugger.build(params, seed=0, max_run_s=0.05)
+    dbg.run(0.05)
+    dbg.run(0.05)  # two commands: 0.1 s simulated, 50 chart ticks
+    with pytest.raises(DebugError, match=re.escape(
+            "replay: it would run 0.079 s of simulated time again from power-on (to control step 79), beyond the"
+            " 0.05 s one command runs (start the debugger with --max-run SECONDS to allow more)")):
+        dbg.replay(40)
+    assert dbg.robot.steps == 100  # refused before the robot was rebuilt
+    assert dbg.replay(25).tick == 25  # 0.05 s: within the bound

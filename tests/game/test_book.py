@@ -103,3 +103,37 @@ def test_more_entries_re_prove_from_scratch(book):
     solver = Solver(max_entries=5_000_000)
     for key, (cell, outcome) in sample(book, per_level=60, seed=2, levels=range(0, book.line_stones + 1)):
         assert holds(solver, key, cell, outcome), (bin(key), cell, outcome)
+
+
+def test_an_unwritable_book_is_said_in_one_line_before_the_solving(tmp_path, capsys):
+    from ttt_sm.game import book
+
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    assert book.main(["--max-stones", "0", "--line-stones", "0", "--out", str(blocker / "book.bin")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "not a folder" in err and "Traceback" not in err
+
+
+def test_a_book_the_disk_refuses_is_said_in_one_line_and_the_old_one_kept(tmp_path, capsys, monkeypatch):
+    import errno
+    import os
+
+    from ttt_sm.game import book
+
+    out = tmp_path / "book.bin"
+    out.write_bytes(b"the old book")
+    real_write = os.write
+
+    def full_disk(fd, data):  # the real write path, refused as a full disk refuses it
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(os, "write", full_disk)
+    try:
+        status = book.main(["--max-stones", "0", "--line-stones", "0", "--out", str(out)])
+    finally:
+        monkeypatch.setattr(os, "write", real_write)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 1 and err[-1].startswith("python -m ttt_sm.game.book: error: ")
+    assert "No space left on device" in err[-1] and out.read_bytes() == b"the old book"
+    assert [p.name for p in tmp_path.iterdir()] == ["book.bin"]

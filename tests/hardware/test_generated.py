@@ -70,3 +70,17 @@ def test_a_doc_that_would_close_the_c_comment_is_refused():
     bad = layout.block("XX", "a block", [("A", "ends */ early")])
     with pytest.raises(ValueError, match="XX_A"):
         generate.layout_h([bad])
+
+
+def test_an_unwritable_generated_file_is_said_in_one_line_and_nothing_half_written(tmp_path, monkeypatch, capsys):
+    from ttt_sm.hardware import generate
+
+    root = tmp_path / "firmware"
+    (root / "src").mkdir(parents=True)
+    (root / "include" / "ttt_fw" / "layout.h").mkdir(parents=True)  # a folder where the file belongs
+    monkeypatch.setenv("TTT_SM_FIRMWARE", str(root))
+    assert generate.main([]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("python -m ttt_sm.hardware.generate: error: ") and "layout.h" in err
+    assert sorted(p.name for p in (root / "include" / "ttt_fw").iterdir()) == ["layout.h"]  # no temporary left

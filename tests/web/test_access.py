@@ -3,10 +3,6 @@ and no Origin is refused; another machine reaches ``--host 0.0.0.0`` with the to
 
 from __future__ import annotations
 
-import re
-import signal
-import subprocess
-import sys
 import time
 import urllib.error
 import urllib.request
@@ -15,6 +11,7 @@ from pathlib import Path
 import pytest
 from starlette.testclient import TestClient
 
+from gui_process import running_gui
 from ttt_sm.web.access import allowed_hosts, is_loopback, port_of, reachable_host
 from ttt_sm.web.server import create_app
 from ttt_sm.web.session import Session
@@ -77,33 +74,20 @@ def _get(url: str) -> int:
 
 
 def test_gui_on_every_interface_prints_a_reachable_address_that_serves_with_the_token(tmp_path: Path) -> None:
-    proc = subprocess.Popen([sys.executable, "-m", "ttt_sm.cli", "gui", "--host", "0.0.0.0", "--port", "0",
-                             "--paused", "--trace", str(tmp_path / "trace.jsonl")],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
-    try:
-        assert proc.stdout is not None
-        found = None
-        for _ in range(10):
-            found = re.search(r"http://([^/:\s]+):(\d+)/charts\?token=([\w-]+)", proc.stdout.readline())
-            if found:
-                break
-        assert found is not None, "no address printed"
-        host, port, token = found.groups()
+    with running_gui("--host", "0.0.0.0", "--paused", "--trace", str(tmp_path / "trace.jsonl"), cwd=tmp_path,
+                     lines=10) as gui:
+        assert gui.host is not None, "no address printed"
+        host, token = gui.host, gui.token
         assert host != "0.0.0.0"
         if is_loopback(host):
             pytest.skip("this machine has no address but loopback: another machine could not reach it anyway")
-        base = f"http://{host}:{port}"  # as another machine on the network asks: Host names that address
+        base = gui.base  # as another machine on the network asks: Host names that address
         deadline = time.monotonic() + 120
         while _get(f"{base}/static/session.js") != 200:
-            assert time.monotonic() < deadline and proc.poll() is None, "the cockpit did not start"
+            assert time.monotonic() < deadline and gui.proc.poll() is None, "the cockpit did not start"
             time.sleep(0.1)
         assert _get(f"{base}/charts?token={token}") == 200
         assert _get(f"{base}/charts") == 403
         assert _get(f"{base}/charts?token=wrong") == 403
-        proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=60)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    assert proc.returncode == 0, err
+        status, err = gui.stop()
+    assert status == 0, err

@@ -329,3 +329,30 @@ def test_the_streamed_trace_is_served_as_written_so_far(tmp_path: Any) -> None:
         assert got.status_code == 200 and written.startswith(got.content) and got.content.count(b"\n") >= 2
     finally:
         s.stop()
+
+
+def test_a_page_over_its_share_has_its_messages_dropped_unparsed_and_is_told_once_a_window(
+        client: TestClient, session: Session, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A flood costs the server a check per message, not a parse and a reply each (issue 28: the robot's pace
+    under a flood of 20,000 ``hello``s)."""
+    from ttt_sm.web import session as session_module
+
+    monkeypatch.setattr(session_module, "PAGE_BURST_S", 0.0)  # no burst: any use at all is over the share
+    monkeypatch.setattr(session_module, "PAGE_SHARE", 1e-9)  # ... and it does not fall back during the test
+    monkeypatch.setattr(session_module, "DROP_NOTICE_S", 1e9)  # one window: the whole test
+    flood = 300
+    with client.websocket_connect("/ws") as ws:
+        cid = max(session._clients)
+        ws.send_text('{"type": "tick", "id": 1}')
+        assert json.loads(ws.receive_text())["id"] == 1  # handled: the page has used the session now ...
+        session.call(lambda d: None)  # ... and its use is counted (after the reply went out)
+        for i in range(flood):  # hellos (a full frame each) and text that is no JSON at all
+            ws.send_text(json.dumps({"type": "hello", "id": i + 2}) if i % 2 else "{not json")
+        notice = json.loads(ws.receive_text())
+        deadline = time.monotonic() + 60  # a timeout for a loaded machine, not a measurement
+        while session.page_counts(cid)["dropped"] < flood and time.monotonic() < deadline:
+            time.sleep(0.01)
+        counts = session.page_counts(cid)
+    assert counts == {"parsed": 1, "dropped": flood, "refused": 0}  # none parsed, none refused after parsing
+    assert notice["type"] == "error" and notice["id"] is None and notice["dropped"] == 1
+    assert notice["error"].startswith("refused: 1 message(s) dropped unread: this page's commands have used")

@@ -109,6 +109,9 @@ class GameSession:
         self.o_pos = 0
         self.result_code = 0
         self.erase_started = False
+        #: What set the erase flag: "game over" (the Game chart asked, thesis section 3.6) or "full board"
+        #: (the manipulator's symbols and the camera's add up to 25, section 3.6.1); None: not yet.
+        self.erase_cause: str | None = None
         self.erased_seen = False
         self.pending_move: Cell | None = None
         self.detections_correct = 0
@@ -502,6 +505,7 @@ class GameSession:
             "realtime_factor": round(robot.t / wall_s, 1),
             "setup_wall_s": round(self.setup_wall_s, 3),
             "erased": ink_left == 0.0,
+            "erase_cause": self.erase_cause,
             "ink_left_mm2": round(ink_left, 3),
             "camera": self.camera.mode,
             "camera_link": self.camera.stats(),
@@ -509,6 +513,11 @@ class GameSession:
             "ignored_play_clicks": self.activator.ignored_triggers,
             **(NO_PRECISION if self.pen_path is None else self.pen_path.precision()),
         }
+
+    @property
+    def detected_count(self) -> int:
+        """The Session block's `detected`: the person's symbols the camera has detected."""
+        return self.o_pos.bit_count()
 
     def checkpoint(self) -> dict[str, Any]:
         """The state of the game now, as its record keeps it (:func:`.game_record.checkpoint`)."""

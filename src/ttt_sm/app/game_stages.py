@@ -59,6 +59,7 @@ class StagedSession(Protocol):
     driver: GameDriver | None
     outcome: str | None
     erase_started: bool
+    erase_cause: str | None
     erased_seen: bool
 
     def flow(self, max_moves: int = 25) -> Flow:
@@ -152,7 +153,7 @@ class GameStage:
     def __init__(self, session: StagedSession) -> None:
         self.s = session
         self._feed_game: Callable[[], None] = not_wired
-        self._after_game: Callable[[], tuple[bool, bool, bool]] = not_wired
+        self._after_game: Callable[[], tuple[bool, bool, bool, int, int]] = not_wired
         self._feed_activator: Callable[[], None] = not_wired
         self._enable: Callable[[], bool] = not_wired
 
@@ -164,7 +165,8 @@ class GameStage:
         """Compile this stage's part of the wiring table."""
         s = self.s
         self._feed_game = wiring.feed([s.game.chart_name])
-        self._after_game = wiring.collect("EraseFlag.request", "Session.erasing", "Session.field_drawn")
+        self._after_game = wiring.collect("EraseFlag.request", "Session.erasing", "Session.field_drawn",
+                                          "EraseFlag.ctr", "EraseFlag.detected")
         self._feed_activator = wiring.feed([s.activator.chart_name])
         self._enable = wiring.collect("Session.enable")
 
@@ -174,17 +176,25 @@ class GameStage:
             s.driver.before_chart_step()
         self._feed_game()
         s.game.tick()
-        request, erasing, field_drawn = self._after_game()
+        request, erasing, field_drawn, ctr, detected = self._after_game()
         flag = s.robot.control_stage
-        if request and not flag.erase_requested and not s.erase_started:
+        # the thesis' Erase_flag (section 3.6.1): the symbols drawn by the manipulator and those the
+        # camera detected reach 25, a full board; or the game asks (section 3.6: the game is over)
+        full = ctr + detected >= FULL_BOARD
+        if (request or full) and not flag.erase_requested and not s.erase_started:
             flag.erase_requested = True
             s.erase_started = True
+            s.erase_cause = "full board" if full else "game over"
         if s.erase_started and not s.erased_seen and not erasing and not field_drawn:
             s.erased_seen = True
         self._feed_activator()
         s.activator.tick()
         if self._enable():
             s.robot_turn_now()
+
+
+#: The symbols on a full board: the thesis' Erase_flag turns on when the count reaches it (section 3.6.1).
+FULL_BOARD = 25
 
 
 class PenPathStage:

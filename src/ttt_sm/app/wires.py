@@ -14,7 +14,10 @@ loop has these blocks (what each declares, the table reads):
 - ``Homing``: whether every drive passes its position through (a logical AND
   of the init charts' `passing`);
 - ``EraseFlag``: the thesis' Erase_flag: set by whoever asks for erasing
-  (the game, `ttt-sm play`), reset once the Control chart erases;
+  (the game, `ttt-sm play`), and in a game when the symbols drawn by the
+  manipulator (the Control chart's `ctr`) and those the camera detected
+  add up to 25, a full board (thesis section 3.6.1); reset once the Control
+  chart erases;
 - ``Session``: the game around the charts (the Tic-tac-toe GUI, the engine,
   the camera's moves): the result, the person's moves, the algorithm's answer;
 - ``Monitor``: what the Safety chart watches of each drive (following error,
@@ -69,6 +72,8 @@ HOMING = Block("Homing", "every drive passes its position through: a logical AND
 ERASE_FLAG = Block("EraseFlag", "the thesis' Erase_flag: erase at the next wait", inputs=(
     Port("request", "bool", "erasing asked for (set on its rising edge)"),
     Port("erasing", "bool", "the Control chart erases: the flag is reset"),
+    Port("ctr", "1", "symbols drawn by the manipulator (thesis section 3.6.1)"),
+    Port("detected", "1", "symbols the camera has detected: with ctr, 25 is a full board and sets the flag"),
 ), outputs=(
     Port("flag", "bool", "erase at the next wait", attr="erase_requested"),
 ))
@@ -82,6 +87,8 @@ SESSION = Block("Session", "the game around the charts: GUI, engine, the camera'
     Port("erased", "bool", "the board has been erased since the game ended", attr="erased_seen"),
     Port("play_again", "bool", "start a new game after erasing"),
     Port("o_pos", "1", "the person's moves, one bit per cell"),
+    Port("detected", "1", "the person's symbols the camera has detected (the bits of o_pos)",
+         attr="detected_count"),
 ))
 
 MONITOR = Block("Monitor", "what the Safety chart watches of each drive, from the arm's readings", outputs=(
@@ -188,6 +195,9 @@ GAME_WIRES: tuple[Wire, ...] = (
     Wire("Session.erased", "Game.erased"),
     Wire("Session.play_again", "Game.play_again"),
     Wire("Game.erase", "EraseFlag.request"),
+    Wire("Control.ctr", "EraseFlag.ctr"),
+    Wire("Session.detected", "EraseFlag.detected"),
+    Wire("Control.erasing", "Game.sponge"),
     Wire("Game.finish", "Control.finish"),
     Wire("Control.erasing", "Session.erasing"),
     Wire("Control.Pl_fld", "Session.field_drawn"),

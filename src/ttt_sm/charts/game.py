@@ -88,6 +88,7 @@ class Game(TickChart):
         Data("busy", "bool", False, "the Control chart is drawing, erasing or moving"),
         Data("result", "1", 0, "0: game on; 1: the manipulator won; 2: the person won; 3: draw; 4: the person gave up"),
         Data("erased", "bool", False, "the Control chart has erased the board and left Erase"),
+        Data("sponge", "bool", False, "the Control chart erases (a full board set the erase flag itself)"),
         Data("play_again", "bool", False, "start a new game after erasing instead of turning off"),
         Data("finished", "bool", False, "the Control chart is back at its start pose"),
     )
@@ -119,7 +120,8 @@ class Game(TickChart):
     stop = turning_off.from_(compiling, initialising, playing, game_over, erasing)
     compiling.to(initialising)
     initialising.to(playing, cond="ready")
-    playing.to(game_over, cond="result != 0 and ready")
+    # ready: the last drawing is done; erasing: a full board erases at once (thesis section 3.6.1)
+    playing.to(game_over, cond="result != 0 and (ready or sponge)")
     game_over.to(erasing, cond=after_s(2.0))  # the result stays on show for 2 s
     erasing.to(playing, cond="erased and ready and play_again", on="new_game")
     erasing.to(turning_off, cond="erased and not play_again")

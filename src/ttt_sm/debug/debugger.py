@@ -284,6 +284,14 @@ class Debugger:
         if steps > furthest:
             raise DebugError(f"replay: control step {steps} lies beyond where this session has been (step"
                              f" {furthest}); replay goes back, run goes forward")
+        # a replay runs the robot again from power-on: its work is the simulated time to `steps`, bounded
+        # as one command's run is (docs/gui.md, "Limits"), so no replay holds the session for minutes
+        seconds = steps * self.robot.params.control.dt
+        limit = self.stepper.max_run_s
+        if seconds > limit * (1 + 1e-9):
+            raise DebugError(f"replay: it would run {seconds:g} s of simulated time again from power-on (to control"
+                             f" step {steps}), beyond the {limit:g} s one command runs (start the debugger with"
+                             f" --max-run SECONDS to allow more)")
         kept = [a for a in self.actions if a.steps <= steps]
         dropped = len(self.actions) - len(kept)
         self.forced.clear()

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+from ..files import RecordWriteError, write_atomic
 from .bitboard import FULL, N_CELLS, bits, canonical, has_four
 from .solver import Outcome, Solver, choose
 
@@ -202,12 +203,27 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", default=str(Path(__file__).with_name(BOOK_FILE)),
                    help="file to write (default: the packaged book.bin)")
     args = p.parse_args(argv)
+    prog = p.prog
+    out = Path(args.out)
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir() or out.is_dir():  # said before the half hour of solving, not after it
+        what = "is a folder where a file belongs" if out.is_dir() else f"is in {str(folder)!r}, which is not a folder"
+        print(f"{prog}: error: --out {str(out)!r} {what}; choose another path", file=sys.stderr)
+        return 2
     t0 = time.perf_counter()
-    known = load_book(args.known) if args.known else None
+    try:
+        known = load_book(args.known) if args.known else None
+    except BookError as exc:
+        print(f"{prog}: error: --known: {exc}", file=sys.stderr)
+        return 2
     book = build_book(args.max_stones, args.line_stones, known=known,
                       progress=lambda msg: print(msg, file=sys.stderr, flush=True))
     data = encode(book)
-    Path(args.out).write_bytes(data)
+    try:
+        write_atomic(out, data)  # the whole book or the one that was there (docs/reliability.md)
+    except RecordWriteError as exc:
+        print(f"{prog}: error: {exc.filename}: {exc.strerror}; the book was not written", file=sys.stderr)
+        return 1
     print(f"{len(book)} positions (all up to {book.max_stones} marks, the book's lines up to "
           f"{book.line_stones}), {len(data)} bytes, {time.perf_counter() - t0:.0f} s -> {args.out}")
     return 0

@@ -22,6 +22,7 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from ..files import RecordWriteError, write_atomic
 from ..twin import layout
 from .firmware import firmware_root
 
@@ -84,7 +85,7 @@ def write(root: Path | None = None) -> list[Path]:
     """Write every generated file that is stale; return those written."""
     written = []
     for path in stale(root):
-        path.write_text(generated(root)[path](), encoding="utf-8")
+        write_atomic(path, generated(root)[path]())  # the whole file or the one that was there
         written.append(path)
     return written
 
@@ -101,7 +102,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         for path in old:
             print(f"{path}: stale; regenerate it with python -m ttt_sm.hardware.generate", file=sys.stderr)
         return 1 if old else 0
-    for path in write():
+    try:
+        written = write()
+    except RecordWriteError as exc:
+        print(f"{parser.prog}: error: {exc.filename}: {exc.strerror}; it was not written", file=sys.stderr)
+        return 1
+    for path in written:
         print(f"wrote {path}")
     return 0
 

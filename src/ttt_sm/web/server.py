@@ -40,6 +40,7 @@ import asyncio
 import contextlib
 import hmac
 import threading
+import time
 from collections.abc import AsyncIterator, Callable, Iterable
 from importlib import resources
 from typing import Any
@@ -332,6 +333,8 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                 message = await websocket.receive()
                 if message["type"] == "websocket.disconnect":
                     break
+                if session.refusing(cid, time.perf_counter()):
+                    continue  # refused anyway: dropped before it is parsed, the page told once a window
                 raw = message.get("text")
                 if raw is None:
                     raw = message.get("bytes") or b""

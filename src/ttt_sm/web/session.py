@@ -39,6 +39,7 @@ import contextlib
 import gc
 import itertools
 import logging
+import os
 import queue
 import threading
 import time
@@ -64,12 +65,21 @@ from .protocol import Command
 
 log = logging.getLogger(__name__)
 
+#: A test-only fault hook (docs/gui.md, "When the session dies"): with this environment variable set to a
+#: command type, the simulation thread raises when it takes a command of that type, outside the handling
+#: that keeps a command's failure from ending the thread, as a bug of the session's own loop would.  The
+#: process-level test of ``ttt-sm gui``'s exit status uses it; nobody else should.
+FAULT_ENV = "TTT_SM_TEST_SESSION_FAULT"
+_FAULT_ON = os.environ.get(FAULT_ENV) or None
+
 #: Frames a second at most, to every page.
 FRAME_HZ = 30.0
 #: One ``Debugger.run`` call while running: the run goes on after it (it is not a stop).
 RUN_CHUNK_S = 60.0
 #: Commands of one page waiting for the simulation thread at most; one more is refused with an error reply.
 PAGE_QUEUE = 16
+#: A page whose messages are dropped unread hears of them at most once in this many seconds (wall).
+DROP_NOTICE_S = 1.0
 #: Wall time one command may hold the simulation thread: a ``step``, ``tick`` or ``next`` that runs longer
 #: pauses after it (the reply says how far it came; send it again to go on).
 COMMAND_BUDGET_S = run_commands.COMMAND_BUDGET_S
@@ -98,6 +108,13 @@ class _Client:
     #: Seconds of the simulation thread this page's commands have used, less PAGE_SHARE of the time since.
     used_s: float = 0.0
     used_at: float = 0.0
+    #: Messages of this page read and parsed, and those dropped unparsed while it was refused (:meth:`Session.
+    #: refusing`): a flood costs the server a check per message, not a parse and a reply.
+    parsed: int = 0
+    dropped: int = 0
+    #: The dropped messages not yet told to the page, and when it may be told next (one reply a window).
+    untold: int = 0
+    tell_at: float = 0.0
 
     def use(self, now: float, spent: float = 0.0) -> float:
         """The page's use of the simulation thread now (``spent`` added): it falls by PAGE_SHARE a second."""
@@ -165,6 +182,7 @@ class Session:
         self.chart_classes = {name: type(c) for name, c in robot.charts.items()}
         self.info["scenarios"] = list(scenarios or {})
         self.info["arm"] = arm_scene(self.params)
+        self._info_text: str | None = None  # the ``session`` message, once a page has joined
         self.trace_path = trace_path
         self.clock = PacedClock(self.params.control.dt, speed)
         self.speed = speed
@@ -227,6 +245,41 @@ class Session:
         """A page is gone; nothing else changes."""
         with self._lock:
             self._clients.pop(cid, None)
+
+    def refusing(self, cid: int, now: float) -> bool:
+        """Whether this page's next message is dropped unread: it has :data:`PAGE_QUEUE` commands waiting, or
+        has used more than its share (the refusals of :meth:`submit`, decided before the message is parsed).
+
+        The server calls it for every message it reads.  A dropped message is counted; the page hears of
+        them in one ``error`` a :data:`DROP_NOTICE_S` window (its ``dropped`` count), not one reply each."""
+        with self._lock:
+            client = self._clients.get(cid)
+            if client is None:
+                return False
+            full = client.queued >= PAGE_QUEUE
+            greedy = client.use(now) > PAGE_BURST_S
+            if not (full or greedy):
+                client.parsed += 1
+                return False
+            client.dropped += 1
+            client.untold += 1
+            if now < client.tell_at:
+                return True
+            told, client.untold, client.tell_at = client.untold, 0, now + DROP_NOTICE_S
+            wait = (client.used_s - PAGE_BURST_S) / PAGE_SHARE if greedy else 0.0
+        why = (f"this page has {PAGE_QUEUE} commands waiting for the session already (the most one page may"
+               " have); wait for their replies" if full else
+               f"this page's commands have used the session more than one page may ({PAGE_SHARE:.0%} of its"
+               f" time, after a burst of {PAGE_BURST_S:g} s); send again in {max(wait, 0.1):.1f} s")
+        self.send_to(cid, {"type": "error", "id": None, "command": None, "dropped": told,
+                           "error": f"refused: {told} message(s) dropped unread: {why}"})
+        return True
+
+    def page_counts(self, cid: int) -> dict[str, int]:
+        """A page's messages parsed, dropped unread, and commands refused after parsing (tests, the probe)."""
+        with self._lock:
+            c = self._clients.get(cid)
+            return {} if c is None else {"parsed": c.parsed, "dropped": c.dropped, "refused": c.refused}
 
     def submit(self, cid: int, command: Command) -> None:
         """Queue a checked command; the simulation thread handles it between two control steps.
@@ -368,7 +421,9 @@ class Session:
             client = self._clients.get(cid)
             if client is None:
                 return
-        self.send_to(cid, {"type": "session", "info": self.info})
+        if self._info_text is None:  # what the session runs does not change: serialized once, not per hello
+            self._info_text = dumps(jsonable({"type": "session", "info": self.info}))
+        client.send(self._info_text)
         self.send_to(cid, self.frames.frame(True, self._status()))
         if self.coverage.shown is not None:
             self.send_to(cid, {"type": "coverage", **self.coverage.shown})
@@ -524,6 +579,8 @@ class Session:
                     return
                 if item is None:
                     return
+                if item[1].type == _FAULT_ON:
+                    raise RuntimeError(f"{FAULT_ENV}={_FAULT_ON}: the test's fault in the simulation thread")
                 self._handle(*item)
                 if self.mode == "running" and time.perf_counter() - started > budget and not self._queue.empty():
                     self._wake = True  # the rest after a stretch of the run

@@ -341,6 +341,7 @@ def test_a_page_over_its_share_has_its_messages_dropped_unparsed_and_is_told_onc
     monkeypatch.setattr(session_module, "PAGE_SHARE", 1e-9)  # ... and it does not fall back during the test
     monkeypatch.setattr(session_module, "DROP_NOTICE_S", 1e9)  # one window: the whole test
     flood = 300
+    watcher = session.connect(lambda text: None)  # another page: the one a flood must not starve
     with client.websocket_connect("/ws") as ws:
         cid = max(session._clients)
         ws.send_text('{"type": "tick", "id": 1}')
@@ -353,6 +354,34 @@ def test_a_page_over_its_share_has_its_messages_dropped_unparsed_and_is_told_onc
         while session.page_counts(cid)["dropped"] < flood and time.monotonic() < deadline:
             time.sleep(0.01)
         counts = session.page_counts(cid)
+    session.disconnect(watcher)
     assert counts == {"parsed": 1, "dropped": flood, "refused": 0}  # none parsed, none refused after parsing
     assert notice["type"] == "error" and notice["id"] is None and notice["dropped"] == 1
     assert notice["error"].startswith("refused: 1 message(s) dropped unread: this page's commands have used")
+
+
+def test_one_page_alone_with_the_robot_paused_is_never_held_back(
+        session: Session, monkeypatch: pytest.MonkeyPatch) -> None:
+    # a loaded run of the suite: a replay took over 2 s of the thread, and the page's next Run was refused
+    # (the page waited for a breakpoint that never came); nobody else needed the thread
+    from ttt_sm.web import session as session_module
+
+    monkeypatch.setattr(session_module, "PAGE_BURST_S", 0.0)  # any use at all is over the burst
+    monkeypatch.setattr(session_module, "PAGE_SHARE", 1e-9)  # ... and it does not fall back during the test
+    heard: list[dict[str, Any]] = []
+    alone = session.connect(lambda text: heard.append(json.loads(text)))
+    try:
+        session.submit(alone, parse_command('{"type": "tick", "id": 1}'))
+        session.call(lambda d: None)
+        assert not session.refusing(alone, time.perf_counter())
+        session.submit(alone, parse_command('{"type": "tick", "id": 2}'))
+        session.call(lambda d: None)
+        other = session.connect(lambda text: None)  # now someone else needs the thread too: held back
+        try:
+            assert session.refusing(alone, time.perf_counter())
+        finally:
+            session.disconnect(other)
+    finally:
+        session.disconnect(alone)
+    assert [(m["type"], m["id"]) for m in heard] == [("reply", 1), ("reply", 2), ("error", None)]
+    assert "used the session more than one page may" in heard[2]["error"]  # told when held back, not before

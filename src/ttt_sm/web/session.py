@@ -257,7 +257,7 @@ class Session:
             if client is None:
                 return False
             full = client.queued >= PAGE_QUEUE
-            greedy = client.use(now) > PAGE_BURST_S
+            greedy = self._greedy(cid, client.use(now))
             if not (full or greedy):
                 client.parsed += 1
                 return False
@@ -274,6 +274,15 @@ class Session:
         self.send_to(cid, {"type": "error", "id": None, "command": None, "dropped": told,
                            "error": f"refused: {told} message(s) dropped unread: {why}"})
         return True
+
+    def _greedy(self, cid: int, used: float) -> bool:
+        """Whether a page that has used `used` seconds of the simulation thread (less its share since) is held
+        back: over :data:`PAGE_BURST_S`, while someone else needs the thread (the robot running, or another
+        page connected).  One page alone with a paused robot is never held back: a replay that takes seconds on
+        a slow or busy machine must not make the next Run or Pause a refusal.  Called with the lock held."""
+        if used <= PAGE_BURST_S:
+            return False
+        return self.mode == "running" or any(k != cid for k in self._clients)
 
     def page_counts(self, cid: int) -> dict[str, int]:
         """A page's messages parsed, dropped unread, and commands refused after parsing (tests, the probe)."""
@@ -302,7 +311,7 @@ class Session:
                 return
             full = client is not None and client.queued >= PAGE_QUEUE
             used = client.use(time.perf_counter()) if client is not None else 0.0
-            greedy = used > PAGE_BURST_S
+            greedy = self._greedy(cid, used)
             if client is not None:
                 if full or greedy:
                     client.refused += 1

@@ -9,6 +9,7 @@ import pytest
 
 from ttt_sm.params import load_params
 from ttt_sm.twin.kinematics import UnreachableTargetError, ik_closed_form
+from ttt_sm.twin.kinematics.closed_form import solve_point
 from ttt_sm.twin.kinematics.workspace import (
     BOTH,
     DOWN_ONLY,
@@ -17,7 +18,6 @@ from ttt_sm.twin.kinematics.workspace import (
     classify,
     field_cells,
     solve_grid,
-    solve_point,
     with_lengths,
     workspace,
 )

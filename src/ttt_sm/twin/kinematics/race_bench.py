@@ -17,10 +17,10 @@ import numpy as np
 
 from ttt_sm.params import ArmParams, IKParams
 
-from .closed_form import ik_closed_form
+from .closed_form import ik_closed_form, solve_point
 from .dls import damped_least_squares
 from .race import THESIS_LAMBDA, THESIS_TOLERANCE, race
-from .workspace import solve_point, workspace
+from .workspace import workspace
 
 
 def _per_call_us(fn: Any, args: tuple[Any, ...], repeat: int, **kw: Any) -> float:

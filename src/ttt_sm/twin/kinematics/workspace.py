@@ -1,7 +1,7 @@
 """The pen tip's reachable workspace from the joint limits (thesis section 3.4; docs/kinematics.md, "Lab").
 
-The closed form of :func:`~.closed_form.ik_closed_form`, written on numpy
-arrays, solves every point of a grid at once for both elbow configurations;
+The closed form of :func:`~.closed_form.ik_closed_form` (its one compiled
+source, :func:`~.closed_form.closed_form_q`) solves every point of a grid for both elbow configurations;
 a point is reachable in a configuration when its solution exists and lies
 within the joint limits (``[drive.*]`` and ``[servo]`` of the parameter
 file).  Three tools: the pen held vertical (``phi = 0``, how the arm draws),
@@ -22,9 +22,12 @@ import math
 from dataclasses import dataclass, replace
 from typing import Any
 
+import numba
 import numpy as np
 
 from ttt_sm.params import ArmParams, Geometry
+
+from .closed_form import closed_form_q, wrap_angle
 
 UNREACHABLE, UP_ONLY, DOWN_ONLY, BOTH = 0, 1, 2, 3
 #: Names of the codes, in code order.
@@ -51,22 +54,17 @@ def solve_grid(x: Any, y: Any, z: Any, phi: float, geometry: Geometry, elbow_up:
     """
     g = geometry
     x, y, z = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float), np.asarray(z, float))
-    u, v = x + g.l_f, y
-    with np.errstate(invalid="ignore"):
-        r = np.sqrt(u * u + v * v - g.l_f**2)
-        q1 = np.arctan2(v, u) - np.arctan2(r, g.l_f)
-        q1 = np.arctan2(np.sin(q1), np.cos(q1))
-        r_w = r - g.L4 * math.sin(phi)
-        h_w = (g.L1 - z) - g.L4 * math.cos(phi)
-        dist = np.hypot(r_w, h_w)
-        ok = (dist <= g.L2 + g.L3) & (dist >= abs(g.L2 - g.L3)) & np.isfinite(r)
-        c3 = np.clip((dist**2 - g.L2**2 - g.L3**2) / (2.0 * g.L2 * g.L3), -1.0, 1.0)
-        q3 = np.arccos(c3)
-        if elbow_up:
-            q3 = -q3
-        q2 = np.arctan2(r_w, h_w) - np.arctan2(g.L3 * np.sin(q3), g.L2 + g.L3 * np.cos(q3))
-        q = np.stack([q1, q2, q3, phi - q2 - q3], axis=-1)
-    q[~ok] = np.nan
+    q = _solve_all(x.ravel(), y.ravel(), z.ravel(), float(phi), g.L1, g.L2, g.L3, g.L4, g.l_f, bool(elbow_up))
+    return q.reshape(*x.shape, 4)
+
+
+@numba.njit(cache=True)
+def _solve_all(x: np.ndarray, y: np.ndarray, z: np.ndarray, phi: float, L1: float, L2: float, L3: float,
+               L4: float, l_f: float, elbow_up: bool) -> np.ndarray:
+    q = np.empty((x.size, 4))
+    for i in range(x.size):
+        q1, q[i, 1], q[i, 2], q[i, 3], _, _ = closed_form_q(x[i], y[i], z[i], phi, L1, L2, L3, L4, l_f, elbow_up)
+        q[i, 0] = wrap_angle(q1)
     return q
 
 
@@ -207,28 +205,3 @@ def workspace(params: ArmParams, tool: str = "pen_vertical", geometry: Geometry 
 def with_lengths(geometry: Geometry, **lengths: float) -> Geometry:
     """`geometry` with some link lengths (m) replaced: ``with_lengths(g, L2=0.25)``."""
     return replace(geometry, **lengths)
-
-
-def solve_point(x: float, y: float, z: float, phi: float, geometry: Geometry,
-                elbow_up: bool = True) -> tuple[float, float, float, float] | None:
-    """:func:`~.closed_form.ik_closed_form` on plain floats: q1..q4 (rad), or None where out of reach.
-
-    The same equations without arrays or exceptions, for the IK race's timing (``ttt-sm bench``
-    section ``ik_race``): about a microsecond a solve.  q1 is not wrapped (the closed form's is
-    the same angle in (-pi, pi]).
-    """
-    g = geometry
-    u = x + g.l_f
-    r_sq = u * u + y * y - g.l_f * g.l_f
-    if r_sq < 0.0:
-        return None
-    r = math.sqrt(r_sq)
-    q1 = math.atan2(y, u) - math.atan2(r, g.l_f)
-    r_w = r - g.L4 * math.sin(phi)
-    h_w = (g.L1 - z) - g.L4 * math.cos(phi)
-    c3 = (r_w * r_w + h_w * h_w - g.L2 * g.L2 - g.L3 * g.L3) / (2.0 * g.L2 * g.L3)
-    if not -1.0 <= c3 <= 1.0:
-        return None
-    q3 = -math.acos(c3) if elbow_up else math.acos(c3)
-    q2 = math.atan2(r_w, h_w) - math.atan2(g.L3 * math.sin(q3), g.L2 + g.L3 * math.cos(q3))
-    return (q1, q2, q3, phi - q2 - q3)

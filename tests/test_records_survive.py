@@ -161,7 +161,10 @@ def test_a_scenario_runs_report_and_traces_survive_a_signal_and_json_stays_one_d
         assert document["complete"] is True and "coverage" in document
     else:
         assert document["complete"] is False and document["ended"]["signal"] == sig.name
-        assert last["scenario"] and last["scenarios_done"] == len(results)
+        # where it stood: in a scenario, or between two (None: a loaded soak run met one there), or before
+        # the first began (the command's own ending: nothing done yet)
+        assert last.get("scenarios_done", 0) == len(results), last
+        assert "scenario" in last or not results, last
 
 
 @pytest.mark.parametrize("seed", [1, *SOAK])

@@ -217,3 +217,28 @@ def test_a_robot_scenario_cannot_name_a_chart_the_robot_does_not_hold() -> None:
                                " at the top of the file")
     s = load("name: n\nsteps:\n  - set: {Robotic.request: true}\n  - expect: q_true[1] > 0\n")
     assert s.bare is None
+
+
+def test_a_run_stopped_between_two_scenarios_ends_its_report_saying_so(tmp_path) -> None:
+    # a loaded soak run met it: the signal came after one scenario ended and before the next began, and
+    # the report's ending said neither where the run stood nor how many scenarios it had done
+    from ttt_sm.runtime.recordfile import RecordFile
+    from ttt_sm.runtime.recordfile import read_lines as read_record
+
+    text = """\
+        name: latch N
+        chart: Latch
+        steps:
+          - run: {seconds: 0.01}
+    """
+    scenarios = [load(text.replace("N", str(n))) for n in (1, 2)]
+
+    def stop_after_the_first(_result: Any) -> None:
+        raise KeyboardInterrupt
+
+    report = RecordFile(tmp_path / "report.jsonl")
+    with pytest.raises(KeyboardInterrupt):
+        run_scenarios(scenarios, PARAMS, report_file=report, progress=stop_after_the_first)
+    lines = read_record(tmp_path / "report.jsonl")
+    assert [e["event"] for e in lines] == ["scenario", "interrupted"]
+    assert lines[-1]["scenario"] is None and lines[-1]["scenarios_done"] == 1

@@ -76,43 +76,49 @@ def run_scenarios(scenarios: Iterable[Scenario], params: ArmParams, *, coverage:
     scenario.  ``report_file`` gets a line per
     scenario as it finishes, then the coverage and the counts; both end with
     ``interrupted`` or ``error`` (and where: the scenario, its transitions so
-    far, the chart time of the last) if the run is stopped.  ``progress``
+    far, the chart time of the last; ``scenario`` null between two scenarios;
+    the report also ``scenarios_done``) if the run is stopped.  ``progress``
     hears of each finished scenario, ``step_progress`` of a long step on its
     way (see :func:`~.runner.run_scenario`).
     """
     wall0 = time.perf_counter()
     cov = Coverage() if coverage else None
     results: list[ScenarioResult] = []
-    for scenario in scenarios:
-        trace_file = None
-        if trace_dir is not None:
-            trace_file = RecordFile(Path(trace_dir) / f"{Path(scenario.file).stem}.jsonl")
-        trace = Trace(sink=trace_file, limit=1)  # the last transition: where a stopped run stood
-        try:
-            result = run_scenario(scenario, params, coverage=cov, listeners=[trace], progress=step_progress)
-        except BaseException as exc:
-            how, data = ending_of(exc)
-            last = trace.records[-1] if trace.records else None
-            where = {"scenario": scenario.name, "file": scenario.file, "transitions": trace.count,
-                     "last_transition_time_s": None if last is None else last.time_s}
+    where: dict[str, object] = {"scenario": None}  # between scenarios (a signal may come there too)
+    try:
+        for scenario in scenarios:
+            trace_file = None
+            if trace_dir is not None:
+                trace_file = RecordFile(Path(trace_dir) / f"{Path(scenario.file).stem}.jsonl")
+            trace = Trace(sink=trace_file, limit=1)  # the last transition: where a stopped run stood
+            try:
+                result = run_scenario(scenario, params, coverage=cov, listeners=[trace], progress=step_progress)
+            except BaseException as exc:
+                how, data = ending_of(exc)
+                last = trace.records[-1] if trace.records else None
+                where = {"scenario": scenario.name, "file": scenario.file, "transitions": trace.count,
+                         "last_transition_time_s": None if last is None else last.time_s}
+                if trace_file is not None:
+                    trace_file.end(how, **data, **where)
+                raise
             if trace_file is not None:
-                trace_file.end(how, **data, **where)
+                trace_file.end("finished", scenario=scenario.name, passed=result.passed,
+                               transitions=trace.count, sim_time_s=result.sim_time_s)
+            results.append(result)
             if report_file is not None:
-                report_file.end(how, **data, **where, scenarios_done=len(results))
-            raise
-        if trace_file is not None:
-            trace_file.end("finished", scenario=scenario.name, passed=result.passed, transitions=trace.count,
-                           sim_time_s=result.sim_time_s)
-        results.append(result)
+                report_file.add({"event": "scenario", **result.to_dict()})
+            if progress is not None:
+                progress(result)
+        run = RunReport(tuple(results), cov.report() if cov is not None else None, time.perf_counter() - wall0)
         if report_file is not None:
-            report_file.add({"event": "scenario", **result.to_dict()})
-        if progress is not None:
-            progress(result)
-    run = RunReport(tuple(results), cov.report() if cov is not None else None, time.perf_counter() - wall0)
-    if report_file is not None:
-        summary = run.to_dict()
-        if "coverage" in summary:
-            report_file.add({"event": "coverage", "coverage": summary["coverage"]})
-        report_file.end("finished", passed=summary["passed"], counts=summary["counts"],
-                        sim_time_s=summary["sim_time_s"], wall_time_s=summary["wall_time_s"])
+            summary = run.to_dict()
+            if "coverage" in summary:
+                report_file.add({"event": "coverage", "coverage": summary["coverage"]})
+            report_file.end("finished", passed=summary["passed"], counts=summary["counts"],
+                            sim_time_s=summary["sim_time_s"], wall_time_s=summary["wall_time_s"])
+    except BaseException as exc:
+        if report_file is not None and not report_file.ended:
+            how, data = ending_of(exc)
+            report_file.end(how, **data, **where, scenarios_done=len(results))
+        raise
     return run

@@ -69,6 +69,16 @@ def test_the_index_links_every_page_and_controls_have_names(page: Any, cockpit: 
     float(page.locator('[data-role="sim-time"]').text_content())
 
 
+def test_the_page_opens_on_the_chart_the_tutorial_starts_with(page: Any, cockpit: Cockpit) -> None:
+    # issue 27: it opened on Safety, the last tab; docs/tutorial.md begins with DriveInit1
+    open_cockpit(page, cockpit)
+    page.wait_for_function("(() => { const d = document.querySelector('[data-role=diagram]');"
+                           " return d.dataset.chart && !d.dataset.loading; })()")
+    first = page.locator('[data-role="chart-tabs"] button').first.text_content()
+    assert first == "DriveInit1"
+    assert page.locator('[data-role="diagram"]').get_attribute("data-chart") == first
+
+
 def test_the_highlighted_states_are_the_robots_configuration_at_the_paused_tick(
         page: Any, cockpit: Cockpit) -> None:
     open_cockpit(page, cockpit)

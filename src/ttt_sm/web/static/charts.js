@@ -70,7 +70,8 @@ function onSession(info) {
   breakpoints.describe(info.charts);
   coverage.describe(info.scenarios);
   const shown = diagram.chart;
-  showChart(shown && diagram.charts[shown] ? shown : info.charts[info.charts.length - 1].name);
+  // a page opens on the first chart, DriveInit1 on the robot: the one the tutorial starts with (docs/tutorial.md)
+  showChart(shown && diagram.charts[shown] ? shown : info.charts[0].name);
 }
 
 function onFrame(f) {

@@ -3,9 +3,6 @@
 Each prints the same JSON document as the page's route ``/api/kinematics/<view>``
 (``--json``), or a short text, and draws the view into a PNG (``--png PATH``).
 docs/kinematics.md, "Lab", explains the views and the exercises.
-
-Other modules add subcommands to the group through :data:`ACTIONS_HOOKS`
-(each called with the group's subparsers object) or :func:`actions`.
 """
 
 from __future__ import annotations
@@ -18,23 +15,12 @@ from typing import Any
 
 from .common import print_json
 
-#: Called with the ``kinematics`` group's subparsers object when the group is built (more subcommands).
-ACTIONS_HOOKS: list[Callable[[Any], None]] = []
-_actions: Any = None
-
-
-def actions() -> Any:
-    """The ``kinematics`` group's subparsers object (after :func:`register`)."""
-    return _actions
-
 
 def register(sub: Any) -> argparse.ArgumentParser:
     """Add the ``kinematics`` command group to the subcommands of ``ttt-sm``."""
-    global _actions
     help_ = "the kinematics lab: reachable workspace, DH table, IK methods raced (the /kinematics page)"
     sp: argparse.ArgumentParser = sub.add_parser("kinematics", help=help_, description=help_)
     acts = sp.add_subparsers(dest="kinematics_command", required=True)
-    _actions = acts
 
     ws = acts.add_parser("workspace", help="where the pen tip reaches within the joint limits, top and side view",
                          description="The pen tip's reachable set within the joint limits, the board and the"
@@ -68,8 +54,6 @@ def register(sub: Any) -> argparse.ArgumentParser:
     rc.add_argument("--max-iterations", type=int, default=100, help="iterations per method (default 100)")
     _common(rc)
     rc.set_defaults(func=_run("race"))
-    for hook in ACTIONS_HOOKS:
-        hook(acts)
     return sp
 
 

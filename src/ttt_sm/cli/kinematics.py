@@ -159,6 +159,8 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch, Rectangle
 
+    from ..files import save_figure
+
     if view == "workspace":
         fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5.5))
         cmap = ListedColormap(CODE_COLOURS)
@@ -247,5 +249,7 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
         ax2.set_title("pen tip per iteration, top view")
         ax2.legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=90, format="png")
-    plt.close(fig)
+    try:
+        save_figure(fig, path, dpi=90, format="png")  # whole or not at all (docs/reliability.md)
+    finally:
+        plt.close(fig)

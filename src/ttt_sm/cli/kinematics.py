@@ -13,7 +13,7 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
-from .common import print_json
+from .common import CliError, print_json
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
@@ -114,14 +114,12 @@ def _run(view: str) -> Callable[[argparse.Namespace], int]:
         from ..web.kinematics import VIEWS, KinematicsQueryError
 
         if args.png is not None and (not args.png.lower().endswith(".png") or os.path.isdir(args.png)):
-            print(f"ttt-sm kinematics {view}: error: --png must name a .png file, got {args.png!r}", file=sys.stderr)
-            return 2
+            raise CliError(f"{view}: --png must name a .png file, got {args.png!r}")
         params = load_arm(args.params)
         try:
             data = VIEWS[view](params, _query(view, args))
         except (KinematicsQueryError, ValueError) as exc:
-            print(f"ttt-sm kinematics {view}: error: {_option_names(str(exc))}", file=sys.stderr)
-            return 2
+            raise CliError(f"{view}: {_option_names(str(exc))}") from None
         if args.png:
             draw_png(view, data, args.png)
             print(f"kinematics {view}: wrote {args.png}", file=sys.stderr)

@@ -143,7 +143,7 @@ def field_cells(params: ArmParams, n: int, field_size: float | None = None, tool
     b = params.board
     size = b.field_size if field_size is None else field_size
     cell = size / n
-    x0, y0 = b.field_center_x - size / 2, b.field_center_y - size / 2
+    x0, _, y0, _ = replace(b, field_size=size).field_bounds()
     out = []
     for i in range(n):
         row = []
@@ -196,8 +196,7 @@ def workspace(params: ArmParams, tool: str = "pen_vertical", geometry: Geometry 
     side = classify(0.0, side_r[None, :], side_z[:, None] - off, params, tool, g, lo, hi)
     n = cells or b.cells
     size = b.field_size if field_size is None else field_size
-    field = (b.field_center_x - size / 2, b.field_center_x + size / 2,
-             b.field_center_y - size / 2, b.field_center_y + size / 2)
+    field = replace(b, field_size=size).field_bounds()
     return Workspace(tool, g, lo, hi, top_x, top_y, top.astype(np.int8), side_r, side_z, side.astype(np.int8),
                      b.board_bounds(), field, field_cells(params, n, size, tool, g, lo, hi))
 

@@ -256,9 +256,8 @@ class Session:
             client = self._clients.get(cid)
             if client is None:
                 return False
-            full = client.queued >= PAGE_QUEUE
-            greedy = self._greedy(cid, client.use(now))
-            if not (full or greedy):
+            why = self._held_back(cid, client, now)
+            if why is None:
                 client.parsed += 1
                 return False
             client.dropped += 1
@@ -266,23 +265,25 @@ class Session:
             if now < client.tell_at:
                 return True
             told, client.untold, client.tell_at = client.untold, 0, now + DROP_NOTICE_S
-            wait = (client.used_s - PAGE_BURST_S) / PAGE_SHARE if greedy else 0.0
-        why = (f"this page has {PAGE_QUEUE} commands waiting for the session already (the most one page may"
-               " have); wait for their replies" if full else
-               f"this page's commands have used the session more than one page may ({PAGE_SHARE:.0%} of its"
-               f" time, after a burst of {PAGE_BURST_S:g} s); send again in {max(wait, 0.1):.1f} s")
         self.send_to(cid, {"type": "error", "id": None, "command": None, "dropped": told,
                            "error": f"refused: {told} message(s) dropped unread: {why}"})
         return True
 
-    def _greedy(self, cid: int, used: float) -> bool:
-        """Whether a page that has used `used` seconds of the simulation thread (less its share since) is held
-        back: over :data:`PAGE_BURST_S`, while someone else needs the thread (the robot running, or another
-        page connected).  One page alone with a paused robot is never held back: a replay that takes seconds on
-        a slow or busy machine must not make the next Run or Pause a refusal.  Called with the lock held."""
-        if used <= PAGE_BURST_S:
-            return False
-        return self.mode == "running" or any(k != cid for k in self._clients)
+    def _held_back(self, cid: int, client: _Client, now: float) -> str | None:
+        """Why this page's next command is refused now, or None: it has :data:`PAGE_QUEUE` commands waiting,
+        or it has used more than :data:`PAGE_BURST_S` of the simulation thread (less its share since) while
+        someone else needs the thread (the robot running, or another page connected).  One page alone with a
+        paused robot is never held back for its use: a replay that takes seconds on a slow or busy machine
+        must not make the next Run or Pause a refusal.  Called with the lock held; counts the use up to `now`."""
+        used = client.use(now)
+        if client.queued >= PAGE_QUEUE:
+            return (f"this page has {PAGE_QUEUE} commands waiting for the session already (the most one page may"
+                    " have); wait for their replies")
+        if used > PAGE_BURST_S and (self.mode == "running" or any(k != cid for k in self._clients)):
+            wait = (used - PAGE_BURST_S) / PAGE_SHARE
+            return (f"this page's commands have used the session more than one page may ({PAGE_SHARE:.0%} of"
+                    f" its time, after a burst of {PAGE_BURST_S:g} s); send it again in {max(wait, 0.1):.1f} s")
+        return None
 
     def page_counts(self, cid: int) -> dict[str, int]:
         """A page's messages parsed, dropped unread, and commands refused after parsing (tests, the probe)."""
@@ -309,23 +310,14 @@ class Session:
             client = self._clients.get(cid)
             if client is None and cid != 0:  # a page gone (cid 0: the server's own, the bench's: not bounded)
                 return
-            full = client is not None and client.queued >= PAGE_QUEUE
-            used = client.use(time.perf_counter()) if client is not None else 0.0
-            greedy = self._greedy(cid, used)
+            why = self._held_back(cid, client, time.perf_counter()) if client is not None else None
             if client is not None:
-                if full or greedy:
+                if why is not None:
                     client.refused += 1
                 else:
                     client.queued += 1
-        if full:
-            self.reply_error(cid, f"{command.type}: refused: this page has {PAGE_QUEUE} commands waiting for the"
-                                  " session already (the most one page may have); wait for their replies", command)
-            return
-        if greedy:
-            wait = (used - PAGE_BURST_S) / PAGE_SHARE
-            self.reply_error(cid, f"{command.type}: refused: this page's commands have used the session more than"
-                                  f" one page may ({PAGE_SHARE:.0%} of its time, after a burst of {PAGE_BURST_S:g}"
-                                  f" s); send it again in {max(wait, 0.1):.1f} s", command)
+        if why is not None:
+            self.reply_error(cid, f"{command.type}: refused: {why}", command)
             return
         self._queue.put((cid, command))
         self._wake = True

@@ -121,8 +121,9 @@ diagram DriveInit1 {svg}
     assert "replayed to step 201 (t = 0.201 s, chart tick 101), 3 recorded inputs re-applied;" \
            " identical to the first visit" in out
     assert "replayed to step 199 (t = 0.199 s, chart tick 100), 1 recorded input re-applied," \
-           " 2 later ones dropped; identical to the first visit" in out
-    assert out.count("step 201: force DriveInit2.index True") == 1  # dropped from the inputs
+           " 2 later ones kept (applied again when you run to their steps); identical to the first visit" in out
+    # kept, not dropped: show inputs lists them as ahead
+    assert "step 201: force DriveInit2.index True (ahead: applied when the run gets there)" in out
     assert (tmp_path / "t.jsonl").read_text().count("\n") == 1  # replayed to before run -> stopped
     assert "<svg" in (tmp_path / "d1.svg").read_text()
 
@@ -168,4 +169,4 @@ def test_continue_runs_on_as_run_does(tmp_path, capsys):
                                          "continue\ncontinue 20\nhelp continue\n")
     assert rc == 0, out
     assert "entered turn_fwd at chart tick 1" in out and "entered turn_back at chart tick" in out
-    assert "continue [SECONDS]: the same as run" in out
+    assert "continue [TIME]: the same as run" in out

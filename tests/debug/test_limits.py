@@ -61,7 +61,7 @@ def test_the_repl_refuses_run_1e12_in_one_line_and_goes_on(tmp_path: Path, capsy
     assert rc == 1
     assert f"error: run: 1e+12 s is {BOUND}" in out
     assert f"error: step: 1000000000000 control steps (1e+09 s) is {BOUND}" in out
-    assert "time is up at t = 0.0100 s, step 10" in out
+    assert "time is up at t = 0.010 s, step 10" in out
 
 
 def test_max_run_raises_the_bound_from_the_command_line(tmp_path: Path, capsys):

@@ -93,7 +93,7 @@ where
     for i, line in enumerate(lines):
         if line.startswith("error: "):
             assert lines[i - 1].startswith(PROMPT)
-    assert "done at t = 0.0030 s, step 3, chart tick 2" in out
+    assert "done at t = 0.003 s, step 3, chart tick 2" in out
     assert re.search(r"DriveInit1 +run > initialise > turn_fwd", out)
 
 
@@ -118,11 +118,12 @@ diagram DriveInit1 {svg}
     assert "DriveInit2.index = True (forced until release)" in out
     assert "step 199: set DriveInit1.stop True" in out and "step 201: force DriveInit2.index True" in out
     assert "released DriveInit2.index" in out
-    assert "replayed to step 201 (t = 0.2010 s, chart tick 101), 3 recorded inputs re-applied;" \
+    assert "replayed to step 201 (t = 0.201 s, chart tick 101), 3 recorded inputs re-applied;" \
            " identical to the first visit" in out
-    assert "replayed to step 199 (t = 0.1990 s, chart tick 100), 1 recorded input re-applied," \
-           " 2 later ones dropped; identical to the first visit" in out
-    assert out.count("step 201: force DriveInit2.index True") == 1  # dropped from the inputs
+    assert "replayed to step 199 (t = 0.199 s, chart tick 100), 1 recorded input re-applied," \
+           " 2 later ones kept (applied again when you run to their steps); identical to the first visit" in out
+    # kept, not dropped: show inputs lists them as ahead
+    assert "step 201: force DriveInit2.index True (ahead: applied when the run gets there)" in out
     assert (tmp_path / "t.jsonl").read_text().count("\n") == 1  # replayed to before run -> stopped
     assert "<svg" in (tmp_path / "d1.svg").read_text()
 
@@ -132,7 +133,7 @@ def test_standard_input_that_is_not_a_terminal_is_read_as_commands(monkeypatch, 
     assert main(["debug", "--seed", "2", "--start", "10,20,-30"]) == 0
     out = capsys.readouterr().out
     assert "seed 2, start (10.0, 20.0, -30.0, 0.0) deg" in out
-    assert "done at t = 0.0050 s, step 5, chart tick 3" in out
+    assert "done at t = 0.005 s, step 5, chart tick 3" in out
 
 
 def test_bad_options_are_one_line_cli_errors(capsys):
@@ -168,4 +169,4 @@ def test_continue_runs_on_as_run_does(tmp_path, capsys):
                                          "continue\ncontinue 20\nhelp continue\n")
     assert rc == 0, out
     assert "entered turn_fwd at chart tick 1" in out and "entered turn_back at chart tick" in out
-    assert "continue [SECONDS]: the same as run" in out
+    assert "continue [TIME]: the same as run" in out

@@ -28,14 +28,14 @@ def test_no_internal_exception_name_reaches_the_user(tmp_path: Path, capsys: pyt
         assert name not in out, out
     assert "Control: chart ticks 0..0" in out  # a window longer than the run: the whole run
     assert out.count("may not carry a datum named") == 2
-    assert "done at t = 0.0020 s, step 2" in out  # the robot runs on
+    assert "done at t = 0.002 s, step 2" in out  # the robot runs on
 
 
 def test_a_line_EOF_in_a_commands_file_is_an_unknown_command_not_the_end(  # noqa: N802
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     rc, out = _run(tmp_path, capsys, "step\nEOF\nstep\n")
     assert f"{PROMPT}EOF\nerror: unknown command 'EOF'" in out
-    assert "done at t = 0.0020 s, step 2" in out and out.rstrip().endswith("(end of commands)")
+    assert "done at t = 0.002 s, step 2" in out and out.rstrip().endswith("(end of commands)")
 
 
 def test_forcing_a_cell_beyond_the_field_is_refused_and_within_it_taken(dbg: Debugger) -> None:

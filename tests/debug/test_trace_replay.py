@@ -68,7 +68,7 @@ def test_replay_re_applies_inputs_at_their_step_and_drops_later_ones(dbg: Debugg
     assert all(np.array_equal(a, b) for a, b in zip(arrays, _twin_arrays(dbg), strict=True))
     assert dbg.forced == {("DriveInit2", "index"): True}
 
-    result = dbg.replay(250)  # before the second set and the force: those are dropped
+    result = dbg.replay(250, drop=True)  # before the second set and the force: those are dropped
     assert (result.applied, result.dropped, result.identical) == (1, 2, None)
     assert dbg.where()["DriveInit1"] == ["stopped"] and dbg.forced == {}
     assert dbg.robot.value("DriveInit1", "stop") is True

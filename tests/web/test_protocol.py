@@ -425,3 +425,17 @@ def test_the_robots_objects_are_kept_out_of_the_collectors_passes_while_a_sessio
     finally:
         s.stop()
     assert gc.get_freeze_count() == 0
+
+
+def test_the_slider_keeps_the_inputs_given_after_its_tick_unless_told_to_drop_them(client: Any) -> None:
+    """As ``replay`` and ``replay --drop`` in ttt-sm debug: going back does not lose the future you gave."""
+    with client.websocket_connect("/ws") as ws:
+        page = Page(ws)
+        page.join()
+        assert page.answer(page.send(type="tick", n=3))["ok"]
+        assert page.answer(page.send(type="set", chart="DriveInit1", name="stop", value=False))["ok"]
+        assert page.answer(page.send(type="tick", n=2))["ok"]
+        kept = page.answer(page.send(type="replay", tick=1))
+        assert kept["ok"] and "later one kept" in kept["text"] and "dropped" not in kept["text"], kept
+        dropped = page.answer(page.send(type="replay", tick=1, drop=True))
+        assert dropped["ok"] and "later one dropped" in dropped["text"] and "kept" not in dropped["text"], dropped

@@ -123,6 +123,8 @@ class Debugger:
             return self.robot
 
         names = RobotNames(now)
+        #: The charts' data and the robot's signals by name (what conditions and ``display`` read).
+        self.names = names
         self.trace_keep = trace_keep
         #: The file the whole trace streams to (None: the kept transitions only).
         self.trace_file: RecordFile | None = None
@@ -135,6 +137,7 @@ class Debugger:
         self.history = History(now, forced)
         self.inputs = Inputs(now, names, self.history, forced)
         self.stepper = Stepper(now, self.breakpoint_table, self.watch, self.history.remember, float(max_run_s))
+        self.stepper.ahead, self.stepper.apply_due = self.inputs.ahead, self.inputs.apply_due
         #: The breakpoints, in the order they were added.
         self.breakpoints: list[Breakpoint] = self.breakpoint_table.items
         #: What the user did (inputs set, forced, released, events posted), in order, for replay.
@@ -251,29 +254,51 @@ class Debugger:
             old.close()  # its record ends (as interrupted, unless the game ended)
         self.recipe = recipe
         self.actions.clear()
+        self.inputs.ahead.clear()
         self.forced.clear()
         self._attach(recipe.build())
         self.watch.mark("start_over")  # the trace goes on: the transitions after this mark are the new run's
         self.history.restart()
         self.breakpoint_table.rearm()
 
-    def replay(self, tick: int) -> ReplayResult:
+    def replay(self, tick: int, *, drop: bool = False) -> ReplayResult:
         """Rebuild the robot and run it to chart ``tick``, re-applying the recorded inputs.
 
         It stops where a breakpoint at that tick stops: right after the control
         step holding the tick (:meth:`~.history.History.steps_of_tick`).  Inputs
-        and events recorded after that point are dropped (the session continues
-        from the replayed past).  Breakpoints do not hit during a replay; the
-        trace is recorded anew.
+        and events recorded after that point are kept and applied again when a
+        run reaches their control steps (the future you gave is not lost);
+        ``drop``: they are dropped instead.  Breakpoints do not hit during a
+        replay; the trace is recorded anew.
         """
         if not isinstance(tick, int) or tick < 0:
             raise DebugError(f"replay: the chart tick must be a whole number >= 0, got {tick!r}")
         if self.steps_of_tick(tick) > self.history.furthest_steps:
             raise DebugError(f"replay: chart tick {tick} lies beyond where this session has been (chart tick"
                              f" {self.furthest_tick}); replay goes back, run goes forward")
-        return self.replay_to_step(self.steps_of_tick(tick))
+        return self.replay_to_step(self.steps_of_tick(tick), drop=drop)
 
-    def replay_to_step(self, steps: int) -> ReplayResult:
+    def back(self, ticks: int = 1) -> ReplayResult:
+        """Go back ``ticks`` chart ticks (a replay): to right after the chart tick ``ticks`` before the
+        last one run (right after the last one, if the robot has stepped past it since)."""
+        if not isinstance(ticks, int) or ticks < 1:
+            raise DebugError(f"back: the count must be a whole number >= 1, got {ticks!r}")
+        now = self.robot.chart_ticks
+        target = now - ticks if self.robot.steps <= self.steps_of_tick(now) else now - ticks + 1
+        if target < 0:
+            raise DebugError(f"back: {ticks} chart tick{'s' if ticks != 1 else ''} back is before power-on"
+                             f" (the robot is at chart tick {now})")
+        return self.replay(target)
+
+    def step_back(self, steps: int = 1) -> ReplayResult:
+        """Go back ``steps`` control steps (a replay)."""
+        if not isinstance(steps, int) or steps < 1:
+            raise DebugError(f"step back: the count must be a whole number >= 1, got {steps!r}")
+        if steps > self.robot.steps:
+            raise DebugError(f"step -{steps}: that is before power-on (the robot is at step {self.robot.steps})")
+        return self.replay_to_step(self.robot.steps - steps)
+
+    def replay_to_step(self, steps: int, *, drop: bool = False) -> ReplayResult:
         """:meth:`replay` to any control step count (a position between two ticks, too)."""
         if self.recipe is None:
             raise DebugError("replay needs the robot's recipe: build with Debugger.build(...) or"
@@ -292,8 +317,10 @@ class Debugger:
             raise DebugError(f"replay: it would run {seconds:g} s of simulated time again from power-on (to control"
                              f" step {steps}), beyond the {limit:g} s one command runs (start the debugger with"
                              f" --max-run SECONDS to allow more)")
-        kept = [a for a in self.actions if a.steps <= steps]
-        dropped = len(self.actions) - len(kept)
+        given = [*self.actions, *self.inputs.ahead]
+        kept = [a for a in given if a.steps <= steps]
+        later = [a for a in given if a.steps > steps]
+        self.inputs.ahead.clear()
         self.forced.clear()
         old = game_of(self.robot)
         if old is not None and old.record.attached:
@@ -305,7 +332,10 @@ class Debugger:
             self.watch.mark("replay", actions=len(kept))
         self.stepper.note_game()
         self.actions[:] = kept
-        identical, diffs = self.history.arrived(steps, dropped > 0)
+        if not drop:
+            self.inputs.ahead.extend(later)
+        identical, diffs = self.history.arrived(steps, drop and bool(later))
         self.breakpoint_table.rearm()
         robot = self.robot
-        return ReplayResult(robot.chart_ticks, robot.steps, robot.t, len(kept), dropped, identical, diffs)
+        return ReplayResult(robot.chart_ticks, robot.steps, robot.t, len(kept), len(later) if drop else 0,
+                            identical, diffs, ahead=0 if drop else len(later))

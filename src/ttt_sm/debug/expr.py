@@ -47,6 +47,15 @@ class Condition:
     names: Names = field(repr=False)
     _evaluate: Callable[[], Any] = field(repr=False, compare=False)
 
+    def value(self) -> Any:
+        """The expression's value now (a number or a flag), as ``display`` shows it."""
+        try:
+            return self._evaluate()
+        except ExprError as exc:
+            raise DebugError(f"cannot be evaluated: {exc.message}") from None
+        except TypeError as exc:
+            raise DebugError(f"cannot be evaluated: {exc}") from None
+
     def evaluate(self, names: Names | None = None) -> bool:
         # Bound once at parse time: a condition is evaluated after every chart tick.
         evaluate = self._evaluate if names is None or names is self.names else _bind(self.expression, names)

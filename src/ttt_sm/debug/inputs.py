@@ -7,6 +7,7 @@ a replay applies them again at the same steps (:meth:`Inputs.apply`).
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Callable
 from typing import Any
 
@@ -44,6 +45,9 @@ class Inputs:
         self._history = history
         #: What the user did, in order: a replay applies them again at their control steps.
         self.actions: list[Action] = []
+        #: Inputs given after the control step a replay went back to, in order: applied again when
+        #: the run reaches their steps (:meth:`apply_due`), so going back keeps the future you gave.
+        self.ahead: deque[Action] = deque()
         self.forced = forced
 
     def datum_decl(self, chart: str, name: str) -> Data:
@@ -122,6 +126,15 @@ class Inputs:
                 robot.post(action.chart, action.name, **action.data)
         except (RobotError, UnknownEventError) as exc:
             raise DebugError(str(exc)) from None
+
+    def apply_due(self, steps: int) -> None:
+        """Apply the inputs :attr:`ahead` whose control step is ``steps`` (or earlier), and record them."""
+        ahead = self.ahead
+        while ahead and ahead[0].steps <= steps:
+            action = ahead.popleft()
+            self.apply(action)
+            self.actions.append(action)
+        self._names.forget()
 
     def _do(self, action: Action) -> None:
         """Apply an action and record it (a refused one raises and is not recorded)."""

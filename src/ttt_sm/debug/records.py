@@ -61,7 +61,7 @@ class StopReason:
         return self.hits[0] if self.hits else None
 
     def describe(self) -> str:
-        where = f"t = {self.t:.4f} s, step {self.steps}, chart tick {self.chart_ticks}"
+        where = f"t = {self.t:.3f} s, step {self.steps}, chart tick {self.chart_ticks}"
         if self.kind == "breakpoint":
             return f"stopped at {where}: " + "; ".join(h.describe() for h in self.hits)
         if self.kind == "game":

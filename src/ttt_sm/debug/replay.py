@@ -165,12 +165,17 @@ class ReplayResult:
     dropped: int
     identical: bool | None
     differences: tuple[str, ...] = ()
+    #: Later inputs kept: applied again when a run reaches their control steps.
+    ahead: int = 0
 
     def describe(self) -> str:
-        text = f"replayed to step {self.steps} (t = {self.t:.4f} s, chart tick {self.tick})," \
+        text = f"replayed to step {self.steps} (t = {self.t:.3f} s, chart tick {self.tick})," \
                f" {self.applied} recorded input{'s' if self.applied != 1 else ''} re-applied"
         if self.dropped:
             text += f", {self.dropped} later one{'s' if self.dropped != 1 else ''} dropped"
+        if self.ahead:
+            text += (f", {self.ahead} later one{'s' if self.ahead != 1 else ''} kept (applied again when"
+                     " you run to {})".format("their steps" if self.ahead != 1 else "its step"))
         if self.identical is True:
             text += "; identical to the first visit"
         elif self.identical is False:

@@ -24,6 +24,7 @@ from ..runtime.jsonable import dumps
 from . import views
 from .debugger import Debugger
 from .errors import DebugError
+from .expr import Condition, parse_condition
 
 PROMPT = "(ttt-sm) "
 #: What a command may raise for a request it cannot take: printed as one ``error:`` line.
@@ -51,6 +52,23 @@ def _seconds(arg: str, what: str, default: float) -> float:
         raise DebugError(f"{what}: expected simulated seconds, got {arg.strip()!r}") from None
 
 
+def _duration(arg: str, what: str, default: float, tick_s: float) -> float:
+    """Simulated seconds from ``0.5``, ``0.5s``, ``500ms`` or ``250 ticks`` (chart ticks of ``tick_s``)."""
+    text = arg.strip().lower()
+    if not text:
+        return default
+    number, factor = text, 1.0
+    for suffix, scale in (("ticks", tick_s), ("tick", tick_s), ("ms", 1e-3), ("s", 1.0)):
+        if text.endswith(suffix):
+            number, factor = text[:-len(suffix)].strip(), scale
+            break
+    try:
+        return float(number) * factor
+    except ValueError:
+        raise DebugError(f"{what}: expected simulated time, e.g. {what} 0.5 (seconds), {what} 0.5s,"
+                         f" {what} 500ms or {what} 250 ticks; got {arg.strip()!r}") from None
+
+
 def _chart_dot(arg: str, what: str) -> tuple[str, str]:
     chart, dot, name = arg.partition(".")
     if not dot or not chart or not name or " " in name:
@@ -74,6 +92,9 @@ class DebugShell(cmd.Cmd):
         #: The command running now (None between commands): where an interrupted session stood.
         self.command: str | None = None
         self._trace_failure_told = False
+        #: ``display``: expressions shown after each stop, by number.
+        self.displays: dict[int, Condition] = {}
+        self._next_display = 1
 
     # -- plumbing -----------------------------------------------------------------
 
@@ -181,26 +202,89 @@ class DebugShell(cmd.Cmd):
 
     # -- running ------------------------------------------------------------------
 
+    def _tick_s(self) -> float:
+        control = self.dbg.robot.params.control
+        return float(control.chart_divider * control.dt)
+
+    def stopped(self, lines: Iterable[str]) -> None:
+        """What a command that moved the robot says: its lines, then the ``display`` expressions."""
+        self.say(*lines, *self.display_lines())
+
     def do_run(self, arg: str) -> None:
-        """run [SECONDS]: run until a breakpoint hits or SECONDS pass (default 60); Ctrl-C pauses.
-        SECONDS are simulated seconds; the run stops between two control steps."""
-        self.say(*views.stop_lines(self.dbg.run(_seconds(arg, "run", 60.0))))
+        """run [TIME]: run until a breakpoint hits or TIME passes (default 60 s); Ctrl-C pauses.
+        TIME is simulated: 0.5 or 0.5s (seconds), 500ms, 250 ticks (chart ticks, 2 ms each);
+        the run stops between two control steps."""
+        self.stopped(views.stop_lines(self.dbg.run(_duration(arg, "run", 60.0, self._tick_s()))))
 
     def do_continue(self, arg: str) -> None:
-        """continue [SECONDS]: the same as run: on from here until a breakpoint (default 60 s)."""
+        """continue [TIME]: the same as run: on from here until a breakpoint (default 60 s)."""
         self.do_run(arg)
 
     def do_step(self, arg: str) -> None:
-        """step [N]: run N control steps (default 1; a chart tick starts every second one)."""
-        self.say(*views.stop_lines(self.dbg.step(_count(arg, "step"))))
+        """step [N]: run N control steps (default 1; a chart tick starts every second one);
+        step -N: go N control steps back (a replay, as back)."""
+        n = _count(arg, "step")
+        if n < 0:
+            self.stopped([self.dbg.step_back(-n).describe()])
+            return
+        self.stopped(views.stop_lines(self.dbg.step(n)))
+
+    def do_back(self, arg: str) -> None:
+        """back [N]: go N chart ticks back (default 1): a replay to right after that tick.
+        The inputs you gave later are kept and applied again when you run forward."""
+        self.stopped([self.dbg.back(_count(arg, "back")).describe()])
 
     def do_tick(self, arg: str) -> None:
         """tick [N]: run up to and through the next N chart ticks (default 1)."""
-        self.say(*views.stop_lines(self.dbg.tick(_count(arg, "tick"))))
+        self.stopped(views.stop_lines(self.dbg.tick(_count(arg, "tick"))))
 
     def do_next(self, arg: str) -> None:
-        """next [SECONDS]: run until any chart takes a transition (at most SECONDS, default 10)."""
-        self.say(*views.stop_lines(self.dbg.next(_seconds(arg, "next", 10.0))))
+        """next [TIME]: run until any chart takes a transition (at most TIME, default 10 s; units as run)."""
+        self.stopped(views.stop_lines(self.dbg.next(_duration(arg, "next", 10.0, self._tick_s()))))
+
+    # -- display ------------------------------------------------------------------
+
+    def do_display(self, arg: str) -> None:
+        """display EXPR: show EXPR after every stop (run, step, tick, next, back, replay);
+        display alone shows them now.  EXPR as in break when: DriveInit1.pos_out, q_true[1],
+        DriveInit1.pos_out - DriveInit1.pos_Encoder, DriveInit1.index and not DriveInit1.stop.
+        watch is the same command; undisplay N removes one."""
+        if not arg.strip():
+            self.say(*(self.display_lines() or ["  (nothing displayed: display EXPR adds one)"]))
+            return
+        condition = parse_condition(arg, self.dbg.names)
+        n = self._next_display
+        self._next_display += 1
+        self.displays[n] = condition
+        self.say(*self._display_line(n, condition))
+
+    do_watch = do_display
+
+    def do_undisplay(self, arg: str) -> None:
+        """undisplay N... | undisplay all: stop showing display expressions."""
+        if arg.strip() == "all":
+            self.displays.clear()
+            self.say("nothing displayed now")
+            return
+        for n in self._ids(arg, "undisplay"):
+            if self.displays.pop(n, None) is None:
+                raise DebugError(f"undisplay: no display {n}; displays: "
+                                 f"{', '.join(map(str, self.displays)) or 'none'}")
+            self.say(f"display {n} removed")
+
+    def display_lines(self) -> list[str]:
+        return [line for n, c in self.displays.items() for line in self._display_line(n, c)]
+
+    def _display_line(self, n: int, condition: Condition) -> list[str]:
+        try:
+            value = condition.value()
+        except DebugError as exc:
+            return [f"  {n}: {condition.text} = ? ({exc})"]
+        chart, dot, name = condition.text.partition(".")
+        unit = ""
+        if dot and chart in self.dbg.robot.charts and name.isidentifier():
+            unit = self.dbg.datum_decl(chart, name).unit
+        return [f"  {n}: {condition.text} = {views.fmt_value(value, unit)}"]
 
     # -- breakpoints --------------------------------------------------------------
 
@@ -296,7 +380,8 @@ class DebugShell(cmd.Cmd):
         elif what == "breakpoints":
             self.say(*views.breakpoint_lines(self.dbg.breakpoints))
         elif what == "inputs":
-            self.say(*views.action_lines(self.dbg.actions))
+            self.say(*views.action_lines(self.dbg.actions),
+                     *(f"  {a.describe()} (ahead: applied when the run gets there)" for a in self.dbg.inputs.ahead))
         elif what == "snapshot":
             self.say(dumps(self.dbg.robot.snapshot(), sort_keys=True))
         else:
@@ -385,20 +470,86 @@ class DebugShell(cmd.Cmd):
         self.say(f"posted {words[1]} to {words[0]}; handled at its next tick")
 
     def do_replay(self, arg: str) -> None:
-        """replay TICK | replay step N: rebuild the robot and run it again to chart tick TICK.
+        """replay TICK | replay step N [--drop]: rebuild the robot and run it again to chart tick TICK.
         The robot is rebuilt from its parameters, seed and start pose; the inputs you set,
-        forced and posted up to there are re-applied at the same control steps (later ones
-        are dropped), and the state reached is compared with the one the session saw there
-        before: configurations, chart data and twin state, float for float."""
+        forced and posted up to there are re-applied at the same control steps, and the state
+        reached is compared with the one the session saw there before: configurations, chart
+        data and twin state, float for float.  The inputs you gave after it are kept: a run
+        forward applies them again at their steps (show inputs lists them as ahead);
+        --drop drops them instead."""
         words = arg.split()
+        drop = "--drop" in words
+        words = [w for w in words if w != "--drop"]
         if not words:
             raise DebugError("replay: to which chart tick? e.g. replay 1510 (or replay step 3021)")
         if words[0] == "step":
             if len(words) != 2:
                 raise DebugError("replay step: which control step? e.g. replay step 3021")
-            self.say(self.dbg.replay_to_step(_count(words[1], "replay step")).describe())
+            self.stopped([self.dbg.replay_to_step(_count(words[1], "replay step"), drop=drop).describe()])
             return
-        self.say(self.dbg.replay(_count(arg, "replay")).describe())
+        if len(words) != 1:
+            raise DebugError(f"replay: expected TICK [--drop], got {arg.strip()!r}")
+        self.stopped([self.dbg.replay(_count(words[0], "replay"), drop=drop).describe()])
+
+    # -- completion (Tab, on a terminal) ---------------------------------------------------
+
+    def _states(self) -> list[str]:
+        index = self.dbg.watch.index
+        return [f"{c}.{s}" for c in self.dbg.chart_names for s in index.states(c)]
+
+    def _data(self, inputs_only: bool = False) -> list[str]:
+        out = []
+        for name, chart in self.dbg.robot.charts.items():
+            out += [f"{name}.{d.name}" for d in chart.declarations() if not inputs_only or d.kind == "input"]
+        return out
+
+    def _events(self) -> list[str]:
+        index = self.dbg.watch.index
+        return [f"{c}.{e}" for c in self.dbg.chart_names for e in index.events(c)]
+
+    @staticmethod
+    def _matching(text: str, names: Iterable[str]) -> list[str]:
+        return [n for n in names if n.startswith(text)]
+
+    def complete_break(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
+        """Tab: the kind, then Chart.state (enter, exit), Chart.event, Chart.datum (when), a state (transition)."""
+        words = line[:begidx].split()
+        if len(words) <= 1:
+            return self._matching(text, ("enter", "exit", "transition", "event", "when"))
+        kind = words[1]
+        if kind in ("enter", "exit"):
+            return self._matching(text, self._states())
+        if kind == "event":
+            return self._matching(text, self._events())
+        if kind == "when":
+            return self._matching(text, self._data())
+        if kind == "transition":
+            if len(words) == 2:
+                return self._matching(text, self.dbg.chart_names)
+            return self._matching(text, [*self.dbg.watch.index.states(words[2]), "*"]) \
+                if words[2] in self.dbg.chart_names else []
+        return []
+
+    def complete_display(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
+        return self._matching(text, self._data())
+
+    complete_watch = complete_display
+
+    def complete_set(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
+        return self._matching(text, self._data(inputs_only=True)) if len(line[:begidx].split()) <= 1 else []
+
+    complete_force = complete_release = complete_set
+
+    def complete_show(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
+        words = line[:begidx].split()
+        if len(words) <= 1:
+            return self._matching(text, _SHOW)
+        return self._matching(text, self.dbg.chart_names) if words[1] in ("data", "timeline") else []
+
+    def complete_diagram(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
+        return self._matching(text, self.dbg.chart_names) if len(line[:begidx].split()) <= 1 else []
+
+    complete_post = complete_diagram
 
     # -- leaving ----------------------------------------------------------------------
 

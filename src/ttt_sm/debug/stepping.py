@@ -59,6 +59,10 @@ class Stepper:
         self.progress: Callable[[float, float], None] | None = None
         self._pause = threading.Event()
         self._game_stopped = False
+        #: Inputs waiting for their control step (a replay went back before them), oldest first, and
+        #: what applies the due ones (:meth:`~.inputs.Inputs.apply_due`); set by the debugger.
+        self.ahead: deque[Action] = deque()
+        self.apply_due: Callable[[int], None] | None = None
 
     def note_game(self) -> None:
         """Take the game as it stands: a run stops for an error of its flow that happens from now on."""
@@ -151,8 +155,11 @@ class Stepper:
         report_every = max(1, int(round(PROGRESS_EVERY_S / dt)))
         t_end = robot.t + max_steps * dt
         game_error_now = self._game_error_now
+        ahead, apply_due = self.ahead, self.apply_due
         with self._sigint_pauses():
             for done in range(1, max_steps + 1):
+                if ahead and apply_due is not None and ahead[0].steps <= robot.steps:
+                    apply_due(robot.steps)
                 ticking = robot.steps % divider == 0
                 pending = [[e for e, _ in c.pending_events] for c in charts] \
                     if ticking and watch_events else None

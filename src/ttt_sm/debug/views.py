@@ -81,7 +81,7 @@ def _vector(values: Sequence[Any], unit: str | tuple[str, ...]) -> str:
 def where_lines(dbg: Debugger) -> list[str]:
     """Time and each chart's active configuration (outermost state first)."""
     robot = dbg.robot
-    lines = [f"t = {robot.t:.4f} s, step {robot.steps}, chart tick {robot.chart_ticks}"
+    lines = [f"t = {robot.t:.3f} s, step {robot.steps}, chart tick {robot.chart_ticks}"
              + (", initialised" if robot.initialised else "")]
     width = max(len(n) for n in robot.charts)
     for name, states in dbg.where().items():
@@ -249,9 +249,11 @@ def signal_text(name: str, value: Any) -> str:
 
 
 def record_line(r: TraceRecord) -> str:
-    """One transition: chart tick, chart time (ticks x period, the trace's ``time_s``), what."""
-    t = f" (chart time {r.time_s:.3f} s)" if r.time_s is not None else ""
-    return f"  tick {r.tick}{t}  {r.chart}: {r.source} -> {r.target}  [{r.trigger}]"
+    """One transition: the chart tick it was taken in, and what.
+
+    No second clock beside the ``t`` a stop prints (the simulated time): the
+    chart's own clock (the trace's ``time_s``) is in the trace file."""
+    return f"  tick {r.tick}  {r.chart}: {r.source} -> {r.target}  [{r.trigger}]"
 
 
 def trace_lines(records: Sequence[TraceRecord], last: int = 10) -> list[str]:

@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 from ...debug.errors import DebugError
-from ..fields import identifier, integer, number, optional
+from ..fields import flag, identifier, integer, number, optional
 from .spec import Cockpit, Reply, command
 
 
-@command("replay", tick=integer(0, 10**9))
-def replay(session: Cockpit, cid: int, tick: int) -> Reply:
-    """Go back (or forward, as far as the run has been) to chart tick ``tick``: the run replayed from power-on."""
+@command("replay", tick=integer(0, 10**9), drop=optional(flag, False))
+def replay(session: Cockpit, cid: int, tick: int, drop: bool) -> Reply:
+    """Go back (or forward, as far as the run has been) to chart tick ``tick``: the run replayed from power-on.
+
+    The inputs given after ``tick`` are kept and applied again when the run reaches them (as ``replay`` in
+    ``ttt-sm debug``); ``drop``: they are dropped (``replay --drop``)."""
     dbg = session.debugger
     if tick > dbg.furthest_tick:
         raise DebugError(f"replay: chart tick {tick} lies beyond where this session has been (chart tick"
@@ -19,7 +22,7 @@ def replay(session: Cockpit, cid: int, tick: int) -> Reply:
                          "hits": []}
     session.publish()
     with session.robot_replaced(replaying=True):
-        result = dbg.replay(tick)
+        result = dbg.replay(tick, drop=drop)
     session.last_stop = {"kind": "replay", "text": result.describe(), "tick": result.tick, "hits": []}
     return {"text": result.describe(), "identical": result.identical}
 

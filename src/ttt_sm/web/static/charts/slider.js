@@ -1,5 +1,6 @@
 // The time slider: back to any chart tick the run has passed (a replay from power-on, same seed,
-// same inputs), or forward as far as it has been.
+// same inputs), or forward as far as it has been.  The inputs given after that tick are kept and
+// applied again when the run reaches them, or dropped when "drop my later inputs" is ticked.
 
 import { role } from "../dom.js";
 
@@ -12,7 +13,7 @@ export class TimeSlider {
     const form = role("slider-form");
     const replay = () => {
       form.dataset.dragging = "false";
-      link.send({ type: "replay", tick: Number(slider.value) });
+      link.send({ type: "replay", tick: Number(slider.value), drop: role("replay-drop").checked });
     };
     slider.addEventListener("input", (e) => {
       form.dataset.dragging = "true";

@@ -142,11 +142,8 @@ def staircase_poses(spec: StaircaseSpec, frm: tuple[float, float, float, float],
     Returns the poses, the tick the pre-roll starts at and the tick of each stair.
     """
     start = np.array([*spec.start, 0.0])
-    here = np.asarray(frm, dtype=float)
-    dist = float(np.linalg.norm(start[:3] - here[:3]))
-    n_app = max(1, int(math.ceil(dist / APPROACH_M_S / chart_dt)))
-    frac = np.linspace(0.0, 1.0, n_app + 1)[1:, None]
-    approach = here + frac * (start - here)
+    approach = _approach(np.asarray(frm, dtype=float), start, chart_dt)
+    n_app = len(approach)
     settle = int(round(PRE_ROLL_S / chart_dt))
     hold = int(round(spec.hold_s / chart_dt))
     rows = [approach, np.repeat(start[None, :], settle, axis=0)]
@@ -297,6 +294,144 @@ def clearance_bound_m(params: ArmParams, q: np.ndarray, axis: np.ndarray, spec: 
     return float(row @ np.asarray(play)) + spec.resolution_m + 4 * spec.noise_m
 
 
+class StaircaseStage(PathStage):
+    """Task stage that plays a staircase's poses and switches its recorder on for the pre-roll and the stairs.
+
+    After the stairs it plays the way back to where the tool started (when
+    ``back`` was asked for, :meth:`Staircase.start`) and then sends nothing
+    more: the Control chart's pose stands again.  A Safety trip ends it at
+    once (the arm is held; no pose of a staircase moves it afterwards).
+    """
+
+    def __init__(self, robot: Robot, poses: np.ndarray, first: int, end: int, recorder: StairRecorder) -> None:
+        super().__init__(poses)
+        self.robot = robot
+        self.first, self.end = first, end
+        self.recorder = recorder
+        #: The simulated time the recording began at (the pre-roll's last tick), or None before.
+        self.t_start: float | None = None
+        self.aborted = False
+
+    @property
+    def recorded(self) -> bool:
+        """True once the stairs are recorded whole (the way back may still be played)."""
+        return self.index >= self.end and not self.aborted
+
+    def tick(self, signals: Signals) -> None:
+        if self.index == self.end:
+            self.recorder.on = False
+        if self.done:
+            return
+        if self.robot.tripped:
+            self.recorder.on, self.aborted, self.index = False, True, len(self.samples)
+            return
+        if self.index == self.first - 1:
+            self.recorder.on, self.t_start = True, signals.t
+        super().tick(signals)
+
+
+class Staircase:
+    """The staircase of section 3.5 on a robot that waits in ``wait_1``: its stage, its recorder, its measurement.
+
+    :meth:`start` puts a :class:`StaircaseStage` after the Control chart's task
+    stage (its pose wins while it plays) and a :class:`StairRecorder` last
+    among the joint stages; :meth:`result` measures what was recorded.
+    ``ttt-sm precision staircase`` (:func:`run_staircase`) and the Operational
+    page's "Staircase" both run it so.
+    """
+
+    def __init__(self, robot: Robot, spec: StaircaseSpec, tuning: str, seed: int = 0,
+                 mount: SensorMount | None = None, sensor_spec: SensorSpec | None = None) -> None:
+        if robot.truth is None:
+            raise PrecisionError("the staircase is measured with a triangulation sensor on the simulated arm's"
+                                 " true tool; this arm has none (run it on the simulated arm)")
+        self.robot, self.spec, self.tuning, self.seed = robot, spec, tuning, seed
+        self.sensor_spec = sensor_spec or SensorSpec()
+        self.sensor = TriangulationSensor(mount or spec.default_mount(), self.sensor_spec, seed=seed + 1)
+        self.axis = axis_vector(spec.axis)
+        self.recorder = StairRecorder(robot, robot.truth, self.sensor, self.axis)
+        self.stage: StaircaseStage | None = None
+        self.ticks: list[int] = []
+        self.wall0 = time.perf_counter()
+
+    def start(self, back: bool = False) -> StaircaseStage:
+        """Play it from the Control chart's pose now (``back``: and return there after the stairs)."""
+        robot = self.robot
+        c = robot.control
+        here = (c.X_out, c.Y_out, c.Z_out, c.phi)
+        chart_dt = robot.params.control.chart_dt
+        poses, first, self.ticks = staircase_poses(self.spec, here, chart_dt)
+        end = len(poses)
+        if back:
+            poses = np.vstack([poses, _approach(poses[-1], np.asarray(here, dtype=float), chart_dt)])
+        self.stage = StaircaseStage(robot, poses, first, end, self.recorder)
+        robot.sched.task_stages[:] = [s for s in robot.sched.task_stages
+                                      if not (isinstance(s, StaircaseStage) and s.done)]
+        robot.sched.task_stages.append(self.stage)  # after the Control chart's stage: its pose wins
+        robot.sched.joint_stages.append(self.recorder)
+        return self.stage
+
+    @property
+    def chart_ticks(self) -> int:
+        """Chart ticks the staircase plays (its approach, pre-roll, stairs and way back)."""
+        return 0 if self.stage is None else len(self.stage.samples)
+
+    def finish(self) -> None:
+        """Take the recorder off the robot (the stage sends nothing once done)."""
+        self.recorder.on = False
+        stages = self.robot.sched.joint_stages
+        if self.recorder in stages:
+            stages.remove(self.recorder)
+
+    def result(self) -> StaircaseResult:
+        """The three comparisons and their parts, per stair, of what was recorded."""
+        stage = self.stage
+        if stage is None or stage.t_start is None or not stage.recorded:
+            raise PrecisionError("the staircase was not played to its last stair"
+                                 + (f": the Safety chart tripped ({self.robot.safety.reason})"
+                                    if stage is not None and stage.aborted else ""))
+        robot, spec, rec = self.robot, self.spec, self.recorder.record
+        params = robot.params
+        chart_dt = params.control.chart_dt
+        t_start, first = stage.t_start, stage.first
+        t = np.asarray(rec.t)
+        a = AXES.index(spec.axis)
+        series = {
+            "desired": np.asarray(rec.desired)[:, a], "fk": np.asarray(rec.fk)[:, a],
+            "true": np.asarray(rec.true)[:, a],
+            "sensor": np.array([math.nan if v is None else v for v in rec.sensor]),
+        }
+        stair_times = [t_start + (k - first) * chart_dt for k in self.ticks]
+        tg = params.true_geometry
+        q_enc = np.asarray(rec.q_encoder)
+        series["fk_as_built"] = np.array([fk(q, tg)[a] for q in q_enc])
+        errors = {name: step_errors(t, series[p] - series[m], stair_times, spec.hold_s)
+                  for name, (p, m) in {**COMPARISONS, **PARTS}.items()}
+        summary = {name: _summary(v) for name, v in errors.items()}
+        sspec, sensor = self.sensor_spec, self.sensor
+        bound = max(clearance_bound_m(params, q, self.axis, sspec) for q in q_enc[:: max(1, len(q_enc) // 50)])
+        result = StaircaseResult(
+            axis=spec.axis, steps=spec.steps, tuning=self.tuning, step_mm=spec.step_m * 1e3, stairs=spec.count,
+            hold_s=spec.hold_s, seed=self.seed, thesis_figure=THESIS_FIGURE.get((spec.axis, spec.steps)),
+            sensor={"origin_m": list(sensor.mount.origin), "beam": list(sensor.mount.beam),
+                    "range_m": [sspec.range_min_m, sspec.range_max_m], "resolution_m": sspec.resolution_m,
+                    "noise_m": sspec.noise_m},
+            errors=errors, summary=summary, clearance_bound_mm=round(bound * 1e3, 4),
+            sensor_out_of_range=int(sum(v is None for v in rec.sensor)), samples=len(t),
+            sim_time_s=round(robot.t, 3), wall_time_s=round(time.perf_counter() - self.wall0, 3), reading=[],
+            t=t - t_start, series=series, stair_times=tuple(s - t_start for s in stair_times),
+        )
+        return _with_reading(result)
+
+
+def _approach(frm: np.ndarray, to: np.ndarray, chart_dt: float) -> np.ndarray:
+    """Poses from `frm` to `to` (x, y, z, phi), one per chart tick, at :data:`APPROACH_M_S` at most."""
+    dist = float(np.linalg.norm(to[:3] - frm[:3]))
+    n = max(1, int(math.ceil(dist / APPROACH_M_S / chart_dt)))
+    frac = np.linspace(0.0, 1.0, n + 1)[1:, None]
+    return frm + frac * (to - frm)
+
+
 def run_staircase(params: ArmParams, axis: str, steps: str, tuning: str = "ours", seed: int = 0,
                   count: int = STAIRS, hold_s: float = HOLD_S, mount: SensorMount | None = None,
                   sensor_spec: SensorSpec | None = None) -> StaircaseResult:
@@ -320,62 +455,23 @@ def run_staircase(params: ArmParams, axis: str, steps: str, tuning: str = "ours"
     mount, sensor_spec : optional
         The sensor's pose (default :meth:`StaircaseSpec.default_mount`) and its data (the thesis').
     """
-    wall0 = time.perf_counter()
     spec = StaircaseSpec.of(axis, steps, count, hold_s)
     if tuning not in PRESETS:
         raise PrecisionError(f"unknown tuning {tuning!r}; choose from {', '.join(PRESETS)}")
-    e = axis_vector(axis)
     # the arm initialises with the designed gains and runs the preset's once initialised (PresetGainsStage)
-    params = replace(params, tuning=Tuning(tuning))
-    robot = Robot(params, seed=seed)
-    assert robot.truth is not None and robot.sim is not None
-    sspec = sensor_spec or SensorSpec()
-    sensor = TriangulationSensor(mount or spec.default_mount(), sspec, seed=seed + 1)
-    recorder = StairRecorder(robot, robot.truth, sensor, e)
-    robot.sched.joint_stages.append(recorder)
+    robot = Robot(replace(params, tuning=Tuning(tuning)), seed=seed)
+    staircase = Staircase(robot, spec, tuning, seed, mount, sensor_spec)
     if not robot.run_until(lambda: robot.initialised, 40.0):
         raise PrecisionError("the drives did not initialise within 40 s")
     c = robot.control
     if not robot.run_until(lambda: not c.busy, 40.0):
         raise PrecisionError("the Control chart did not reach wait_1 within 40 s")
-    chart_dt = params.control.chart_dt
-    poses, first, ticks = staircase_poses(spec, (c.X_out, c.Y_out, c.Z_out, c.phi), chart_dt)
-    robot.sched.task_stages.append(PathStage(poses))  # after the Control chart's stage: its pose wins
-    robot.run_until(lambda: False, (first - 1) * chart_dt)
-    recorder.on = True
-    t_start = robot.t
-    robot.run_until(lambda: False, (len(poses) - first + 1) * chart_dt)
-    recorder.on = False
+    stage = staircase.start()
+    robot.run_until(lambda: stage.recorded, (staircase.chart_ticks + 1) * params.control.chart_dt)
+    staircase.finish()
     if robot.tripped:
         raise PrecisionError(f"the Safety chart tripped during the staircase: {robot.safety.reason}")
-    rec = recorder.record
-    t = np.asarray(rec.t)
-    a = AXES.index(axis)
-    series = {
-        "desired": np.asarray(rec.desired)[:, a], "fk": np.asarray(rec.fk)[:, a],
-        "true": np.asarray(rec.true)[:, a],
-        "sensor": np.array([math.nan if v is None else v for v in rec.sensor]),
-    }
-    stair_times = [t_start + (k - first) * chart_dt for k in ticks]
-    tg = params.true_geometry
-    q_enc = np.asarray(rec.q_encoder)
-    series["fk_as_built"] = np.array([fk(q, tg)[a] for q in q_enc])
-    errors = {name: step_errors(t, series[p] - series[m], stair_times, spec.hold_s)
-              for name, (p, m) in {**COMPARISONS, **PARTS}.items()}
-    summary = {name: _summary(v) for name, v in errors.items()}
-    bound = max(clearance_bound_m(params, q, e, sspec) for q in q_enc[:: max(1, len(q_enc) // 50)])
-    result = StaircaseResult(
-        axis=axis, steps=steps, tuning=tuning, step_mm=spec.step_m * 1e3, stairs=spec.count, hold_s=spec.hold_s,
-        seed=seed, thesis_figure=THESIS_FIGURE.get((axis, steps)),
-        sensor={"origin_m": list(sensor.mount.origin), "beam": list(sensor.mount.beam),
-                "range_m": [sspec.range_min_m, sspec.range_max_m], "resolution_m": sspec.resolution_m,
-                "noise_m": sspec.noise_m},
-        errors=errors, summary=summary, clearance_bound_mm=round(bound * 1e3, 4),
-        sensor_out_of_range=int(sum(v is None for v in rec.sensor)), samples=len(t),
-        sim_time_s=round(robot.t, 3), wall_time_s=round(time.perf_counter() - wall0, 3), reading=[],
-        t=t - t_start, series=series, stair_times=tuple(s - t_start for s in stair_times),
-    )
-    return _with_reading(result)
+    return staircase.result()
 
 
 def _summary(errs: list[StepErrors]) -> dict[str, float | None]:
@@ -414,4 +510,5 @@ def _with_reading(r: StaircaseResult) -> StaircaseResult:
 
 __all__ = ["AXES", "STEP_KINDS", "STEP_M", "STAIRS", "HOLD_S", "STATIC_WINDOW_S", "DYNAMIC_WINDOW_S",
            "COMPARISONS", "PARTS", "THESIS_FIGURE", "PrecisionError", "StaircaseSpec", "StairRecord", "StairRecorder",
-           "StepErrors", "StaircaseResult", "staircase_poses", "step_errors", "clearance_bound_m", "run_staircase"]
+           "StepErrors", "StaircaseResult", "StaircaseStage", "Staircase", "staircase_poses", "step_errors",
+           "clearance_bound_m", "run_staircase"]

@@ -28,7 +28,14 @@ import pytest
 
 from ttt_sm.debug.debugger import Debugger
 from ttt_sm.params import load_params
-from ttt_sm.web.operate import MSG_DRAWING, MSG_INITIALISING, MSG_READY, MSG_TURNING_OFF, SAMPLE_PERIOD_S
+from ttt_sm.web.operate import (
+    MSG_DRAWING,
+    MSG_INITIALISING,
+    MSG_READY,
+    MSG_STAIRCASE,
+    MSG_TURNING_OFF,
+    SAMPLE_PERIOD_S,
+)
 from ttt_sm.web.session import Session
 
 from .conftest import Cockpit, open_page, served, text_of
@@ -298,5 +305,44 @@ def test_stop_simulation_turns_the_manipulator_off_and_trigger_says_why(
         assert text_of(page, "why") == "Trigger is off: the manipulator is being turned off"
         operate_cockpit.session.call(lambda d: d.robot.run_until(lambda: d.robot.control.at_start, 60.0))
         assert operate_cockpit.session.call(lambda d: bool(d.robot.control.at_start))
+    finally:
+        page.close()
+
+
+def test_the_staircase_choice_plays_section_3_5_and_shows_its_three_comparisons(
+        browser: Any, powered_on: Cockpit, tmp_path: Path) -> None:
+    session = powered_on.session
+    page = browser.new_page(viewport={"width": 1500, "height": 1000})
+    try:
+        open_operate(page, powered_on)
+        run_until_waiting(page)
+        assert page.get_by_label("Axis", exact=True).is_hidden()
+        page.get_by_label("Symbol", exact=True).select_option("staircase")
+        # its own choices instead of the magnitude and the speed
+        assert page.get_by_label("Axis", exact=True).is_visible() and page.get_by_label("Steps").is_visible()
+        assert page.get_by_role("slider", name="Magnitude", exact=True).is_hidden()
+        page.get_by_label("Axis", exact=True).select_option("z")
+        page.get_by_label("Steps").select_option("small")
+        done = session.call(lambda d: len(session.operate.results))
+        trigger(page).click()
+        wait_status(page, MSG_STAIRCASE)
+        assert text_of(page, "reply").startswith("Trigger: the staircase of section 3.5 along Z, 5 small stairs")
+        assert trigger(page).is_disabled() and "follows the staircase" in text_of(page, "why")
+        while session.call(lambda d: len(session.operate.results)) == done:
+            page.wait_for_timeout(100)
+        wait_status(page, MSG_READY)
+        result = session.call(lambda d: session.operate.results[-1])
+        assert result["symbol"] == "staircase" and result["thesis_figure"] == "3.15"
+        table = page.get_by_role("table", name="the last staircase")
+        page.wait_for_function("document.querySelector('[data-key=staircase-what]').textContent.startsWith('along Z')",
+                               timeout=30_000)
+        assert table.locator("[data-key=staircase-what]").text_content() == (
+            "along Z, 5 small stairs of 0.5 mm, as fig. 3.15")
+        for comparison in ("desired_vs_fk", "fk_vs_sensor", "desired_vs_sensor"):
+            row = table.locator(f"[data-comparison={comparison}]")
+            for key, col in (("max_static_mm", "static"), ("max_dynamic_mm", "dynamic")):
+                assert row.locator(f"[data-key={col}]").text_content() == f"{result['summary'][comparison][key]:.3f} mm"
+        assert result["summary"]["desired_vs_sensor"]["max_static_mm"] <= 0.1
+        page.screenshot(path=str(Path(os.environ.get("TTT_SM_SCREENSHOTS") or tmp_path) / "gui_operate_staircase.png"))
     finally:
         page.close()

@@ -365,11 +365,20 @@ class Staircase:
         if back:
             poses = np.vstack([poses, _approach(poses[-1], np.asarray(here, dtype=float), chart_dt)])
         self.stage = StaircaseStage(robot, poses, first, end, self.recorder)
-        robot.sched.task_stages[:] = [s for s in robot.sched.task_stages
-                                      if not (isinstance(s, StaircaseStage) and s.done)]
-        robot.sched.task_stages.append(self.stage)  # after the Control chart's stage: its pose wins
+        sched = robot.sched
+        # the staircases played before go, with their recorders (between two steps: no stage list is being run)
+        done = [s for s in sched.task_stages if isinstance(s, StaircaseStage) and s.done]
+        gone = [s.recorder for s in done]
+        sched.task_stages[:] = [s for s in sched.task_stages if s not in done]
+        sched.joint_stages[:] = [s for s in sched.joint_stages if not any(s is r for r in gone)]
+        sched.task_stages.append(self.stage)  # after the Control chart's stage: its pose wins
         robot.sched.joint_stages.append(self.recorder)
         return self.stage
+
+    @property
+    def playing(self) -> bool:
+        """True from :meth:`start` until its last pose (the way back too) is sent."""
+        return self.stage is not None and not self.stage.done
 
     @property
     def chart_ticks(self) -> int:
@@ -422,6 +431,11 @@ class Staircase:
             t=t - t_start, series=series, stair_times=tuple(s - t_start for s in stair_times),
         )
         return _with_reading(result)
+
+
+def staircase_playing(robot: Robot) -> StaircaseStage | None:
+    """The staircase the robot plays now (its way back included), or None."""
+    return next((s for s in robot.sched.task_stages if isinstance(s, StaircaseStage) and not s.done), None)
 
 
 def _approach(frm: np.ndarray, to: np.ndarray, chart_dt: float) -> np.ndarray:
@@ -510,5 +524,6 @@ def _with_reading(r: StaircaseResult) -> StaircaseResult:
 
 __all__ = ["AXES", "STEP_KINDS", "STEP_M", "STAIRS", "HOLD_S", "STATIC_WINDOW_S", "DYNAMIC_WINDOW_S",
            "COMPARISONS", "PARTS", "THESIS_FIGURE", "PrecisionError", "StaircaseSpec", "StairRecord", "StairRecorder",
-           "StepErrors", "StaircaseResult", "StaircaseStage", "Staircase", "staircase_poses", "step_errors",
+           "StepErrors", "StaircaseResult", "StaircaseStage", "Staircase", "staircase_playing",
+           "staircase_poses", "step_errors",
            "clearance_bound_m", "run_staircase"]

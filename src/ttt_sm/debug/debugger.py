@@ -155,7 +155,7 @@ class Debugger:
                                                                   stepper.next, stepper.run)
         self.datum_decl, self.parse_value = inputs.datum_decl, inputs.parse_value
         self.set_input, self.release = inputs.set_input, inputs.release
-        self.post, self.game_input = inputs.post, inputs.game_input
+        self.post, self.game_input, self.staircase = inputs.post, inputs.game_input, inputs.staircase
         self.fingerprint, self.steps_of_tick = self.history.fingerprint, self.history.steps_of_tick
         self._attach(robot)
         self.history.restart()

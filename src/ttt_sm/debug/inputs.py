@@ -12,6 +12,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..app.game_outcome import GameError
+from ..app.precision import PrecisionError, Staircase, StaircaseSpec
 from ..app.robot import Robot, RobotError
 from ..runtime import Data, UnknownEventError
 from .errors import DebugError
@@ -102,9 +103,25 @@ class Inputs:
         turn, a locked symbol) raises :class:`DebugError` and is not recorded."""
         self._do(Action(self._robot().steps, "game", "Game", name, data=dict(data)))
 
-    def apply(self, action: Action) -> None:
-        """Do what ``action`` says to the robot now (a replay: at the control step it was recorded at)."""
+    def staircase(self, axis: str, steps: str) -> Staircase:
+        """Play the staircase of thesis section 3.5 along ``axis`` with ``steps`` ("small" or "big") stairs
+        from the Control chart's pose, and back there (:class:`~ttt_sm.app.precision.Staircase`), recorded
+        so a replay plays it again at the same control step.  Returns it, to be measured once played."""
+        return self._do(Action(self._robot().steps, "staircase", "Control", axis, data={"steps": steps}))
+
+    def apply(self, action: Action) -> Any:
+        """Do what ``action`` says to the robot now (a replay: at the control step it was recorded at).
+
+        Returns the :class:`~ttt_sm.app.precision.Staircase` a ``staircase`` action started, else None."""
         robot = self._robot()
+        if action.kind == "staircase":
+            try:
+                staircase = Staircase(robot, StaircaseSpec.of(action.name, action.data["steps"]),
+                                      robot.params.tuning.preset)
+            except PrecisionError as exc:
+                raise DebugError(f"staircase: {exc}") from None
+            staircase.start(back=True)
+            return staircase
         if action.kind == "game":
             game = game_of(robot)
             if game is None:
@@ -136,13 +153,13 @@ class Inputs:
             self.actions.append(action)
         self._names.forget()
 
-    def _do(self, action: Action) -> None:
-        """Apply an action and record it (a refused one raises and is not recorded)."""
+    def _do(self, action: Action) -> Any:
+        """Apply an action and record it (a refused one raises and is not recorded); what it returned."""
         if len(self.actions) >= MAX_ACTIONS:
             raise DebugError(f"{action.kind}: this run has recorded {len(self.actions)} inputs, the most a replay"
                              " repeats; replay to an earlier tick (it drops the inputs after it) or start the"
                              " session again")
-        self.apply(action)
+        done = self.apply(action)
         self.actions.append(action)
         # The future after this step is no longer what the session saw.
         self._history.forget_after(action.steps)
@@ -150,3 +167,4 @@ class Inputs:
         # Conditions keep their last checked value: one the user just made true
         # hits at the next chart tick.
         self._names.forget()
+        return done

@@ -16,9 +16,10 @@ class Action:
     """Something the user did to the robot, at control step ``steps``, for replay."""
 
     steps: int
-    kind: Literal["set", "force", "release", "post", "game"]
+    kind: Literal["set", "force", "release", "post", "game", "staircase"]
     chart: str
-    name: str  # input name, event name for "post", the person's input for "game" (cell, play, symbol, engine)
+    name: str  # input name, event name for "post", the person's input for "game" (cell, play, symbol, engine),
+    #            the axis for "staircase" (its data: steps)
     value: Any = None
     data: dict[str, Any] = field(default_factory=dict)
 
@@ -30,6 +31,8 @@ class Action:
         if self.kind == "game":
             args = "".join(f" {k}={v}" for k, v in self.data.items())
             return f"{where}: the person's {self.name}{args}"
+        if self.kind == "staircase":
+            return f"{where}: the staircase of section 3.5 along {self.name}, {self.data.get('steps')} steps"
         if self.kind == "release":
             return f"{where}: release {self.chart}.{self.name}"
         return f"{where}: {self.kind} {self.chart}.{self.name} {self.value!r}"

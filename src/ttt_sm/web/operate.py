@@ -9,7 +9,10 @@ sent when it changed) and the ``plot`` part, the graphs' new samples.
 
 Trigger sets the Control chart's inputs through the debugger (recorded, so a
 replay draws the same) and posts the chart's ``button`` (an X or an O in the
-middle cell of the field) or ``draw_sine`` event:
+middle cell of the field) or ``draw_sine`` event; or, for "Staircase", plays
+the precision experiment of section 3.5 from the waiting pose and back
+(:class:`ttt_sm.app.precision.Staircase`, recorded too), along the axis and
+with the steps chosen, and measures it as ``ttt-sm precision staircase`` does:
 
 * Magnitude, 0 to 10 cm (the thesis' range): the X's side, the O's diameter,
   the sine wave's peak-to-peak height (``Control.size``;
@@ -24,8 +27,9 @@ at its waiting pose (``wait_1``) with nothing of its own to do.
 
 The graphs' data are sampled in simulated time, :data:`SAMPLE_PERIOD_S`
 apart, by a joint stage (:class:`OperateStage`) that runs after inverse
-kinematics in every chart step: the desired tool position (the chart's
-``X_out``, ``Y_out``, ``Z_out``) against forward kinematics of the encoders
+kinematics in every chart step: the desired tool position (the pose
+commanded: the chart's ``X_out``, ``Y_out``, ``Z_out``, or a staircase's while
+it plays) against forward kinematics of the encoders
 (its ``X_now``, ``Y_now``, ``Z_now``), the current of drives 1-3 and each
 drive's following error (its joint setpoint minus its encoder angle).  So
 the graphs get the same points per simulated second at any pacing, x0.1 or as
@@ -45,6 +49,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..app.drawing import DrawError, DrawRecord, RecordStage, measure
+from ..app.precision import AXES, STEP_KINDS, PrecisionError, Staircase, staircase_playing
 from ..app.robot import Robot
 from ..debug.debugger import Debugger
 from ..sched.scheduler import Signals
@@ -54,10 +59,14 @@ MSG_INITIALISING = "The manipulator is being initialized"
 MSG_READY = "The manipulator is ready for your command"
 MSG_DRAWING = "The manipulator is drawing"
 MSG_TURNING_OFF = "The manipulator is being turned off"
-STATUS_MESSAGES = (MSG_INITIALISING, MSG_READY, MSG_DRAWING, MSG_TURNING_OFF)
+#: Ours, not the thesis': the precision experiment of section 3.5 runs.
+MSG_STAIRCASE = "The manipulator follows the staircase"
+STATUS_MESSAGES = (MSG_INITIALISING, MSG_READY, MSG_DRAWING, MSG_TURNING_OFF, MSG_STAIRCASE)
 
-#: The Symbol list, as the page offers it: what Trigger draws.
-SYMBOLS = ("X", "O", "sine")
+#: The Symbol list, as the page offers it: what Trigger draws (or, for "staircase", plays).
+SYMBOLS = ("X", "O", "sine", "staircase")
+#: The staircase's axes and steps (:mod:`ttt_sm.app.precision`).
+STAIRCASE_AXES, STAIRCASE_STEPS = AXES, STEP_KINDS
 #: The Magnitude slider's range, cm (section 3.7).
 MAGNITUDE_CM = (0.0, 10.0)
 #: The Speed slider's range (0 the slowest, 5 the fastest).
@@ -115,7 +124,7 @@ class OperateStage:
     another robot, and :class:`Operate` another stage).
     """
 
-    def __init__(self, robot: Robot, on_done: Callable[[Drawing, dict[str, Any]], None]) -> None:
+    def __init__(self, robot: Robot, on_done: Callable[[Drawing | None, dict[str, Any]], None]) -> None:
         self.robot = robot
         self.control = robot.control
         self.arm = robot.arm
@@ -125,6 +134,8 @@ class OperateStage:
         #: The Control chart has waited at its waiting pose once: the arm is initialised and placed.
         self.waited = False
         self.drawing: Drawing | None = None
+        #: The staircase Trigger started, until it is measured.
+        self.staircase: tuple[Staircase, float] | None = None
         self.pending: deque[tuple[float, list[float | None]]] = deque(maxlen=PENDING)
         self.history: deque[list[float | None]] = deque(maxlen=HISTORY)
         self.on_done = on_done
@@ -144,6 +155,10 @@ class OperateStage:
             elif drawing.started:
                 self.drawing = None
                 self.on_done(drawing, self._precision(drawing))
+        if self.staircase is not None and not self.staircase[0].playing:
+            staircase, t0 = self.staircase
+            self.staircase = None
+            self.on_done(None, self._staircase_result(staircase, t0))
         self.ticks += 1
         if self.ticks % self.every == 0:
             self._sample(signals)
@@ -153,8 +168,10 @@ class OperateStage:
         q_set = signals.q_set
         q_enc = self.arm.encoder_angles()
         current = self.arm.sensors().current_a
+        task = signals.task  # the pose commanded: the Control chart's, or a staircase's while one plays
         row: list[float | None] = [
-            round(self.robot.t, 4), _mm(c.X_out), _mm(c.X_now), _mm(c.Y_out), _mm(c.Y_now), _mm(c.Z_out), _mm(c.Z_now),
+            round(self.robot.t, 4), _mm(float(task[0])), _mm(c.X_now), _mm(float(task[1])), _mm(c.Y_now),
+            _mm(float(task[2])), _mm(c.Z_now),
             *(round(float(current[i]), 4) for i in range(3)),
             *(round(math.degrees(float(q_set[i]) - q_enc[i]), 4) if math.isfinite(float(q_set[i])) else None
               for i in range(3)),
@@ -168,6 +185,19 @@ class OperateStage:
         if self.recorder is not None:
             self.recorder.record = DrawRecord()
             self.recorder.on = True
+
+    def _staircase_result(self, staircase: Staircase, t0: float) -> dict[str, Any]:
+        """The staircase's three comparisons, as ``ttt-sm precision staircase`` reports them."""
+        spec = staircase.spec
+        done: dict[str, Any] = {"symbol": "staircase", "axis": spec.axis, "steps": spec.steps,
+                                "step_mm": spec.step_m * 1e3, "stairs": spec.count, "tuning": staircase.tuning,
+                                "duration_s": round(self.robot.t - t0, 3)}
+        try:
+            result = staircase.result()
+        except PrecisionError as exc:
+            return {**done, "error": str(exc)}
+        return {**done, "thesis_figure": result.thesis_figure, "summary": result.summary,
+                "clearance_bound_mm": result.clearance_bound_mm, "reading": result.reading}
 
     def _precision(self, drawing: Drawing) -> dict[str, Any]:
         done: dict[str, Any] = {"symbol": drawing.symbol, "magnitude_cm": drawing.magnitude_cm,
@@ -212,7 +242,7 @@ class Operate:
             self.results = []
         return self.stage
 
-    def _done(self, drawing: Drawing, result: dict[str, Any]) -> None:
+    def _done(self, drawing: Drawing | None, result: dict[str, Any]) -> None:
         self.results.append(result)
         del self.results[:-20]
 
@@ -225,6 +255,8 @@ class Operate:
         c = robot.control
         if c.finish or c.at_start:
             status = MSG_TURNING_OFF
+        elif staircase_playing(robot) is not None:
+            status = MSG_STAIRCASE
         elif not c.busy:
             status = MSG_READY
         elif stage.waited or stage.drawing is not None:
@@ -256,6 +288,8 @@ class Operate:
             return "the manipulator is being turned off"
         if stage.drawing is not None:
             return "the manipulator is drawing: Trigger again when it waits at its waiting pose"
+        if staircase_playing(robot) is not None:
+            return "the manipulator follows the staircase: Trigger again when it is back at its waiting pose"
         if c.busy:
             if not stage.waited:
                 return ("the manipulator is not at its waiting pose yet: Run_simulation, then wait for it to be"
@@ -300,12 +334,16 @@ class Operate:
 
     # -- the page's commands ------------------------------------------------------------------
 
-    def trigger(self, symbol: str, magnitude_cm: float, speed: float) -> dict[str, Any]:
-        """Trigger: draw ``symbol`` at ``magnitude_cm`` and ``speed`` (checked by :mod:`.protocol`)."""
+    def trigger(self, symbol: str, magnitude_cm: float, speed: float, axis: str = "z",
+                steps: str = "big") -> dict[str, Any]:
+        """Trigger: draw ``symbol`` at ``magnitude_cm`` and ``speed`` (checked by :mod:`.protocol`), or play
+        the staircase along ``axis`` with ``steps`` stairs (``symbol`` "staircase"; magnitude and speed unused)."""
         stage = self._attach()
         why = self._why_not(stage)
         if why:
             raise ValueError(f"Trigger is not taken now: {why}")
+        if symbol == "staircase":
+            return self._staircase(stage, axis, steps)
         if symbol != "sine" and magnitude_cm < MIN_SYMBOL_CM:
             raise ValueError(f"an {symbol} of {magnitude_cm:g} cm is a dot: choose a Magnitude of"
                              f" {MIN_SYMBOL_CM:g} cm or more")
@@ -327,6 +365,16 @@ class Operate:
         return {"text": f"Trigger: {what}, {magnitude_cm:g} cm {measure_word}, speed {speed:g}"
                         f" ({speed_mm_s(speed):g} mm/s)"}
 
+    def _staircase(self, stage: OperateStage, axis: str, steps: str) -> dict[str, Any]:
+        robot = self.debugger.robot
+        t0 = robot.t
+        staircase = self.debugger.staircase(axis, steps)
+        stage.staircase = (staircase, t0)
+        spec = staircase.spec
+        return {"text": f"Trigger: the staircase of section 3.5 along {axis.upper()}, {spec.count} {steps} stairs of"
+                        f" {spec.step_m * 1e3:g} mm held {spec.hold_s:g} s each, from the waiting pose and back"
+                        f" ({staircase.chart_ticks * robot.params.control.chart_dt:.1f} s of simulated time)"}
+
     def stop(self) -> dict[str, Any]:
         """Stop_simulation: the Control chart's ``finish``; the arm returns to its start pose."""
         dbg = self.debugger
@@ -336,5 +384,8 @@ class Operate:
             raise ValueError("the manipulator has not been started: nothing to turn off (Run_simulation first)")
         if dbg.robot.control.finish:
             raise ValueError("the manipulator is being turned off already")
+        if staircase_playing(dbg.robot) is not None:
+            raise ValueError("the manipulator follows the staircase: Stop_simulation once it is back at its"
+                             " waiting pose")
         dbg.set_input("Control", "finish", True)
         return {"text": "Stop_simulation: the manipulator returns to its start pose, then stops"}

@@ -26,7 +26,7 @@ const GRAPHS = [
   { id: "following_error", title: "Following error", unit: "deg", series: [["following_error_1_deg", "drive 1", "#1f4e9c"], ["following_error_2_deg", "drive 2", "#d33"], ["following_error_3_deg", "drive 3", "#1d7a1d"]] },
 ];
 
-const MEANS = { X: "the X's side", O: "the O's diameter", sine: "the sine wave's peak to peak" };
+const MEANS = { X: "the X's side", O: "the O's diameter", sine: "the sine wave's peak to peak", staircase: "" };
 
 const state = { op: null, speedRange: [5, 30], toAck: [], dirty: false };
 // What the graphs received, for the tests and the bench: points, redraws, simulated time covered.
@@ -267,6 +267,10 @@ function check() {
 }
 
 function describeSettings() {
+  const staircase = role("symbol").value === "staircase";
+  role("staircase-options").hidden = !staircase;
+  role("magnitude-field").hidden = staircase;
+  role("speed-field").hidden = staircase;
   role("magnitude-means").textContent = MEANS[role("symbol").value];
   const s = speed.valid() ? Number(speed.slider.value) : NaN;
   const [lo, hi] = state.speedRange;
@@ -283,7 +287,9 @@ function drawOperate(op) {
   $('[data-cmd="stop"]').disabled = op.turning_off;
   const p = op.precision;
   const cell = (key) => role("precision").querySelector(`[data-key="${key}"]`);
-  if (p) {
+  if (p && p.symbol === "staircase") {
+    drawStaircase(p);
+  } else if (p) {
     const what = { X: "an X", O: "an O", sine: "a sine wave" }[p.symbol];
     cell("what").textContent = `${what}, ${p.magnitude_cm} cm, speed ${p.speed} (${p.speed_mm_s} mm/s)`;
     const mm = (v) => (v === null || v === undefined ? "–" : `${v.toFixed(3)} mm`);
@@ -294,6 +300,21 @@ function drawOperate(op) {
     cell("duration_s").textContent = `${p.duration_s.toFixed(1)} s of simulated time`;
   }
   describeSettings();
+}
+
+// The last staircase's three comparisons (the largest static and dynamic error over its stairs, mm).
+function drawStaircase(p) {
+  const table = role("staircase");
+  const fig = p.thesis_figure ? `, as fig. ${p.thesis_figure}` : "";
+  table.querySelector('[data-key="staircase-what"]').textContent =
+    `along ${p.axis.toUpperCase()}, ${p.stairs} ${p.steps} stairs of ${p.step_mm} mm${fig}`;
+  const mm = (v) => (v === null || v === undefined ? "–" : `${v.toFixed(3)} mm`);
+  for (const row of table.querySelectorAll("[data-comparison]")) {
+    const s = p.summary ? p.summary[row.dataset.comparison] : null;
+    row.querySelector('[data-key="static"]').textContent = p.error ? p.error : mm(s && s.max_static_mm);
+    row.querySelector('[data-key="dynamic"]').textContent = mm(s && s.max_dynamic_mm);
+  }
+  table.title = (p.reading || []).join("\n");
 }
 
 function drawFrame(f) {
@@ -327,7 +348,12 @@ describeSettings();
 $('[data-cmd="run"]').addEventListener("click", () => link.send({ type: "run" }));
 $('[data-cmd="stop"]').addEventListener("click", () => link.send({ type: "operate_stop" }));
 $('[data-cmd="trigger"]').addEventListener("click", () => {
-  link.send({ type: "operate_trigger", symbol: role("symbol").value, magnitude_cm: magnitude.value(), speed: speed.value() });
+  const symbol = role("symbol").value;
+  if (symbol === "staircase") {  // the staircase has no magnitude or speed of its own
+    link.send({ type: "operate_trigger", symbol, magnitude_cm: 0, speed: 0, axis: role("axis").value, steps: role("steps").value });
+  } else {
+    link.send({ type: "operate_trigger", symbol, magnitude_cm: magnitude.value(), speed: speed.value() });
+  }
 });
 link.connect();
 requestAnimationFrame(redraw);

@@ -346,3 +346,26 @@ def test_the_staircase_choice_plays_section_3_5_and_shows_its_three_comparisons(
         page.screenshot(path=str(Path(os.environ.get("TTT_SM_SCREENSHOTS") or tmp_path) / "gui_operate_staircase.png"))
     finally:
         page.close()
+
+
+@pytest.mark.parametrize("path", ["/operate", "/charts"])
+def test_stop_drive_1_is_a_toggle_on_the_operational_page_and_the_cockpit(
+        browser: Any, powered_on: Cockpit, path: str) -> None:
+    session = powered_on.session
+    page = browser.new_page()
+    try:
+        open_page(page, powered_on, path)
+        button = page.get_by_role("button", name="Stop drive 1", exact=True)
+        assert button.get_attribute("aria-pressed") == "false"
+        button.click()
+        released = page.get_by_role("button", name="Release drive 1", exact=True)
+        released.wait_for(timeout=30_000)
+        assert released.get_attribute("aria-pressed") == "true"
+        assert session.call(lambda d: bool(d.robot.chart("DriveInit1").stop)) is True
+        released.click()
+        page.get_by_role("button", name="Stop drive 1", exact=True).wait_for(timeout=30_000)
+        assert session.call(lambda d: bool(d.robot.chart("DriveInit1").stop)) is False
+        assert [a.describe().split(": ", 1)[1] for a in session.call(lambda d: d.actions)][-2:] == [
+            "set DriveInit1.stop True", "set DriveInit1.stop False"]
+    finally:
+        page.close()

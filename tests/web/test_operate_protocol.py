@@ -224,3 +224,31 @@ def test_the_staircase_plays_from_the_waiting_pose_and_back_and_is_measured_as_t
     assert replay.identical is True, replay.differences
     assert "the staircase of section 3.5 along x, big steps" in session.call(
         lambda d: "; ".join(a.describe() for a in d.actions))
+
+
+def test_drive_1_stops_where_it_is_and_is_released_back_into_the_state_it_left() -> None:
+    """Thesis section 3.1.2: drive 1's ``stop`` input, from the cockpit and the Operational page (drive1_stop)."""
+    with _operating() as (session, _, page, full):
+        assert full["drive1"] == {"stop": False, "stopped": False}
+        assert page.answer(page.send(type="tick", n=400))["ok"]  # drive 1 turns, searching its index
+        before = session.call(lambda d: (sorted(d.robot.active("DriveInit1")), d.robot.arm.encoder_angles()[0]))
+        assert before[0] == ["initialise", "run", "turn_fwd"], before
+        stop = page.answer(page.send(type="drive1_stop", stop=True))
+        assert stop["ok"] and stop["text"].startswith("Drive 1 stops where it is"), stop
+        again = page.answer(page.send(type="drive1_stop", stop=True))
+        assert again["error"] == "drive1_stop: drive 1 is stopped already"
+        assert page.answer(page.send(type="tick", n=500))["ok"]  # one simulated second
+        q1 = session.call(lambda d: d.robot.arm.encoder_angles()[0])
+        assert session.call(lambda d: "stopped" in d.robot.active("DriveInit1"))
+        assert abs(q1 - before[1]) < 0.02  # it turned at most a few encoder counts past where it was stopped
+        frame = page.frame()
+        while "drive1" not in frame:
+            frame = page.frame()
+        assert frame["drive1"] == {"stop": True, "stopped": True}
+        assert "set DriveInit1.stop True" in " ".join(session.call(lambda d: [a.describe() for a in d.actions]))
+        release = page.answer(page.send(type="drive1_stop", stop=False))
+        assert release["ok"] and release["text"].startswith("Drive 1 released"), release
+        assert page.answer(page.send(type="tick", n=400))["ok"]
+        after = session.call(lambda d: (sorted(d.robot.active("DriveInit1")), d.robot.arm.encoder_angles()[0]))
+        assert after[0] == before[0]  # back in turn_fwd through the history state
+        assert abs(after[1] - q1) > 0.02  # and turning again

@@ -48,7 +48,7 @@ ACTIONS_SHOWN = 50
 STAMPED_FRAMES = 256
 
 #: The parts of a frame sent whole when they changed (data, signals and taken counts go value by value).
-_WHOLE_PARTS = ("breakpoints", "actions", "forced", "stop", "game", "arm", "camera", "operate", "safety")
+_WHOLE_PARTS = ("breakpoints", "actions", "forced", "stop", "game", "arm", "camera", "operate", "safety", "drive1")
 _MISSING = object()
 
 
@@ -73,6 +73,12 @@ def safety_view(robot: Any) -> dict[str, Any]:
     chart = robot.safety
     return {"tripped": bool(chart.tripped), "reason": str(chart.reason), "trips": int(chart.trips),
             "reinitialising": bool(chart.reinit)}
+
+
+def drive1_view(robot: Any) -> dict[str, Any]:
+    """The ``drive1`` part of a frame: drive 1's ``stop`` input and whether its chart is in ``stopped``."""
+    chart = robot.chart("DriveInit1")
+    return {"stop": bool(chart.stop), "stopped": "stopped" in chart.configuration_values}
 
 
 class TransitionTap:
@@ -185,6 +191,7 @@ class Frames:
             "camera": feed_view(self.camera_feed),
             "operate": self.operate.view(),
             "safety": safety_view(robot),
+            "drive1": drive1_view(robot),
         }
 
     def frame(self, full: bool, status: Status, state: dict[str, Any] | None = None) -> dict[str, Any]:

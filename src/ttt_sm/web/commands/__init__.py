@@ -17,7 +17,7 @@ concern:
 - :mod:`.game`: the Tic-tac-toe page's ``game_symbol``, ``game_cell``, ``game_play``, ``game_stop``,
   ``game_engine``, ``game_new``;
 - :mod:`.operate`: the Operational page's ``operate_trigger``, ``operate_stop``;
-- :mod:`.safety`: every page's ``safety_reset``.
+- :mod:`.safety`: every page's ``safety_reset``; ``drive1_stop`` (the chart cockpit, the Operational page).
 """
 
 from __future__ import annotations

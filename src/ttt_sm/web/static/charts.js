@@ -8,7 +8,7 @@
 // session's messages to them, keeps the frames in order and draws the header.
 
 import { $, $$, button, role } from "./dom.js";
-import { addSafety, drawSafety } from "./page.js";
+import { addDrive1Stop, addSafety, drawDrive1, drawSafety } from "./page.js";
 import { SessionLink } from "./session.js";
 import { Breakpoints } from "./charts/breakpoints.js";
 import { CoverageView } from "./charts/coverage.js";
@@ -116,6 +116,7 @@ function drawHeader(f) {
   pace.textContent = parts.join(" · ");
   pace.dataset.overruns = String(p.overruns);
   if ("safety" in f) drawSafety(f.safety);
+  if ("drive1" in f) drawDrive1(f.drive1);
   if (f.stop) say(f.stop.text, false, f.stop.kind);
   if (f.error) say(f.error, true);
 }
@@ -146,6 +147,7 @@ for (const b of $$("[data-cmd]")) {
   b.addEventListener("click", () => link.send({ type: b.dataset.cmd }));
 }
 addSafety($("header"), link);
+addDrive1Stop($(".safety-group"), link);
 role("speed").addEventListener("change", (e) => {
   const v = e.target.value;
   link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });

@@ -8,7 +8,7 @@
 // are plain canvases drawn here; their data live in a ring buffer of fixed size.
 
 import { $, role } from "./dom.js";
-import { drawCommon, pageHeader, sayReply as say } from "./page.js";
+import { addDrive1Stop, drawCommon, pageHeader, sayReply as say } from "./page.js";
 import { SessionLink } from "./session.js";
 
 //: Samples kept per column (2 minutes at 25 a simulated second); the oldest are overwritten.
@@ -340,6 +340,7 @@ const link = new SessionLink(onMessage, (status) => {
 });
 
 pageHeader(link);
+addDrive1Stop($('[data-cmd="stop"]'), link);
 buildGraphs();
 magnitude = pair("Magnitude", " cm", "magnitude", "magnitude-box", describeSettings);
 speed = pair("Speed", "", "speed", "speed-box", describeSettings);

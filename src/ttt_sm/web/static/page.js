@@ -60,6 +60,32 @@ export function addSafety(header, link) {
   header.after(banner);
 }
 
+// Drive 1's stop (thesis section 3.1.2: "a non-zero value stops the first drive"), on the chart
+// cockpit and the Operational page: a toggle that sets the DriveInit1 chart's `stop` input through
+// the session (an input the debugger records) and releases it again.
+export function addDrive1Stop(after, link) {
+  const button = document.createElement("button");
+  button.type = "button";
+  button.dataset.role = "drive1-stop";
+  button.setAttribute("aria-pressed", "false");
+  button.textContent = "Stop drive 1";
+  button.title = "drive 1's stop input (DriveInit1.stop, thesis section 3.1.2): the base stops where it is;"
+    + " press again to release it";
+  button.addEventListener("click", () => {
+    link.send({ type: "drive1_stop", stop: button.getAttribute("aria-pressed") !== "true" });
+  });
+  after.after(button);
+}
+
+// A frame's `drive1` part: whether drive 1's stop is set (the toggle pressed) and its chart stopped.
+export function drawDrive1(d) {
+  const button = role("drive1-stop");
+  if (!button) return;
+  button.setAttribute("aria-pressed", String(d.stop));
+  button.textContent = d.stop ? "Release drive 1" : "Stop drive 1";
+  button.dataset.stopped = String(d.stopped);
+}
+
 const SAFETY_STATES = {
   monitoring: "Safety: monitoring",
   tripped: "Safety: stopped",
@@ -94,6 +120,7 @@ export function drawCommon(f) {
   }
   if (f.t !== undefined) role("sim-time").textContent = f.t.toFixed(1);
   if ("safety" in f) drawSafety(f.safety);
+  if ("drive1" in f) drawDrive1(f.drive1);
 }
 
 // The answer to the page's last command (a reply, or an error in red), in its data-role="reply" box.

@@ -4,6 +4,7 @@ import io
 import json
 
 import cv2
+import numpy as np
 import pytest
 
 from ttt_sm.app.game import GameSession
@@ -201,3 +202,49 @@ def test_the_camera_link_is_silent_between_readings_without_a_silence_warning(ca
         link.close()
     assert stats["silences"] == 0 and stats["frames_ok"] == 2
     assert not [r.getMessage() for r in caplog.records if "no valid frame" in r.getMessage()]
+
+
+@pytest.mark.parametrize(("turn", "reason"), [
+    (lambda photo: np.ascontiguousarray(np.rot90(photo)), "turn it 90 deg"),  # the camera turned on its stand
+    (lambda photo: np.ascontiguousarray(photo[::-1, ::-1]), "turn it 180 deg"),
+])
+def test_a_turned_camera_is_refused_by_its_perspective_and_never_read_as_a_board(monkeypatch, capsys, tmp_path, turn,
+                                                                                  reason):
+    """Issue 28 (no silent wrong board) in a game: the direct camera's photos are checked as ttt-sm vision's are."""
+    from ttt_sm.vision.simulated import SimulatedCamera
+
+    frame = SimulatedCamera.frame
+    monkeypatch.setattr(SimulatedCamera, "frame", lambda self: turn(frame(self)))
+    code = main(["play", "--opponent", "simulated", "--camera", "direct", "--seed", "2", "--json",
+                 "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code != 0
+    assert "the camera's view was refused" in err and reason in err, err[-600:]
+    events = [json.loads(line) for line in (tmp_path / "game.jsonl").read_text().splitlines()]
+    assert not [e for e in events if e["event"] == "detected"]  # nothing was read from a turned photo
+    assert len([e for e in events if e["event"] == "detection_rejected"]) == 1
+
+
+def test_a_mirrored_camera_is_refused_right_after_the_robot_draws_off_the_mirrors_axis(monkeypatch, capsys,
+                                                                                       tmp_path):
+    """A left-right mirror keeps the perspective of a camera on the field's axis; the robot's own marks tell it.
+
+    The game photographs the board after each robot move: a mark off column 3 (the mirror's axis) seen in the
+    mirrored cell ends the game naming the mirror.  The person's moves read before it cannot be checked by any
+    photo (docs/vision.md, "What a single photo can tell")."""
+    from ttt_sm.vision.simulated import SimulatedCamera
+
+    frame = SimulatedCamera.frame
+    monkeypatch.setattr(SimulatedCamera, "frame", lambda self: np.ascontiguousarray(frame(self)[:, ::-1]))
+    code = main(["play", "--opponent", "simulated", "--camera", "direct", "--seed", "2", "--json",
+                 "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code != 0 and "the camera's view was refused: My marks appear where a turned or mirrored" in err, err[-600:]
+    events = [json.loads(line) for line in (tmp_path / "game.jsonl").read_text().splitlines()]
+    kinds = [e["event"] for e in events]
+    robot_cells = [(e["row"], e["column"]) for e in events if e["event"] == "robot_move"]
+    # refused at the photo right after the robot's first move off the axis: no move of the person after it
+    assert kinds[-2:] == ["detection_rejected", "error"]
+    last_robot = len(kinds) - 1 - kinds[::-1].index("robot_move")
+    assert "person_drew" not in kinds[last_robot:]
+    assert robot_cells[-1][1] != 3 and all(c == 3 for _, c in robot_cells[:-1])

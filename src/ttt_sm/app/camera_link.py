@@ -34,6 +34,7 @@ from ..params import ArmParams
 from ..smartcam.protocol import SEQ_MODULUS
 from ..twin.whiteboard import Whiteboard
 from ..vision import Detection, board_text, board_values, detect
+from ..vision.orientation import check_orientation
 from ..vision.simulated import SimulatedCamera
 
 #: A reading asks the camera for another photo when none arrived for this long, s.
@@ -120,6 +121,10 @@ class CameraLink:
         if self.mode == "direct":
             self.last_photo = self.camera.frame()
             d: Detection = detect(self.last_photo)
+            # a camera turned on its stand would put every symbol in the wrong cell: its perspective says so
+            # (OrientationError, never read); a mirror keeps the perspective, the robot's marks tell it
+            # (percent_process, in the game)
+            check_orientation(d.grid, self.view, "the camera's photo")
             return tuple(board_values(list(d.percentages), self.view)), board_text(d.cells, self.view)
         # Frames photographed before now may still wait in the port: only a
         # frame numbered from `fresh` on shows the board as it is now.

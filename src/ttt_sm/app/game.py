@@ -39,7 +39,8 @@ from ..runtime.listeners import Trace
 from ..runtime.recordfile import interruption
 from ..twin.board_picture import save_board_picture
 from ..twin.truth import GroundTruth
-from ..vision import MoveError, percent_process
+from ..vision import MoveError, OrientationError, percent_process
+from ..vision.percent import check_own_marks
 from .camera_link import CameraLink, CameraLost
 from .engines import engine_for
 from .game_outcome import GameError, GameInterrupted, outcome_in_words, result_of
@@ -276,10 +277,23 @@ class GameSession:
             view = self.camera.read()
         except CameraLost as exc:
             raise self._camera_lost(exc) from None
+        except OrientationError as exc:  # a turned camera: the photo is refused, never read as a board
+            self.detections_wrong += 1
+            self.person.tell(str(exc))
+            self._event("detection_rejected", message=str(exc))
+            raise GameError(f"the camera's view was refused: {exc}") from None
         self.robot.camera_status.ok = True  # the Camera block: it answers
         self.last_view = view
         self.photos += 1
         return view
+
+    def _refused(self, exc: MoveError) -> GameError:
+        """The camera's view cannot be taken: the person is told why, the record says so, the game ends."""
+        self.detections_wrong += 1
+        message = getattr(exc, "message_for_person", str(exc))
+        self.person.tell(message)
+        self._event("detection_rejected", message=message)
+        return GameError(f"the camera's view was refused: {message}")
 
     def _camera_lost(self, exc: CameraLost) -> GameError:
         """The camera stopped answering while the game waited for a photo: the Safety chart's Camera block.
@@ -569,11 +583,7 @@ class GameSession:
             seen = percent_process(percentages, self.robot_cells, self.person_cells, robot_ink=self.robot_ink,
                                    symbols=symbols, robot_symbol=self.robot_symbol)
         except MoveError as exc:
-            self.detections_wrong += 1
-            message = getattr(exc, "message_for_person", str(exc))
-            self.person.tell(message)
-            self._event("detection_rejected", message=message)
-            raise GameError(f"the camera's view was refused: {message}") from exc
+            raise self._refused(exc) from exc
         ok = seen.new == cell
         self.detections_correct += ok
         self.detections_wrong += not ok
@@ -619,6 +629,10 @@ class GameSession:
         self._set_board(cell, self.robot_symbol)
         self._place(cell, self.robot_symbol, "truth")
         percentages, _ = self._look()
+        try:  # the robot's marks are the truth the game has: a mirrored or turned picture shows them moved
+            check_own_marks(percentages, self.robot_cells)
+        except MoveError as exc:
+            raise self._refused(exc) from exc
         self.robot_ink[cell] = percentages[cell_index(*cell)]
         self.moves.append({"by": "robot", "symbol": self.robot_symbol, "row": cell[0], "column": cell[1],
                            "t": round(robot.t, 3)})

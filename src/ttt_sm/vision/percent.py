@@ -130,6 +130,24 @@ def percent_process(percentages: Sequence[float], robot_cells: Iterable[Cell],
     return PersonMoves(cells, new[0] if new else None)
 
 
+def check_own_marks(percentages: Sequence[float], robot_cells: Iterable[Cell],
+                    occupied_pct: float = OCCUPIED_PCT) -> None:
+    """Check a photo taken right after the robot drew: every robot mark is seen where the robot drew it.
+
+    The robot's marks are the only cells whose truth a game knows (the
+    person's are what the camera read).  A photo that shows them where a turn
+    or a mirror of the picture would put them is :class:`PictureTurnedError`;
+    one that misses them otherwise, :class:`SymbolVanishedError`.
+    """
+    robot = _cells(robot_cells, "robot_cells")
+    occupied = {(k // N + 1, k % N + 1) for k in range(N * N) if float(percentages[k]) > occupied_pct}
+    if robot <= occupied:
+        return
+    if _turned(robot, occupied):
+        raise PictureTurnedError(sorted(robot))
+    raise SymbolVanishedError(sorted(robot - occupied))
+
+
 def _turned(marks: set[Cell], occupied: set[Cell]) -> bool:
     """Whether a turn or a mirror of the picture (not none) would show every mark on an occupied cell."""
     for change in CHANGES.values():

@@ -1,5 +1,7 @@
 """``ttt-sm kinematics workspace|dh|race``: the ``/kinematics`` page's views on the command line.
 
+(``trajectory`` and ``forces``, the ``/kinematics/motion`` page's, come from :mod:`.kinematics_motion`.)
+
 Each prints the same JSON document as the page's route ``/api/kinematics/<view>``
 (``--json``), or a short text, and draws the view into a PNG (``--png PATH``).
 docs/kinematics.md, "Lab", explains the views and the exercises.
@@ -54,6 +56,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
     rc.add_argument("--max-iterations", type=int, default=100, help="iterations per method (default 100)")
     _common(rc)
     rc.set_defaults(func=_run("race"))
+    from .kinematics_motion import add_motion_commands
+
+    add_motion_commands(acts)  # trajectory, forces: the /kinematics/motion page's views
     return sp
 
 

@@ -123,3 +123,12 @@ def test_gravity_and_friction_must_come_out_of_the_currents() -> None:
     moving = (-g + tau_f) / kt
     assert np.allclose(F.estimate_contact_force(P, q, moving[None], w).vector_n, 0.0, atol=1e-9)
     assert np.abs(F.estimate_contact_force(P, q, hold[None], w).vector_n).max() > 0.3  # friction left in
+
+
+def test_the_bench_section_reports_each_method_and_the_force_estimate() -> None:
+    from ttt_sm.twin.motion_bench import bench_motion_lab
+
+    r = bench_motion_lab(P, quick=True)
+    assert {f"trajectory_{m}_us_per_tick" for m in METHODS} <= set(r)
+    assert r["forces_estimate_mean_rel"] < 0.10 and 0.0 < r["forces_observable_share"] <= 1.0
+    assert r["trajectory_run_move_ms"] > 0 and r["forces_run_ms"] > 0

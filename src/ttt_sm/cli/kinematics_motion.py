@@ -8,12 +8,8 @@ docs/kinematics.md, "Lab: trajectories and forces", explains the views.
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 from collections.abc import Callable
 from typing import Any
-
-from .common import CliError, print_json
 
 #: One colour per trajectory method, as the page draws them.
 METHOD_COLOURS = {"increment": "#1f77b4", "step_fr_sw": "#d62728", "cubic": "#2ca02c", "quintic": "#9467bd"}
@@ -110,29 +106,16 @@ def _text(view: str, d: dict[str, Any]) -> str:
         f" over the whole line: mean {pct(e['all_mean_rel'])}, 95th percentile {pct(e['all_p95_rel'])}"])
 
 
+def _views() -> dict[str, Any]:
+    from ..web.kinematics_motion import VIEWS
+
+    return VIEWS
+
+
 def _run(view: str) -> Callable[[argparse.Namespace], int]:
-    def run(args: argparse.Namespace) -> int:
-        from ..twin.workspace import load_arm
-        from ..web.kinematics import KinematicsQueryError
-        from ..web.kinematics_motion import VIEWS
+    from .kinematics import view_command
 
-        if args.png is not None and (not args.png.lower().endswith(".png") or os.path.isdir(args.png)):
-            raise CliError(f"{view}: --png must name a .png file, got {args.png!r}")
-        params = load_arm(args.params)
-        try:
-            data = VIEWS[view](params, _query(view, args))
-        except (KinematicsQueryError, ValueError) as exc:
-            raise CliError(f"{view}: {_option_names(str(exc))}") from None
-        if args.png:
-            draw_png(view, data, args.png)
-            print(f"kinematics {view}: wrote {args.png}", file=sys.stderr)
-        if args.json:
-            print_json(data)
-        else:
-            print(_text(view, data))
-        return 0
-
-    return run
+    return view_command(view, _views, _query, _text, draw_png, _option_names)
 
 
 def draw_png(view: str, d: dict[str, Any], path: str) -> None:

@@ -18,7 +18,7 @@ from ..params import ArmParams
 from ..twin.forces import ellipses_over_board, force_run, velocity_ellipse
 from ..twin.kinematics import IKError, IKSolver, arm_points
 from ..twin.trajectories import DRAW_SPEED_M_S, METHODS, PRESS_M, run_move
-from .kinematics import KinematicsQueryError, _number
+from .kinematics import KinematicsQueryError, _number, json_route
 
 #: Series are sent every this many chart ticks (50 Hz at the thesis' 500 Hz chart rate).
 DECIMATE = 10
@@ -111,24 +111,11 @@ VIEWS: dict[str, Callable[[ArmParams, Mapping[str, str]], dict[str, Any]]] = {
 
 def routes(params: Callable[[], ArmParams], page: Callable[[str], Any]) -> list[Any]:
     """The page ``/kinematics/motion`` and its JSON routes ``/api/kinematics/motion/<view>``."""
-    import asyncio
-
     from starlette.requests import Request
-    from starlette.responses import JSONResponse, Response
+    from starlette.responses import Response
     from starlette.routing import Route
 
     async def motion_page(request: Request) -> Response:
         return page("kinematics_motion.html")  # type: ignore[no-any-return]
 
-    async def view(request: Request) -> Response:
-        name = request.path_params["view"]
-        fn = VIEWS.get(name)
-        if fn is None:
-            return JSONResponse({"error": f"no view {name!r}: one of {', '.join(VIEWS)}"}, status_code=404)
-        try:
-            data = await asyncio.to_thread(fn, params(), dict(request.query_params))
-        except (KinematicsQueryError, ValueError) as exc:
-            return JSONResponse({"error": str(exc)}, status_code=400)
-        return JSONResponse(data, headers={"Cache-Control": "no-store"})
-
-    return [Route("/kinematics/motion", motion_page), Route("/api/kinematics/motion/{view}", view)]
+    return [Route("/kinematics/motion", motion_page), json_route("/api/kinematics/motion/{view}", VIEWS, params)]

@@ -88,17 +88,24 @@ def motion_cockpit(kin_session: Session) -> Iterator[Cockpit]:
         yield cockpit
 
 
-def _ready(page: Any) -> None:
+def _open(page: Any, cockpit: Cockpit) -> None:
+    page.set_viewport_size({"width": 1280, "height": 720})
+    page.goto(cockpit.page_url("/kinematics/motion"))
     page.wait_for_function("document.body.dataset.ready === 'true' || window.kinematicsMotion?.errors > 0",
                            timeout=120_000)
     assert page.evaluate("window.kinematicsMotion.errors") == 0, text_of(page, "status")
 
 
-def test_the_page_in_chromium_shows_both_views_and_links_back(page: Any, motion_cockpit: Cockpit) -> None:
-    page.set_viewport_size({"width": 1280, "height": 720})
-    page.goto(motion_cockpit.page_url("/kinematics/motion"))
-    _ready(page)
-    # trajectories: a row per method, the numbers the route gave
+def _inked(page: Any, canvas: str) -> int:
+    """How many pixels of the canvas were drawn."""
+    return int(page.evaluate(f"""(() => {{ const c = document.querySelector('[data-role={canvas}]');
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let n = 0; for (let i = 3; i < d.length; i += 4) if (d[i]) n++; return n; }})()"""))
+
+
+def test_the_trajectory_view_in_chromium(page: Any, motion_cockpit: Cockpit) -> None:
+    _open(page, motion_cockpit)
+    # a row per method, the numbers the route gave
     rows = page.locator("[data-role=traj-table] tbody tr")
     assert [rows.nth(i).get_attribute("data-method") for i in range(rows.count())] == [
         "increment", "step_fr_sw", "cubic", "quintic"]
@@ -106,11 +113,26 @@ def test_the_page_in_chromium_shows_both_views_and_links_back(page: Any, motion_
     step = traj["methods"][1]
     assert rows.nth(1).locator("td").nth(6).text_content() == f"{step['ink_max_off_line_m'] * 1e3:.2f}"
     assert float(rows.nth(0).locator("td").nth(6).text_content()) < 0.5  # the increments' ink on the line
-    for canvas in ("traj-ink", "traj-lag", "traj-current", "ellipses", "force"):  # every plot drawn
-        assert page.evaluate(f"""(() => {{ const c = document.querySelector('[data-role={canvas}]');
-            const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
-            let n = 0; for (let i = 3; i < d.length; i += 4) if (d[i]) n++; return n; }})()""") > 5000, canvas
-    # forces: the Jacobian at the field's centre, the estimate's error in the text
+    assert page.input_value("[data-role=x0]") == "-0.025" and page.input_value("[data-role=y1]") == "0.275"
+    for canvas in ("traj-ink", "traj-lag", "traj-current"):  # every plot drawn
+        assert _inked(page, canvas) > 5000, canvas
+    # another line: the table and the route's document follow the inputs
+    page.fill("[data-role=x0]", "-0.04")
+    page.fill("[data-role=y0]", "0.25")
+    page.fill("[data-role=x1]", "0.04")
+    page.fill("[data-role=y1]", "0.25")
+    page.click("[data-role=traj-go]")
+    page.wait_for_function("window.kinematicsMotion.trajectory.a_m[0] < -0.03 && window.kinematicsMotion.idle()",
+                           timeout=120_000)
+    assert page.evaluate("window.kinematicsMotion.trajectory.methods[0].move_s") == pytest.approx(0.08 / 0.02)
+    assert page.evaluate("window.kinematicsMotion.errors") == 0
+
+
+def test_the_forces_view_in_chromium_and_the_link_back(page: Any, motion_cockpit: Cockpit) -> None:
+    _open(page, motion_cockpit)
+    for canvas in ("ellipses", "force"):
+        assert _inked(page, canvas) > 5000, canvas
+    # the Jacobian at the field's centre, the estimate's error in the text
     assert page.locator("[data-role=jacobian] tbody tr").count() == 4
     assert text_of(page, "pose") == "x 0.000 m, y 0.250 m"
     assert text_of(page, "force-error").startswith("mean ")
@@ -122,8 +144,11 @@ def test_the_page_in_chromium_shows_both_views_and_links_back(page: Any, motion_
     page.wait_for_function("(window.kinematicsMotion.forces.pose.x_m > 0.02 && window.kinematicsMotion.idle())"
                            " || window.kinematicsMotion.errors > 0", timeout=120_000)
     assert page.evaluate("window.kinematicsMotion.errors") == 0, text_of(page, "status")
-    assert text_of(page, "pose") != "x 0.000 m, y 0.250 m"
-    # and back to /kinematics
+    forces = page.evaluate("window.kinematicsMotion.forces")
+    assert text_of(page, "pose") == f"x {forces['pose']['x_m']:.3f} m, y {forces['pose']['y_m']:.3f} m"
+    jac = page.locator("[data-role=jacobian] tbody tr").nth(0).locator("td").nth(0).text_content()
+    assert jac == f"{forces['pose']['jacobian'][0][0]:.4f}"
+    # and back to /kinematics, which links here
     page.click("[data-role=back]")
     page.wait_for_url("**/kinematics")
     assert page.locator("a[href='/kinematics/motion']").count() == 1

@@ -45,7 +45,7 @@ PEN_SPRING_N_PER_M = 1000.0
 #: ... on top of its preload (N): a whiteboard marker presses with about 2 N at 1 mm.
 PEN_PRELOAD_N = 1.0
 #: The rolling average of the estimate (s), as the WPI report smooths its strain gauges.
-ESTIMATE_WINDOW_S = 0.1
+ESTIMATE_WINDOW_S = 0.2
 #: Samples this long after the pen touches down or before it lifts are left out of the comparison (s).
 EDGE_S = 0.15
 

@@ -11,6 +11,8 @@ import argparse
 from collections.abc import Callable
 from typing import Any
 
+from .kinematics_view import view_command
+
 #: One colour per trajectory method, as the page draws them.
 METHOD_COLOURS = {"increment": "#1f77b4", "step_fr_sw": "#d62728", "cubic": "#2ca02c", "quintic": "#9467bd"}
 
@@ -113,8 +115,6 @@ def _views() -> dict[str, Any]:
 
 
 def _run(view: str) -> Callable[[argparse.Namespace], int]:
-    from .kinematics import view_command
-
     return view_command(view, _views, _query, _text, draw_png, _option_names)
 
 

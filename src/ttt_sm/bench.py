@@ -97,6 +97,13 @@ def bench_ik_race_section(params: ArmParams, seed: int = 0, quick: bool = False)
     return bench_ik_race(params, targets=10 if quick else 50, seed=seed)
 
 
+def bench_motion_lab_section(params: ArmParams, seed: int = 0, quick: bool = False) -> dict[str, Any]:
+    """The kinematics lab's trajectories and forces (see twin/motion_bench.py)."""
+    from .twin.motion_bench import bench_motion_lab
+
+    return bench_motion_lab(params, seed=seed, quick=quick)
+
+
 def bench_steps(params: ArmParams, out_dir: Path) -> dict[str, Any]:
     """Step responses of the three drives on the nonlinear plant (as `ttt-sm tune`)."""
     from .twin.step_response import tune_report
@@ -245,6 +252,7 @@ SECTIONS: dict[str, Callable[..., dict[str, Any]]] = {
     "steps": lambda p, a: bench_steps(p, a["out"]),
     "ik": lambda p, a: bench_ik_section(p, a["seed"]),
     "ik_race": lambda p, a: bench_ik_race_section(p, a["seed"], a["quick"]),
+    "motion_lab": lambda p, a: bench_motion_lab_section(p, a["seed"], a["quick"]),
     "loop": lambda p, a: bench_loop(p, a["loop_seconds"], a["seed"]),
     "pacing": lambda p, a: bench_pacing(p, a["pacing_seconds"], a["seed"]),
     "charts": lambda p, a: bench_charts(p),

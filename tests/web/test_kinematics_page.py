@@ -133,7 +133,10 @@ def test_the_page_in_chromium_answers_the_three_exercises(page: Any, kin_cockpit
     # the DH table shown is the route's, the frames drawn
     assert page.locator("[data-role=dh-table] tbody tr").count() == 4
     assert page.locator("[data-role=dh-table] tbody tr").nth(1).locator("td").nth(3).text_content() == "0.2200"
-    assert page.locator("a[href='/kinematics/motion']").count() == 0  # no link to a page not built yet
+    # the link to the trajectories and forces page works
+    motion = page.locator("a[href='/kinematics/motion']")
+    assert motion.count() == 1
+    assert page.request.get(kin_cockpit.page_url("/kinematics/motion")).status == 200
     # (a)
     _set(page, "q3max", "100")
     assert text_of(page, "elbow-down") == "none"

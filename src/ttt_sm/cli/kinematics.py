@@ -1,5 +1,7 @@
 """``ttt-sm kinematics workspace|dh|race``: the ``/kinematics`` page's views on the command line.
 
+(``trajectory`` and ``forces``, the ``/kinematics/motion`` page's, come from :mod:`.kinematics_motion`.)
+
 Each prints the same JSON document as the page's route ``/api/kinematics/<view>``
 (``--json``), or a short text, and draws the view into a PNG (``--png PATH``).
 docs/kinematics.md, "Lab", explains the views and the exercises.
@@ -8,12 +10,10 @@ docs/kinematics.md, "Lab", explains the views and the exercises.
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 from collections.abc import Callable
 from typing import Any
 
-from .common import CliError, print_json
+from .kinematics_view import view_command
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
@@ -54,6 +54,9 @@ def register(sub: Any) -> argparse.ArgumentParser:
     rc.add_argument("--max-iterations", type=int, default=100, help="iterations per method (default 100)")
     _common(rc)
     rc.set_defaults(func=_run("race"))
+    from .kinematics_motion import add_motion_commands
+
+    add_motion_commands(acts)  # trajectory, forces: the /kinematics/motion page's views
     return sp
 
 
@@ -108,28 +111,14 @@ def _text(view: str, data: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _views() -> dict[str, Any]:
+    from ..web.kinematics import VIEWS
+
+    return VIEWS
+
+
 def _run(view: str) -> Callable[[argparse.Namespace], int]:
-    def run(args: argparse.Namespace) -> int:
-        from ..twin.workspace import load_arm
-        from ..web.kinematics import VIEWS, KinematicsQueryError
-
-        if args.png is not None and (not args.png.lower().endswith(".png") or os.path.isdir(args.png)):
-            raise CliError(f"{view}: --png must name a .png file, got {args.png!r}")
-        params = load_arm(args.params)
-        try:
-            data = VIEWS[view](params, _query(view, args))
-        except (KinematicsQueryError, ValueError) as exc:
-            raise CliError(f"{view}: {_option_names(str(exc))}") from None
-        if args.png:
-            draw_png(view, data, args.png)
-            print(f"kinematics {view}: wrote {args.png}", file=sys.stderr)
-        if args.json:
-            print_json(data)
-        else:
-            print(_text(view, data))
-        return 0
-
-    return run
+    return view_command(view, _views, _query, _text, draw_png, _option_names)
 
 
 def _option_names(message: str) -> str:

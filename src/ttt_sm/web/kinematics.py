@@ -129,8 +129,13 @@ VIEWS: dict[str, Callable[[ArmParams, Mapping[str, str]], dict[str, Any]]] = {
     "workspace": workspace_view, "dh": dh_view, "race": race_view}
 
 
-def routes(params: Callable[[], ArmParams]) -> list[Any]:
-    """The page and its JSON routes (``/api/kinematics/<view>``), for :func:`~.server.create_app`."""
+def json_route(path: str, views: Mapping[str, Callable[[ArmParams, Mapping[str, str]], dict[str, Any]]],
+               params: Callable[[], ArmParams]) -> Any:
+    """The route ``path`` (with ``{view}``) answering ``views[view](params(), query)`` as JSON.
+
+    An unknown view is a 404, a bad query value a 400 with the one-line message; the
+    view runs in a worker thread (a twin run takes a while).
+    """
     import asyncio
 
     from starlette.requests import Request
@@ -139,13 +144,18 @@ def routes(params: Callable[[], ArmParams]) -> list[Any]:
 
     async def view(request: Request) -> Response:
         name = request.path_params["view"]
-        fn = VIEWS.get(name)
+        fn = views.get(name)
         if fn is None:
-            return JSONResponse({"error": f"no view {name!r}: one of {', '.join(VIEWS)}"}, status_code=404)
+            return JSONResponse({"error": f"no view {name!r}: one of {', '.join(views)}"}, status_code=404)
         try:
             data = await asyncio.to_thread(fn, params(), dict(request.query_params))
         except (KinematicsQueryError, ValueError) as exc:
             return JSONResponse({"error": str(exc)}, status_code=400)
         return JSONResponse(data, headers={"Cache-Control": "no-store"})
 
-    return [Route("/api/kinematics/{view}", view)]
+    return Route(path, view)
+
+
+def routes(params: Callable[[], ArmParams]) -> list[Any]:
+    """The page's JSON routes (``/api/kinematics/<view>``), for :func:`~.server.create_app`."""
+    return [json_route("/api/kinematics/{view}", VIEWS, params)]

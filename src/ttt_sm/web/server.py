@@ -12,6 +12,7 @@ Routes: ``/`` (links every page), ``/charts`` (the chart cockpit), ``/game``
 ``/api/camera/frame.png`` (the newest picture of ``--camera``, :mod:`.camera_feed`),
 ``/operate`` (the Operational page, :mod:`.operate`),
 ``/kinematics`` and ``/api/kinematics/<view>`` (the kinematics lab: workspace, DH table, IK race, :mod:`.kinematics`),
+``/kinematics/motion`` and ``/api/kinematics/motion/<view>`` (trajectories and forces, :mod:`.kinematics_motion`),
 ``/lab`` and ``/api/lab`` (with ``ttt-sm gui --lab``: the student's chart live while they write it, :mod:`.lab_watch`),
 ``/static/...`` (the pages' scripts and styles, from the package: nothing from
 a CDN, no build step), ``/api/diagram/{chart}?view=&open=`` (an annotated
@@ -62,6 +63,7 @@ from .camera_feed import feed_png
 from .diagrams import DiagramError, Diagrams
 from .game import photo_png
 from .kinematics import routes as kinematics_routes
+from .kinematics_motion import routes as kinematics_motion_routes
 from .lab_watch import LabWatch
 from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
 from .session import Session
@@ -405,6 +407,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         Route("/lab", lab_page),
         Route("/kinematics", kinematics_page),
         *kinematics_routes(lambda: session.params),
+        *kinematics_motion_routes(lambda: session.params, page),
         Route("/api/lab", lab_state),
         Route("/api/diagram/{chart}", diagram),
         Route("/api/trace.jsonl", trace),

@@ -52,6 +52,27 @@ def test_workspace_json(api: TestClient) -> None:
     assert d["q_max_deg"][2] == pytest.approx(30.0)
 
 
+def test_the_workspace_draws_the_cameras_field_and_it_holds_the_playing_field(api: TestClient, params: Any) -> None:
+    """The game's camera (beyond the far edge, looking down at a slant) sees a trapezoid of the board plane:
+    its image corners mapped back through the camera's homography, the playing field inside it."""
+    from matplotlib.path import Path as Polygon
+
+    from ttt_sm.vision.simulated import CameraPose
+
+    d = get(api, "workspace", resolution=8)
+    footprint = np.asarray(d["camera_field_m"])
+    assert footprint.shape == (4, 2)
+    pose = CameraPose.beyond_far_edge(params)
+    corners = pose.project(np.column_stack([footprint, np.full(4, params.board.surface_z)]))
+    w, h = pose.width_px - 1, pose.height_px - 1
+    assert np.allclose(corners, [[0, 0], [w, 0], [w, h], [0, h]], atol=0.05)  # back on the image's corners
+    fx0, fx1, fy0, fy1 = d["field_m"]
+    assert Polygon(footprint).contains_points([[fx0, fy0], [fx1, fy0], [fx1, fy1], [fx0, fy1]]).all()
+    # nearer the camera (+y) the footprint is narrower: it looks at a slant
+    far, near = footprint[:2], footprint[2:]
+    assert np.ptp(near[:, 0]) < np.ptp(far[:, 0]) and near[:, 1].min() > far[:, 1].max()
+
+
 def test_exercise_a_on_the_route(api: TestClient) -> None:
     d = get(api, "workspace", q2_max_deg=86, q3_max_deg=100, resolution=8)
     down = [(i, j) for i, row in enumerate(d["cells"]) for j, c in enumerate(row) if c == "elbow down"]

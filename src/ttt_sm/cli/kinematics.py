@@ -144,7 +144,7 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
-    from matplotlib.patches import Patch, Rectangle
+    from matplotlib.patches import Patch, Polygon, Rectangle
 
     from ..files import save_figure
 
@@ -156,7 +156,9 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
         bx0, bx1, by0, by1 = data["board_m"]
         fx0, fx1, fy0, fy1 = data["field_m"]
         ax1.add_patch(Rectangle((bx0, by0), bx1 - bx0, by1 - by0, fill=False, ec="k", lw=1.5,
-                                label="whiteboard (the camera's view)"))
+                                label="whiteboard"))
+        ax1.add_patch(Polygon(data["camera_field_m"], closed=True, fill=False, ec="#1f77b4", lw=1.5, ls="--",
+                              label="the camera's field"))
         ax1.add_patch(Rectangle((fx0, fy0), fx1 - fx0, fy1 - fy0, fill=False, ec="#d62728", lw=1.5,
                                 label="playing field"))
         n = len(data["cells"])

@@ -146,6 +146,18 @@ class CameraPose:
         H = self.intrinsics() @ np.column_stack((R[:, 0], R[:, 1], R[:, 2] * surface_z + t))
         return H / H[2, 2]
 
+    def board_footprint(self, surface_z: float = 0.0) -> np.ndarray:
+        """What the camera sees of the board plane: its image's four corners on the plane z = `surface_z`
+        (x, y in m, shape (4, 2); top left, top right, bottom right, bottom left of the image).
+
+        A corner above the horizon (its ray never meets the plane) is a :class:`VisionError`."""
+        H_inv = np.linalg.inv(self.board_to_image(surface_z))
+        w, h = self.width_px - 1, self.height_px - 1
+        corners = H_inv @ np.array([[0.0, w, w, 0.0], [0.0, 0.0, h, h], [1.0, 1.0, 1.0, 1.0]])
+        if not np.all(corners[2] > 0):
+            raise VisionError("camera pose: part of the image lies above the horizon; it sees no whole footprint")
+        return (corners[:2] / corners[2]).T
+
     def project(self, points_m: Any) -> np.ndarray:
         """Image pixels (u, v) of world points, shape (N, 2); `points_m` has shape (N, 3)."""
         p = np.atleast_2d(np.asarray(points_m, float))

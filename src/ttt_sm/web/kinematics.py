@@ -23,6 +23,7 @@ from ..twin.kinematics.dh import DH_COLUMNS, dh_frames, dh_table
 from ..twin.kinematics.race import race
 from ..twin.kinematics.solver import HOME_Q
 from ..twin.kinematics.workspace import TOOLS, with_lengths, workspace
+from ..vision.simulated import CameraPose
 
 
 class KinematicsQueryError(ValueError):
@@ -65,7 +66,9 @@ def workspace_view(params: ArmParams, query: Mapping[str, str]) -> dict[str, Any
     cell_m = _number(query, "cell_m", params.board.cell_size, 0.005, 0.2) or params.board.cell_size
     resolution = int(_number(query, "resolution", 64, 8, 200) or 64)
     w = workspace(params, tool, geometry, lo, hi, resolution=resolution, cells=cells, field_size=cells * cell_m)
-    return w.as_dict()
+    # the game's camera (the simulated one, as mounted by default: beyond the far edge, thesis section 3.6.3)
+    camera = CameraPose.beyond_far_edge(params).board_footprint(params.board.surface_z)
+    return {**w.as_dict(), "camera_field_m": [[round(float(x), 5), round(float(y), 5)] for x, y in camera]}
 
 
 def _q_deg(query: Mapping[str, str]) -> np.ndarray:

@@ -76,16 +76,21 @@ function drawWorkspace(d) {
   grid(ctx, f, t.x_m, t.y_m, t.code);
   rect(ctx, f, d.board_m, "#000", 1.5);
   rect(ctx, f, d.field_m, "#d62728", 1.5);
+  if (d.camera_field_m) {  // what the game's camera sees of the board (a trapezoid: it looks at a slant)
+    ctx.save(); ctx.strokeStyle = "#1f77b4"; ctx.lineWidth = 1.5; ctx.setLineDash([6, 4]); ctx.beginPath();
+    d.camera_field_m.forEach(([x, y], i) => (i ? ctx.lineTo(f.X(x), f.Y(y)) : ctx.moveTo(f.X(x), f.Y(y))));
+    ctx.closePath(); ctx.stroke(); ctx.restore();
+  }
   const [fx0, fx1, fy0] = d.field_m, n = d.cells.length, cs = (fx1 - fx0) / n;
   ctx.font = "10px sans-serif"; ctx.textAlign = "center"; ctx.fillStyle = "#111";
   d.cells.forEach((row, i) => row.forEach((c, j) => {
     ctx.fillText(c === "elbow up" ? "U" : c === "elbow down" ? "D" : "×", f.X(fx0 + (j + 0.5) * cs), f.Y(fy0 + (i + 0.5) * cs) + 4);
   }));
   ctx.fillStyle = "#000"; ctx.beginPath(); ctx.arc(f.X(-d.geometry.l_f), f.Y(0), 4, 0, 7); ctx.fill();
-  legend(ctx, 64, top.height - 46 - 8 * 15, [[CODE_COLOURS[0], "unreachable"], [CODE_COLOURS[1], "elbow up only"],
+  legend(ctx, 64, top.height - 46 - 9 * 15, [[CODE_COLOURS[0], "unreachable"], [CODE_COLOURS[1], "elbow up only"],
     [CODE_COLOURS[2], "elbow down only"], [CODE_COLOURS[3], "both configurations"],
-    ["#000", "whiteboard (camera's view)", "line"], ["#d62728", "playing field (U/D: needs)", "line"],
-    ["#000", "base axis", "mark"]]);
+    ["#000", "whiteboard", "line"], ["#d62728", "playing field (U/D: needs)", "line"],
+    ["#1f77b4", "the camera's field (dashed)", "line"], ["#000", "base axis", "mark"]]);
   const side = role("ws-side"), sc = side.getContext("2d");
   sc.clearRect(0, 0, side.width, side.height);
   const s = d.side;

@@ -21,6 +21,7 @@ from typing import Any
 
 import pytest
 
+from ttt_sm.app.game_outcome import outcome_in_words
 from ttt_sm.app.game_record import read_record
 from ttt_sm.charts.game import MSG_ERASING, MSG_TURNING_OFF, MSG_YOUR_TURN, RESULT_MESSAGES
 from ttt_sm.debug.debugger import Debugger
@@ -52,6 +53,10 @@ def cell(page: Any, row: int, column: int) -> Any:
     return page.get_by_role("gridcell", name=f"row {row}, column {column}", exact=True)
 
 
+#: Some cell of the board can be clicked: the person's turn to draw (occupied cells never can).
+CELL_OFFERED = "Array.from(document.querySelectorAll('[data-role=board] button')).some(b => !b.disabled)"
+
+
 def game_state(cockpit: Cockpit) -> dict[str, Any]:
     def read(dbg: Debugger) -> dict[str, Any]:
         game = dbg.game
@@ -73,7 +78,7 @@ def open_game(page: Any, cockpit: Cockpit) -> None:
 def run_to_first_turn(page: Any) -> None:
     page.get_by_role("button", name="Run", exact=True).click()
     wait_text(page, "text-box2", MSG_YOUR_TURN)
-    page.wait_for_function("!document.querySelector('[data-role=board] button').disabled", timeout=LONG)
+    page.wait_for_function(CELL_OFFERED, timeout=LONG)
 
 
 def wait_board(page: Any, board: str) -> None:
@@ -144,7 +149,7 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
                 " return m !== 'The manipulator is drawing.'; }", timeout=LONG)
             state = game_state(game_cockpit)
             if state["outcome"] is None:
-                page.wait_for_function("!document.querySelector('[data-role=board] button').disabled",
+                page.wait_for_function(CELL_OFFERED,
                                        timeout=LONG)
             photo = page.locator('[data-role="photo"]')
             photos_seen.append(str(photo.get_attribute("data-photo")))
@@ -162,6 +167,9 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
         wait_text(page, "text-box2", MSG_TURNING_OFF)
         # The result, then erasing, then turning off: the thesis' order, as the Game chart output them.
         assert page.evaluate("window.box2")[-3:] == [RESULT_MESSAGES[result], MSG_ERASING, MSG_TURNING_OFF]
+        # ... and who won stays said after Text box2 has moved on
+        words = outcome_in_words(state["outcome"], state["robot"], state["person"])
+        assert text_of(page, "result") == f"Result: {words}."
         state = game_state(game_cockpit)
         person = [m for m in state["moves"] if m["by"] == "person"]
         assert len(person) == person_moves
@@ -187,43 +195,52 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
         page.get_by_role("button", name="New game", exact=True).click()
         wait_text(page, "text-box2", "Wait for the model to be compiled.", timeout=60_000)
         wait_board(page, "." * 25)
+        assert text_of(page, "result") == ""
         assert game_cockpit.session.call(lambda d: (d.robot.t, d.game.engine_name, d.game.moves)) == (0.0, "thesis", [])
         assert text_of(page, "record").startswith(f"The game's record: {tmp_path / 'gui' / 'game-2' / 'game.jsonl'}")
     finally:
         page.close()
 
 
-def test_a_cheat_on_the_robots_cell_is_refused_with_the_games_message(browser: Any,
-                                                                      game_cockpit: Cockpit) -> None:
+def test_an_occupied_cell_cannot_be_clicked_and_a_click_sent_anyway_is_refused_in_words(
+        browser: Any, game_cockpit: Cockpit) -> None:
+    """The page's hand cannot wipe a mark off: an occupied cell is not offered, and the session refuses one
+    without drawing, the game going on (it used to draw, then end the game asking to "wipe your mark")."""
     page = browser.new_page()
     try:
         open_game(page, game_cockpit)
         run_to_first_turn(page)
-        # Play before drawing anything is refused: it is the person's turn.
+        # Play before drawing anything is refused: it is the person's turn (in the page's words).
         page.get_by_role("button", name="Play", exact=True).click()
         page.wait_for_function("document.querySelector('[data-role=reply]').dataset.error === 'true'",
                                timeout=30_000)
-        assert "draw your move (click a cell), then click Play" in text_of(page, "reply")
+        assert text_of(page, "reply").startswith("it is your turn: draw your move (click a cell), then click Play")
         cell(page, 3, 3).click()
         page.get_by_role("button", name="Play", exact=True).click()
         page.wait_for_function("document.querySelector('[data-role=board] button[data-row=\"3\"][data-column=\"3\"]')"
                                ".dataset.by === 'person'", timeout=LONG)
-        page.wait_for_function("!document.querySelector('[data-role=board] button').disabled", timeout=LONG)
-        robot = next(m for m in game_state(game_cockpit)["moves"] if m["by"] == "robot")
-        # The person draws over the manipulator's O: the camera sees it, the game refuses it.
-        cell(page, robot["row"], robot["column"]).click()
-        page.get_by_role("button", name="Play", exact=True).click()
-        wanted = f"Cell ({robot['row']}, {robot['column']}) is already mine."
-        status = page.get_by_role("status", name="the game says").filter(has_text=wanted)
-        status.wait_for(timeout=LONG)
-        assert "Please wipe your mark there and draw in an empty cell." in str(status.text_content())
-        assert status.get_attribute("data-error") == "true"
+        page.wait_for_function(CELL_OFFERED, timeout=LONG)
         state = game_state(game_cockpit)
-        where = 5 * (robot["row"] - 1) + robot["column"] - 1
-        assert state["truth"][where] == "X"  # the hand did draw there ...
-        assert state["board"][where] == "O"  # ... and the game did not take it as the person's move
-        assert state["wrong"] == 1
-        assert len([m for m in state["moves"] if m["by"] == "person"]) == 1
+        robot = next(m for m in state["moves"] if m["by"] == "robot")
+        assert cell(page, robot["row"], robot["column"]).is_disabled() and cell(page, 3, 3).is_disabled()
+        # the symbols in the legend are this game's
+        assert page.locator('[data-role="legend-robot"]').text_content() == state["robot"]
+        assert page.locator('[data-role="legend-person"]').text_content() == state["person"]
+        # a click on the manipulator's cell sent anyway (another page, a script): refused, nothing drawn
+        page.evaluate("([r, c]) => { const b = document.querySelector("
+                      "`[data-role=board] button[data-row=\"${r}\"][data-column=\"${c}\"]`);"
+                      " b.disabled = false; b.click(); }", [robot["row"], robot["column"]])
+        page.wait_for_function("document.querySelector('[data-role=reply]').textContent.startsWith('cell (')",
+                               timeout=30_000)
+        assert text_of(page, "reply") == (f"cell ({robot['row']}, {robot['column']}) holds the manipulator's"
+                                          f" {state['robot']} already: click an empty cell")
+        after = game_state(game_cockpit)
+        assert after["truth"] == state["truth"] and after["wrong"] == 0 and not after["ended"]
+        # the game goes on: an empty cell is taken
+        free = next((r, c) for r in range(1, 6) for c in range(1, 6) if after["truth"][5 * (r - 1) + c - 1] == ".")
+        cell(page, *free).click()
+        page.wait_for_function("([r, c]) => document.querySelector(`[data-role=board] button[data-row=\"${r}\"]"
+                               "[data-column=\"${c}\"]`).dataset.by === 'drawn'", arg=list(free), timeout=30_000)
     finally:
         page.close()
 

@@ -364,6 +364,10 @@ class GameSession:
         if self.remote and self.awaiting != "draw":
             raise GameError("it is not your turn to draw: " + (
                 "click Play for the manipulator to move" if self.awaiting == "play" else self.game.message))
+        there = self.truth[cell_index(row, column)]
+        if self.remote and there != ".":  # the page's hand draws only where it can: it cannot wipe a mark off
+            whose = "the manipulator's" if there == self.robot_symbol and cell in self.robot_cells else "an"
+            raise GameError(f"cell ({row}, {column}) holds {whose} {there} already: click an empty cell")
         self.robot.board.draw_symbol(self.person_symbol, row, column)
         self._place(cell, self.person_symbol, "truth")
         self._event("person_drew", row=row, column=column)

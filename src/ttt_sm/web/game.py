@@ -25,6 +25,7 @@ from typing import Any
 import cv2
 
 from ..app.game import GameSession
+from ..app.game_outcome import outcome_in_words
 from ..app.person import RemotePerson
 from ..charts.game import (
     MSG_COMPILING,
@@ -86,6 +87,7 @@ def game_view(debugger: Debugger) -> dict[str, Any] | None:
         "read": None if view is None else view[1],
         "photos": game.photos,
         "outcome": game.outcome,
+        "result": None if game.outcome is None else outcome_in_words(game.outcome, robot, person),
         "ended": bool(game.game.ended),
         "error": None if driver is None or driver.error is None else str(driver.error),
         "told": told,

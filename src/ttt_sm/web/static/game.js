@@ -99,6 +99,11 @@ function drawGame(g) {
   role("text-box2").textContent = g.message;
   role("robot-symbol").textContent = g.robot_symbol;
   role("person-symbol").textContent = g.person_symbol;
+  role("legend-robot").textContent = g.robot_symbol;
+  role("legend-person").textContent = g.person_symbol;
+  role("legend-drawn").textContent = g.person_symbol;
+  // who won stays shown until a new game (Text box2 moves on to erasing and turning off)
+  role("result").textContent = g.result ? `Result: ${g.result}.` : "";
   // What the game told the person besides Text box2's messages (the robot's move, a refused view).
   const told = g.told.length ? g.told[g.told.length - 1] : "";
   const toldBox = role("told");
@@ -122,7 +127,7 @@ function drawGame(g) {
     }
     b.textContent = shown;
     b.dataset.by = by;
-    b.disabled = !(g.plays_here && g.awaiting === "draw");
+    b.disabled = !(g.plays_here && g.awaiting === "draw") || there !== ".";  // the hand cannot wipe a mark
     b.title = by === "drawn" ? "drawn; the camera reads it when you click Play" : "";
   }
   $('[data-cmd="play"]').disabled = !(g.plays_here && g.awaiting);
@@ -169,7 +174,7 @@ function onMessage(m) {
   } else if (m.type === "reply") {
     say(m.text || "", false);
   } else if (m.type === "error") {
-    say(m.error, true);
+    say(m.error.replace(/^game_\w+: /, ""), true);  // the page's words, not the protocol's command name
     if (m.command === "game_engine" && state.game) role("engine").value = state.game.engine;
   }
 }

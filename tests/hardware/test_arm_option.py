@@ -128,7 +128,7 @@ def test_debug_over_the_emulator_runs_the_charts_on_the_link(emulator, tmp_path,
     commands.write_text("run 2\nshow signals\nreplay 0\n")
     status, out, err = run(["debug", "--arm", emulator.arm, "--commands", str(commands)], capsys)
     assert f"the arm behind {emulator.arm}" in out
-    assert "time is up at t = 2.0000 s, step 2000, chart tick 1000" in out, out
+    assert "time is up at t = 2.000 s, step 2000, chart tick 1000" in out, out
     assert "encoder" in out  # the signals, as the arm behind the link reports them
     # the one thing a session on a real arm cannot do, said so
     assert "replay needs the twin" in out + err and status == 1

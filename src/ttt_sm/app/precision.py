@@ -44,7 +44,6 @@ from ..twin.kinematics import arm_chain_py, fk, jacobian
 from ..twin.plant import gear_play, gravity_torques
 from ..twin.sensor import SensorMount, SensorSpec, TriangulationSensor
 from ..twin.truth import GroundTruth
-from ..twin.tuning import PRESETS
 from .robot import Robot
 
 AXES = ("x", "y", "z")
@@ -470,6 +469,8 @@ def run_staircase(params: ArmParams, axis: str, steps: str, tuning: str = "ours"
         The sensor's pose (default :meth:`StaircaseSpec.default_mount`) and its data (the thesis').
     """
     spec = StaircaseSpec.of(axis, steps, count, hold_s)
+    from ..twin.tuning import PRESETS  # here: it imports python-control, which building a robot need not
+
     if tuning not in PRESETS:
         raise PrecisionError(f"unknown tuning {tuning!r}; choose from {', '.join(PRESETS)}")
     # the arm initialises with the designed gains and runs the preset's once initialised (PresetGainsStage)

@@ -210,6 +210,18 @@ def _cases(tmp: Path) -> list[tuple[list[str], str]]:
     cases.append((["kinematics", "race", "--target", "nan", "0.3"], "--target"))
     numbers(kin_race, "--max-iterations", ("abc", "0", "1e9"))
     numbers(kin_race, "--phi-deg", ("nan", "1e9"))
+    kin_traj = ["kinematics", "trajectory"]
+    numbers(kin_traj, "--speed", ("abc", "nan", "0", "1e9"))
+    numbers(kin_traj, "--hold", ("abc", "nan", "-1"))
+    cases.append(([*kin_traj, "--from", "abc", "0.2"], "--from"))
+    cases.append(([*kin_traj, "--to", "nan", "0.2"], "--to"))
+    cases.append(([*kin_traj, "--methods", "cubic,spline"], "--methods"))
+    cases.append(([*kin_traj, "--png", "picture.jpg"], "--png"))
+    kin_forces = ["kinematics", "forces"]
+    cases.append(([*kin_forces, "--at", "abc", "0.2"], "--at"))
+    cases.append(([*kin_forces, "--at", "9", "9"], "--at"))
+    numbers(kin_forces, "--speed", ("abc", "nan", "0"))
+    cases.append(([*kin_forces, "--png", "/"], "--png"))
     cases.append((["no-such-command"], "no-such-command"))
     return cases
 

@@ -7,7 +7,6 @@ imported only when it runs, so the CLI starts fast.
 from __future__ import annotations
 
 import argparse
-import asyncio
 import ipaddress
 import math
 import secrets
@@ -167,17 +166,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
         server.handle_exit = stop_on  # type: ignore[method-assign]  # uvicorn installs it for SIGINT, SIGTERM
 
         def session_died(why: str) -> None:  # not a corpse that serves pages: the server stops, the status says so
-            def stop() -> None:
-                server.should_exit = True
-
-            loop = getattr(app.state, "loop", None)
-            if loop is None:
-                stop()
-                return
-            try:  # once the pages have heard why (Session.died told them), at most SEND_OUT_S later
-                asyncio.run_coroutine_threadsafe(app.state.when_sent(stop), loop)
-            except RuntimeError:  # the loop is closed: stop at once
-                stop()
+            server.should_exit = True
 
         session.death_listeners.append(session_died)
         try:

@@ -74,9 +74,6 @@ CLIENT_QUEUE = 64
 #: reads that page's socket no faster, so a flood waits in its own connection and never takes the server's
 #: thread (and with it the simulation's share of the interpreter) from the other pages.
 MESSAGE_RATE = 500
-#: When the session dies, ``ttt-sm gui`` stops its server once the pages have their messages (the last one
-#: says why), waiting at most this long, s.
-SEND_OUT_S = 5.0
 #: How long a request that needs the session (``/api/arm/ink.png``) waits for it, seconds; then 503.
 SESSION_WAIT_S = 5.0
 #: Such requests waiting for the session at once, at most; one more gets 503 at once.
@@ -291,9 +288,6 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         body = "".join(r.to_json() + "\n" for r in records)
         return Response(body, media_type="application/x-ndjson", headers=headers)
 
-    outboxes: set[asyncio.Queue[str | None]] = set()  # every page's messages waiting for its socket
-    sending = [0]  # messages being written to a socket now
-
     async def ws(websocket: WebSocket) -> None:
         host = websocket.headers.get("host", "")
         if not origin_ok(websocket.headers.get("origin"), host):
@@ -315,7 +309,6 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
             loop.call_soon_threadsafe(put, text)
 
         cid = session.connect(send_threadsafe)
-        outboxes.add(outbox)
 
         async def pump() -> None:
             nonlocal lagging
@@ -323,11 +316,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                 text = await outbox.get()
                 if text is None:
                     return
-                sending[0] += 1
-                try:
-                    await websocket.send_text(text)
-                finally:
-                    sending[0] -= 1
+                await websocket.send_text(text)
                 if lagging and outbox.empty():
                     lagging = False  # dropped frames: join again for a full frame
                     session.submit(cid, parse_command('{"type": "hello"}'))
@@ -362,25 +351,14 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
             pass
         finally:
             session.disconnect(cid)
-            outboxes.discard(outbox)
             with contextlib.suppress(asyncio.QueueFull):
                 outbox.put_nowait(None)
             sender.cancel()
             with contextlib.suppress(asyncio.CancelledError, Exception):
                 await sender
 
-    async def when_sent(then: Callable[[], None], timeout_s: float = SEND_OUT_S) -> None:
-        """Call ``then`` once every page's messages queued so far are written to its socket, or after
-        ``timeout_s``: ``ttt-sm gui`` stops its server so when the session died, and the pages hear why first."""
-        loop = asyncio.get_running_loop()
-        deadline = loop.time() + timeout_s
-        while (sending[0] or any(not box.empty() for box in outboxes)) and loop.time() < deadline:
-            await asyncio.sleep(0.01)
-        then()
-
     @contextlib.asynccontextmanager
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
-        app.state.loop = asyncio.get_running_loop()
         if manage_session:
             session.start()
         if lab is not None:
@@ -417,6 +395,5 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
     app = Starlette(routes=routes, lifespan=lifespan)
     app.add_middleware(Guard, token=token, hosts=list(hosts))
     app.state.session = session
-    app.state.when_sent = when_sent
     app.state.max_message_bytes = MAX_MESSAGE_BYTES
     return app

@@ -75,6 +75,8 @@ class Viewer:
 
     def __init__(self, host: str, token: str) -> None:
         self.frames: list[tuple[float, float]] = []
+        #: The session's pacing figures of each frame (web/frames.py ``pace``): slips and time lost.
+        self.paces: list[tuple[float, dict[str, Any]]] = []
         self._stop = threading.Event()
         self._thread = threading.Thread(target=lambda: asyncio.run(self._read(host, token)), daemon=True)
         self._thread.start()
@@ -91,7 +93,10 @@ class Viewer:
                 return
             m = json.loads(text)
             if m.get("type") == "frame":
-                self.frames.append((time.perf_counter(), float(m["t"])))
+                now = time.perf_counter()
+                self.frames.append((now, float(m["t"])))
+                if "pace" in m:
+                    self.paces.append((now, m["pace"]))
         await ws.close()
 
     def stop(self) -> None:
@@ -103,7 +108,13 @@ class Viewer:
         gaps = [b[0] - a[0] for a, b in zip(seen, seen[1:], strict=False)]
         edges = [seen[0][0] - t0, t1 - seen[-1][0]] if seen else [t1 - t0]
         pace = (seen[-1][1] - seen[0][1]) / (seen[-1][0] - seen[0][0]) if len(seen) > 1 else 0.0
-        return {"frames": len(seen), "longest_gap_s": round(max(gaps + edges), 3), "pace_x": round(pace, 3)}
+        paces = [p for w, p in self.paces if t0 <= w <= t1]
+        out = {"frames": len(seen), "longest_gap_s": round(max(gaps + edges), 3), "pace_x": round(pace, 3)}
+        if len(paces) > 1:  # the session's own account of the time it did not keep
+            out["slips"] = paces[-1]["slips"] - paces[0]["slips"]
+            out["lost_s"] = round(paces[-1]["lost_s"] - paces[0]["lost_s"], 3)
+            out["overruns"] = paces[-1]["overruns"] - paces[0]["overruns"]
+        return out
 
 
 async def still_answers(host: str, token: str) -> bool:

@@ -385,3 +385,42 @@ def test_one_page_alone_with_the_robot_paused_is_never_held_back(
         session.disconnect(alone)
     assert [(m["type"], m["id"]) for m in heard] == [("reply", 1), ("reply", 2), ("error", None)]
     assert "used the session more than one page may" in heard[2]["error"]  # told when held back, not before
+
+
+def test_a_joined_page_that_says_hello_again_gets_its_full_frame_with_the_next_frame_not_one_per_hello() -> None:
+    """A flood of ``hello``s from a page that joined costs the robot one full frame a frame period, not one
+    per hello (issue 28: the robot's pace under a flood of 20,000 ``hello``s)."""
+    session = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
+    got: list[dict[str, Any]] = []
+    watched: list[dict[str, Any]] = []
+    cid = session.connect(lambda text: got.append(json.loads(text)))
+    watcher = session.connect(lambda text: watched.append(json.loads(text)))
+    session.start()
+    try:
+        session.submit(watcher, parse_command('{"type": "hello"}'))
+        session.submit(cid, parse_command('{"type": "hello"}'))
+        session.call(lambda d: None)
+        assert [m["type"] for m in got[:2]] == ["session", "frame"] and got[1]["full"]
+        while session.call(lambda d: session._dirty):  # the frame due after power-on has gone out
+            time.sleep(0.01)
+        mark = len(got)
+        seq = got[-1]["seq"]
+
+        def burst(d: Debugger) -> None:  # ten hellos handled between the same two frames
+            for _ in range(10):
+                session._handle(cid, parse_command('{"type": "hello"}'))
+            d.step(200)
+        session.call(burst)
+        deadline = time.monotonic() + 60  # a timeout for a loaded machine, not a measurement
+        while not [m for m in got[mark:] if m["type"] == "frame"] and time.monotonic() < deadline:
+            time.sleep(0.01)
+        steps = session.call(lambda d: d.robot.steps)
+    finally:
+        session.stop()
+    again = got[mark:]
+    assert [m["type"] for m in again] == ["session", "frame"]  # once for the ten, with the next frame
+    frames = again[1:]
+    assert frames[0]["full"] and frames[0]["seq"] > seq and again[0]["info"]["charts"]
+    assert frames[0]["steps"] == steps and frames[0]["data"]  # the robot as it is now, whole
+    others = [m for m in watched if m["type"] == "frame" and m["seq"] == frames[0]["seq"]]
+    assert len(others) == 1 and not others[0]["full"]  # the other page gets the same frame, as a change only

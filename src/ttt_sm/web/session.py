@@ -89,6 +89,9 @@ COMMAND_BUDGET_S = run_commands.COMMAND_BUDGET_S
 PAGE_SHARE = 0.25
 #: Seconds of the simulation thread a page may use at once before :data:`PAGE_SHARE` holds it back.
 PAGE_BURST_S = 2.0
+#: A page that joined and says hello again gets what runs and a full frame at most once in this many seconds
+#: (the full frame is the biggest thing the session builds: a flood of hellos must not make it one a period).
+FULL_AGAIN_S = 1.0
 #: While the robot runs, the commands take at most this share of the simulation thread's time (a flood of
 #: them is handled between longer stretches of the run, whose pace they do not take).
 COMMAND_SHARE = 0.3
@@ -115,6 +118,11 @@ class _Client:
     #: The dropped messages not yet told to the page, and when it may be told next (one reply a window).
     untold: int = 0
     tell_at: float = 0.0
+    #: A page that joined has said hello again: it gets what runs and a full frame with the next frame (one
+    #: frame built for every such page, not one per hello: a flood of them costs no more than a frame a period).
+    full_due: bool = False
+    #: When this page may have the next such full frame (perf_counter): one a :data:`FULL_AGAIN_S` at most.
+    full_at: float = 0.0
 
     def use(self, now: float, spent: float = 0.0) -> float:
         """The page's use of the simulation thread now (``spent`` added): it falls by PAGE_SHARE a second."""
@@ -422,8 +430,12 @@ class Session:
             client = self._clients.get(cid)
             if client is None:
                 return
+            again = client.joined
         if self._info_text is None:  # what the session runs does not change: serialized once, not per hello
             self._info_text = dumps(jsonable({"type": "session", "info": self.info}))
+        if again:  # what runs and a full frame come with the next frame, built once for every page that asked
+            client.full_due = self._dirty = True
+            return
         client.send(self._info_text)
         self.send_to(cid, self.frames.frame(True, self._status()))
         if self.coverage.shown is not None:
@@ -439,9 +451,27 @@ class Session:
         now = time.perf_counter()
         frame = self.frames.next(self._status(), self._resync, now)
         self._resync = False
-        self.broadcast(frame)
+        text = dumps(jsonable(frame))
+        with self._lock:
+            targets = []
+            for c in self._clients.values():
+                due = c.full_due and now >= c.full_at
+                if due:
+                    c.full_due, c.full_at = False, now + FULL_AGAIN_S
+                if c.joined:
+                    targets.append((c.send, due))
+            waiting = any(c.full_due for c in self._clients.values())
+        full_text = None
+        for send, due in targets:
+            if due:
+                send(self._info_text or "")
+            if due and not frame["full"]:
+                full_text = full_text or dumps(jsonable(self.frames.frame(True, self._status())))
+                send(full_text)
+            else:
+                send(text)
         self._last_frame_at = now
-        self._dirty = False
+        self._dirty = waiting  # a page's full frame not yet allowed comes with a later frame
 
     def note_stop(self, reason: StopReason) -> None:
         """Keep why the run stopped (a breakpoint, a step's end, ...), for the frames."""

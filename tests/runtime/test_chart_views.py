@@ -10,7 +10,7 @@ import pytest
 from statemachine import State
 
 from ttt_sm.runtime import Data, TickChart
-from ttt_sm.runtime.dot import WHOLE, View, to_dot, views
+from ttt_sm.runtime.dot import WHOLE, View, legend_dot, legend_features, legend_markdown, to_dot, views
 from ttt_sm.runtime.export import export_all, pictures, render_active, svg_from_dot
 
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz dot not installed")
@@ -125,20 +125,23 @@ def test_a_sub_chart_is_drawn_open_with_the_states_outside_it_as_linked_stubs():
 
 
 def _legend(dot: str) -> str:
-    return dot[dot.index("Legend"):dot.index("</table></td></tr></table>>")]
+    return dot[dot.index("Legend"):dot.index("</table>>")]
 
 
-def test_every_picture_has_a_legend_of_what_it_draws():
-    overview = _legend(to_dot(Plotter, view=views(Plotter)[0]))
-    assert "transition without an event" in overview
-    assert "transition with an event" not in overview  # poke's `on` action is inside a closed sub-chart
-    assert "sub-chart, closed" in overview and "drawn once from the dot" in overview
-    assert "2: [guard]" in overview and "final state" in overview
-    assert "du: f" not in overview  # stroke's during action is inside a closed sub-chart
-    assert "outside this sub-chart" not in overview and "history" not in overview
-    draw = _legend(to_dot(Plotter, view=View("draw", root="draw")))
-    assert "du: f" in draw and "outside this sub-chart" in draw and "sub-chart, closed" not in draw
-    assert "transition with an event" not in draw and "final state" not in draw
+def test_the_legend_is_drawn_once_apart_from_the_pictures_with_what_they_use():
+    for view in views(Plotter):
+        assert "Legend" not in to_dot(Plotter, view=view)
+    used = legend_features(Plotter)
+    legend = _legend(legend_dot(used))
+    # the overview and the sub-charts' pictures together draw these ...
+    assert "transition without an event" in legend and "sub-chart, closed" in legend
+    assert "drawn once from the dot" in legend and "outside this sub-chart" in legend
+    assert "2: [guard]" in legend and "final state" in legend and "du: f" in legend
+    # ... and no history junction, no connective junction
+    assert "history" not in legend and "connective" not in legend
+    assert "history" in _legend(legend_dot())  # every row, when asked for all
+    rows = legend_markdown(used)
+    assert rows[:2] == ["| on the picture | meaning |", "|---|---|"] and len(rows) == 2 + len(used)
 
 
 @needs_dot
@@ -163,6 +166,6 @@ def test_a_closed_sub_chart_is_highlighted_while_a_state_inside_it_is_active():
     box = {line.strip().split(" ")[0]: line for line in dot.splitlines()
            if line.strip().startswith('"') and " -> " not in line}
     assert 'fillcolor="turquoise"' in box['"draw"'] and 'fillcolor="turquoise"' not in box['"base"']
-    assert "active now" in _legend(dot)
+    assert "Legend" not in dot
     sub = render_active(chart, "dot", View("draw", root="draw"))
     assert re.search(r'"pen_down" \[[^\n]*fillcolor="turquoise"', sub)

@@ -287,7 +287,11 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
         out += [f"- [{caption}]({name})" for caption, name in pictures]
         out.append("")
     elif pictures:
-        out += [f"Picture with a legend: [{pictures[0][1]}]({pictures[0][1]}).", ""]
+        out += [f"![{structure.name}]({pictures[0][1]})", ""]
+    if pictures:
+        from .dot import legend_features, legend_markdown  # the pictures' module draws on this one
+
+        out += ["How to read the pictures:", "", *legend_markdown(legend_features(cls)), ""]
     out += ["## Diagram", "",
             "```mermaid", to_mermaid(cls).rstrip("\n"), "```", "", MERMAID_LEGEND, ""]
     decls = cls.declarations() if hasattr(cls, "declarations") else ()

@@ -14,10 +14,14 @@ a chart with subcharts:
 * the **whole chart**, compound states as nested clusters (what
   :func:`~.export.render_active` highlights).
 
-Every picture carries its title and a legend of what it uses (transitions with
-and without events, execution order, condition and transition actions,
-entry/during/exit, history, connective junctions, ...).  Labels read as in
-Stateflow: ``2: event [guard] {condition action} / transition action``.  A
+Every picture carries its title; the legend of what a chart's pictures use
+(transitions with and without events, execution order, condition and transition
+actions, ``en:``/``du:``/``ex:``, history, connective junctions, ...) is drawn
+once per page: :func:`legend_dot` (the cockpit), :func:`legend_markdown` (the
+chart's Markdown page).  Labels read as in Stateflow:
+``2: event [guard] {condition action} / transition action``; an action reads as
+what it does (:mod:`.action_text`), a long one summarised with ``…`` and whole in
+the element's tooltip.  A
 connective junction is a small circle.  Transitions with the same trigger,
 guard and action into the same state are drawn once, from a small dot their
 sources lead into.  A state's ``on`` actions (``on button / ignore_button``)
@@ -31,6 +35,7 @@ edge of transition ``n`` (its index in :class:`~.structure.ChartStructure`).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -208,16 +213,54 @@ _LEGEND: tuple[tuple[str, str, str], ...] = (
 )
 
 
-def _title_and_legend(title: str, features: set[str]) -> str:
-    rows = [f'<tr><td align="left" colspan="2"><font point-size="16"><b>{_html(title)}</b></font></td></tr>']
-    items = [(symbol, meaning) for feature, symbol, meaning in _LEGEND if feature in features]
-    if items:
-        legend = "".join(f'<tr>{symbol}<td align="left">{_html(meaning)}</td></tr>' for symbol, meaning in items)
-        rows.append(
-            '<tr><td align="left" colspan="2"><table border="1" color="#b0b0b0" cellborder="0" cellspacing="0"'
-            f' cellpadding="2"><tr><td align="left" colspan="2"><b>Legend</b></td></tr>{legend}</table></td></tr>'
-        )
-    return '<<table border="0" cellborder="0" cellspacing="0" cellpadding="3">' + "".join(rows) + "</table>>"
+def _title(title: str) -> str:
+    return f'<<font point-size="16"><b>{_html(title)}</b></font>>'
+
+
+def _legend_table(features: set[str] | None) -> str:
+    items = [(symbol, meaning) for feature, symbol, meaning in _LEGEND if features is None or feature in features]
+    rows = "".join(f'<tr>{symbol}<td align="left">{_html(meaning)}</td></tr>' for symbol, meaning in items)
+    return ('<<table border="0" cellborder="0" cellspacing="0" cellpadding="3">'
+            f'<tr><td align="left" colspan="2"><b>Legend</b></td></tr>{rows}</table>>')
+
+
+def legend_features(chart: StateChart | type[StateChart]) -> set[str]:
+    """What the pictures of a chart use (its legend explains those): ``tick``, ``event``, ``entry``, ..."""
+    structure, cls = structure_of(chart), chart_class(chart)
+    found: set[str] = set()
+    for view in views(chart):
+        picture = _Picture(structure, view, set(), cls)
+        picture.dot()
+        found |= picture.features
+    return found
+
+
+def legend_dot(features: set[str] | None = None) -> str:
+    """A picture of the legend alone (``features``: the rows to show, all by default).
+
+    The charts' pictures carry no legend: a page shows it once (the cockpit, collapsible)
+    and a chart's Markdown page lists it once (:func:`legend_markdown`).
+    """
+    return (f'digraph "legend" {{\n  graph [label={_legend_table(features)}, labelloc="t", labeljust="l",'
+            f' fontname={_q(FONT)}, fontsize="10", margin="0"];\n}}\n')
+
+
+def legend_markdown(features: set[str] | None = None) -> list[str]:
+    """The legend as a Markdown table (symbol, meaning)."""
+    out = ["| on the picture | meaning |", "|---|---|"]
+    for feature, symbol, meaning in _LEGEND:
+        if features is None or feature in features:
+            text = re.sub(r"<[^>]+>", " ", symbol).replace("&lt;", "<").replace("&gt;", ">")
+            out.append(f"| {_LEGEND_WORDS.get(feature, ' '.join(text.split()))} | {meaning} |")
+    return out
+
+
+#: How the Markdown legend names a symbol it cannot draw as text.
+_LEGEND_WORDS = {
+    "tick": "black arrow", "event": "blue arrow", "final": "double border", "closed": "grey box",
+    "stub": "dashed box, grey name", "active": "turquoise box", "initial": "● arrow",
+    "connective": "small circle", "junction": "small dot several arrows meet at",
+}
 
 
 # -- the drawing ---------------------------------------------------------------
@@ -533,7 +576,7 @@ class _Picture:
         for state_id in sorted(self.stubs, key=self._order):
             self.features.add("stub")
             state = self.by_id[state_id]
-            where = f'<br/><font point-size="8">in {_html(state.parent)}</font>' if state.parent else ""
+            where = f'<br/><font point-size="9">in {_html(state.parent)}</font>' if state.parent else ""
             out.append(
                 f'  {_q("stub__" + state_id)} [label=<<i>{_html(state.label)}</i>{where}>, style="rounded,dashed",'
                 f' color="{STUB_COLOR}", fontcolor="{STUB_COLOR}", URL="{self.picture_of(state_id)}",'
@@ -555,7 +598,7 @@ class _Picture:
         rankdir = "TB" if has_subcharts else "LR"
         head = [
             f"digraph {_q(self.view.file_stem(s.name))} {{",
-            f"  graph [label={_title_and_legend(self.view.title(s.name), self.features)}, labelloc=\"t\","
+            f"  graph [label={_title(self.view.title(s.name))}, labelloc=\"t\","
             f' labeljust="l", fontname={_q(FONT)}, fontsize="10", rankdir="{rankdir}", compound="true",'
             ' nodesep="0.35", ranksep="0.45"];',
             f'  node [fontname={_q(FONT)}, fontsize="10", shape="box", style="rounded,filled",'

@@ -98,12 +98,23 @@ def annotate(svg: str, chart_name: str, structure: ChartStructure) -> str:
         parent = link.parentNode
         assert isinstance(parent, minidom.Element)  # an <a> below the <svg> element
         _keep_tooltip(link)
-        while (child := link.firstChild) is not None:
-            parent.insertBefore(child, link)
-        parent.removeChild(link)
+        _unwrap(link)
+        # the group Graphviz wraps a link in (id "a_<id>") goes too: the element's path, polygon
+        # and texts are its own children again, as the page's styles expect (`.edge > path`)
+        if parent.tagName == "g" and parent.getAttribute("id").startswith("a_") and not parent.getAttribute("class"):
+            _unwrap(parent)
     text = root.toxml()
     document.unlink()
     return text
+
+
+def _unwrap(element: minidom.Element) -> None:
+    """Replace an element by its children."""
+    parent = element.parentNode
+    assert parent is not None
+    while (child := element.firstChild) is not None:
+        parent.insertBefore(child, element)
+    parent.removeChild(element)
 
 
 def _keep_tooltip(link: minidom.Element) -> None:

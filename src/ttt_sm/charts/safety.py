@@ -268,6 +268,8 @@ class Safety(TickChart):
         self.reason = f"servo stuck: pen servo at {q:.3f} rad, commanded {q + self.servo_err:.3f} rad"
         self.fault_drive = 0
 
+    @does("reason = 'camera lost: no frame from the camera'; fault_drive = 0",
+          summary="reason = 'camera lost: ...'; fault_drive = 0")
     def note_camera_lost(self) -> None:
         self.reason = "camera lost: no frame from the camera"
         self.fault_drive = 0

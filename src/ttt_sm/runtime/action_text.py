@@ -19,8 +19,9 @@ of :data:`HELPERS` and those the chart documents in its ``action_helpers``
 quoted text and equation references ``(eq. 3.41)``.  :func:`unknown_names` lists
 any other name (the charts' tests check every packaged chart with it).
 
-Long texts: the picture shows ``summary`` (or the first statement and ``…``) and
-keeps the full text for the tooltip and the cockpit's click panel.
+Long texts: the picture shows ``summary`` (given, it is always shown; else the
+first statement) and ``…``, and keeps the full text for the tooltip and the
+cockpit's click panel.
 """
 
 from __future__ import annotations
@@ -105,12 +106,14 @@ def statements(text: str) -> list[str]:
 
 
 def _picture_lines(full: str, summary: str | None) -> tuple[str, ...]:
+    """The statements, one a line; a declared summary instead (``…`` after it), or the first statement
+    when they are too many or too long for a picture."""
     parts = statements(full)
-    if len(parts) <= MAX_LINES and all(len(p) <= MAX_CHARS for p in parts):
-        return tuple(parts)
     if summary:
         short = statements(summary)
         return (*short[:-1], short[-1] + " …")
+    if len(parts) <= MAX_LINES and all(len(p) <= MAX_CHARS for p in parts):
+        return tuple(parts)
     first = parts[0] if len(parts[0]) <= MAX_CHARS else parts[0][:MAX_CHARS - 1].rstrip()
     return (first + " …",)
 

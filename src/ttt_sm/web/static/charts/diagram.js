@@ -144,6 +144,7 @@ export class DiagramView {
       });
     }
     this.draw([], true);
+    this.reveal();
     this.onLoaded();
     delete box.dataset.loading;
   }
@@ -184,6 +185,18 @@ export class DiagramView {
       .map((t) => parseFloat(t.getAttribute("font-size"))).filter((x) => x > 0);
     if (!sizes.length) return;
     svg.style.minWidth = `${Math.ceil((box.width * MIN_LABEL_PX) / Math.min(...sizes))}px`;
+  }
+
+  // A picture larger than its box opens scrolled to its first active state, not to an empty corner.
+  reveal() {
+    const box = this.box;
+    const active = box.querySelector('[data-state-id][data-active="true"]:not(.cluster)')
+      || box.querySelector('[data-state-id][data-active="true"]');
+    if (!active || (box.scrollWidth <= box.clientWidth && box.scrollHeight <= box.clientHeight)) return;
+    const a = active.getBoundingClientRect();
+    const b = box.getBoundingClientRect();
+    box.scrollLeft += a.left + a.width / 2 - (b.left + b.width / 2);
+    box.scrollTop += a.top + a.height / 2 - (b.top + b.height / 2);
   }
 
   // The legend of what the chart's pictures use: once on the page (collapsible), not in every picture.

@@ -603,7 +603,9 @@ class _Picture:
             ' nodesep="0.35", ranksep="0.45"];',
             f'  node [fontname={_q(FONT)}, fontsize="10", shape="box", style="rounded,filled",'
             ' fillcolor="white", penwidth="1.5"];',
-            f'  edge [fontname={_q(FONT)}, fontsize="9"];',
+            # decorate: a label is underlined and tied to its edge by a line, so a guard placed
+            # away from a crowded edge still says which edge it belongs to
+            f'  edge [fontname={_q(FONT)}, fontsize="9", decorate="true"];',
         ]
         return "\n".join(head + body + ["}"]) + "\n"
 

@@ -111,7 +111,7 @@ def annotate(svg: str, chart_name: str, structure: ChartStructure) -> str:
 def _unwrap(element: minidom.Element) -> None:
     """Replace an element by its children."""
     parent = element.parentNode
-    assert parent is not None
+    assert isinstance(parent, minidom.Element)  # below the <svg> element
     while (child := element.firstChild) is not None:
         parent.insertBefore(child, element)
     parent.removeChild(element)

@@ -267,12 +267,14 @@ MERMAID_LEGEND = (
 )
 
 
-def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[str, str]] = ()) -> str:
+def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[str, str]] = (),
+                legend: Sequence[str] = ()) -> str:
     """A Markdown page: pictures, Mermaid diagram, data, states and transitions tables.
 
     ``pictures`` are the chart's Graphviz pictures as (what it shows, file name),
     the first the one to see first: with more than one, it is embedded in the page
-    and all are linked.
+    and all are linked.  ``legend``: the pictures' legend, Markdown table rows
+    (:func:`~.dot.legend_markdown`), written once under them.
     """
     structure = structure_of(chart)
     cls = chart_class(chart)
@@ -288,10 +290,8 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
         out.append("")
     elif pictures:
         out += [f"![{structure.name}]({pictures[0][1]})", ""]
-    if pictures:
-        from .dot import legend_features, legend_markdown  # the pictures' module draws on this one
-
-        out += ["How to read the pictures:", "", *legend_markdown(legend_features(cls)), ""]
+    if legend:
+        out += ["How to read the pictures:", "", *legend, ""]
     out += ["## Diagram", "",
             "```mermaid", to_mermaid(cls).rstrip("\n"), "```", "", MERMAID_LEGEND, ""]
     decls = cls.declarations() if hasattr(cls, "declarations") else ()

@@ -133,11 +133,11 @@ class Game(TickChart):
     action_helpers = {"result_message(r)": "the result's message: " + "; ".join(
         f"{k}: {text!r}" for k, text in RESULT_MESSAGES.items())}
 
-    @does(f"message = {MSG_INITIALISING!r}", summary=f"message = {MSG_INITIALISING[:22]!r}")
+    @does(f"message = {MSG_INITIALISING!r}", summary="message = 'The compilation is done'")
     def on_enter_initialising(self) -> None:
         self.message = MSG_INITIALISING
 
-    @does(f"message = {MSG_YOUR_TURN!r}", summary=f"message = {MSG_YOUR_TURN[:25]!r}")
+    @does(f"message = {MSG_YOUR_TURN!r}", summary="message = 'If it is your turn to play'")
     def on_enter_your_turn(self) -> None:
         self.message = MSG_YOUR_TURN
 

@@ -114,7 +114,10 @@ def _picture_lines(full: str, summary: str | None) -> tuple[str, ...]:
         return (*short[:-1], short[-1] + " …")
     if len(parts) <= MAX_LINES and all(len(p) <= MAX_CHARS for p in parts):
         return tuple(parts)
-    first = parts[0] if len(parts[0]) <= MAX_CHARS else parts[0][:MAX_CHARS - 1].rstrip()
+    first = parts[0]
+    if len(first) > MAX_CHARS:  # cut at a word's end
+        cut = first[:MAX_CHARS].rstrip()
+        first = cut[:cut.rfind(" ")].rstrip(" ,=+-*/") if " " in cut else cut
     return (first + " …",)
 
 

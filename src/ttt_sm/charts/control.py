@@ -270,8 +270,9 @@ class Control(TickChart):
     #: What the action texts on the diagrams name besides the chart's data (docs/runtime.md, "What an action does").
     action_helpers = {
         "aim(x, y, z)": "the next move's target: tx, ty, tz = x, y, z (x, y may be given as one point)",
-        "move(v)": "one step of the straight move to (tx, ty, tz) at speed v: X_out = X_out_p + inc, the same for"
-                   " Y and Z, the steps together v*dt long, the target reached exactly (eq. 3.36)",
+        "move(v)": "one step of the straight move to (tx, ty, tz) at speed v: each of X_out, Y_out, Z_out its"
+                   " value at the previous tick plus its share of a step v*dt long, the target reached exactly"
+                   " (eq. 3.36)",
         "inc": "the drawing step per tick along the coordinate the state increments: speed*dt/sqrt(2) for the X"
                " and the O (45-degree lines), speed*dt/2 for the sine",
         "field_start(k)": "(x, y) where line k of the field starts: lines 0-3 parallel to X, 4-7 parallel to Y",

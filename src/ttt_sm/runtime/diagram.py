@@ -18,7 +18,7 @@ from typing import Any
 
 from statemachine import StateChart
 
-from .action_text import action_text
+from .action_text import HELPERS, action_text, helpers
 from .structure import ChartStructure, StateInfo, TransitionInfo
 
 ACTIVE_FILL = "turquoise"
@@ -303,6 +303,12 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
             out.append(f"| {d.kind} | `{d.name}` | {_cell(d.unit)} | `{d.default!r}` | {_cell(doc)} |")
     else:
         out.append("This chart declares no data.")
+    own = {name: doc for name, doc in helpers(cls).items() if name not in HELPERS}
+    if own:
+        out += ["", "## Names in the actions", "",
+                "Besides the data above (an output's value at the previous tick as `<name>_p`) and `dt` (the tick"
+                " period), the actions on the pictures name:", "", "| name | meaning |", "|---|---|"]
+        out += [f"| `{name}` | {_cell(doc)} |" for name, doc in own.items()]
     out += ["", "## States", "", "| state | inside | entry | during | exit |", "|---|---|---|---|---|"]
     for s in structure.states:
         if s.history:

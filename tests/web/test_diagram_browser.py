@@ -37,6 +37,16 @@ def _wait_view(page: Any, chart: str, view: str) -> None:
         " && d.querySelector('svg'); }", arg=[chart, view])
 
 
+def _show_driveinit1(page: Any, cockpit: Cockpit) -> None:
+    """Open the cockpit on DriveInit1's whole chart."""
+    open_page(page, cockpit, "/charts", timeout_ms=TIMEOUT_MS)
+    page.set_default_timeout(TIMEOUT_MS)
+    page.wait_for_selector("[data-state]")
+    page.locator('[data-role="chart-tabs"]').get_by_role("button", name="DriveInit1", exact=True).click()
+    page.locator('[data-role="view-bar"]').get_by_role("button", name="Whole chart").click()
+    _wait_view(page, "DriveInit1", "whole")
+
+
 def _charts(page: Any) -> list[str]:
     """The charts of the session, at a laptop's size."""
     page.set_viewport_size({"width": 1280, "height": 720})
@@ -78,12 +88,7 @@ def test_every_label_of_every_picture_is_at_least_11_px_at_1280x720(page: Any, c
 
 def test_a_click_shows_the_whole_text_of_a_summarised_action_and_the_legend_is_once_on_the_page(
         page: Any, cockpit: Cockpit) -> None:
-    open_page(page, cockpit, "/charts", timeout_ms=TIMEOUT_MS)
-    page.set_default_timeout(TIMEOUT_MS)
-    page.wait_for_selector("[data-state]")
-    page.locator('[data-role="chart-tabs"]').get_by_role("button", name="DriveInit1", exact=True).click()
-    page.locator('[data-role="view-bar"]').get_by_role("button", name="Whole chart").click()
-    _wait_view(page, "DriveInit1", "whole")
+    _show_driveinit1(page, cockpit)
     state = page.locator('[data-role="diagram"] [data-state-id="turn_fwd"]')
     drawn = state.locator("text").all_text_contents()
     assert any(t.startswith("en: pos_out = enc_prev = pos_Encoder") for t in drawn)
@@ -106,12 +111,7 @@ def test_a_click_shows_the_whole_text_of_a_summarised_action_and_the_legend_is_o
 
 
 def test_a_taken_transition_shows_its_count_beside_its_label(page: Any, cockpit: Cockpit) -> None:
-    open_page(page, cockpit, "/charts", timeout_ms=TIMEOUT_MS)
-    page.set_default_timeout(TIMEOUT_MS)
-    page.wait_for_selector("[data-state]")
-    page.locator('[data-role="chart-tabs"]').get_by_role("button", name="DriveInit1", exact=True).click()
-    page.locator('[data-role="view-bar"]').get_by_role("button", name="Whole chart").click()
-    _wait_view(page, "DriveInit1", "whole")
+    _show_driveinit1(page, cockpit)
     # power_on -> turn_fwd is taken on the first chart ticks: step until a count is drawn
     for _ in range(20):
         if page.locator('[data-role="diagram"] text.taken-count').count():

@@ -175,16 +175,8 @@ export class DiagramView {
     }
   }
 
-  // A picture fits the page's width only as far as its smallest label stays MIN_LABEL_PX high: a large
-  // chart is then wider than the page, and the box scrolls.
   readable() {
-    const svg = this.box.querySelector("svg");
-    const box = svg && svg.viewBox.baseVal;
-    if (!box || !box.width) return;
-    const sizes = [...svg.querySelectorAll("text")]
-      .map((t) => parseFloat(t.getAttribute("font-size"))).filter((x) => x > 0);
-    if (!sizes.length) return;
-    svg.style.minWidth = `${Math.ceil((box.width * MIN_LABEL_PX) / Math.min(...sizes))}px`;
+    fitReadable(this.box);
   }
 
   // A picture larger than its box opens scrolled to its first active state, not to an empty corner.
@@ -254,6 +246,18 @@ export class DiagramView {
 }
 
 const SVG_NS = "http://www.w3.org/2000/svg";
+
+// The picture in `box` fits the page's width only as far as its smallest label stays MIN_LABEL_PX
+// high: a large chart is then wider than the page, and the box scrolls (the cockpit, the lab page).
+export function fitReadable(box) {
+  const svg = box.querySelector("svg");
+  const view = svg && svg.viewBox.baseVal;
+  if (!view || !view.width) return;
+  const sizes = [...svg.querySelectorAll("text")]
+    .map((t) => parseFloat(t.getAttribute("font-size"))).filter((x) => x > 0);
+  if (!sizes.length) return;
+  svg.style.minWidth = `${Math.ceil((view.width * MIN_LABEL_PX) / Math.min(...sizes))}px`;
+}
 
 // How often an edge was taken, drawn beside its label ("×3"; at the middle of an edge without one).
 function drawCount(edge, count) {

@@ -64,13 +64,14 @@ def test_dot_draws_compound_states_as_nested_clusters_with_guards_and_actions():
     dot = to_dot(Lamp)
     body = _cluster_body(dot, "on")
     assert '"dim" [' in body and '"bright" [' in body and '"off" [' not in body
-    assert "during / during_dim" in body  # during action inside the state
-    assert "entry / on_enter_off" in dot
-    assert '"dim" -> "bright" [label="[after(3)]\\n/ louder"' in dot
+    # actions read as what they do (their own statements, Stateflow's en:/du:), inside the state
+    assert "du: level = level_p + 1" in body
+    assert "en: level = 0.0" in dot
+    assert '"dim" -> "bright" [label="[after(3)]\\l/ level += 10\\l"' in dot
     # off's two transitions into on are tried in the order written: their execution order is drawn
-    assert '"off" -> "on__start" [label="1: [switch]", lhead="cluster_on"' in dot
-    assert '"on" -> "off" [label="[not switch]", ltail="cluster_on"' in dot
-    assert '"off" -> "on__start" [label="2: button"' in dot
+    assert '"off" -> "on__start" [label="1: [switch]\\l", tooltip="off → on: 1: [switch]", lhead="cluster_on"' in dot
+    assert '"on" -> "off" [label="[not switch]\\l", tooltip="on → off: [not switch]", ltail="cluster_on"' in dot
+    assert '"off" -> "on__start" [label="2: button\\l"' in dot
 
 
 def test_mermaid_nests_compound_states():
@@ -79,8 +80,8 @@ def test_mermaid_nests_compound_states():
     nested = re.search(r"state on \{\n(.*?)\n    \}", text, re.S)
     assert nested is not None
     assert "[*] --> dim" in nested.group(1)
-    assert "dim --> bright : [after(3)] / louder" in nested.group(1)
-    assert "dim : during / during_dim" in nested.group(1)
+    assert "dim --> bright : [after(3)] / level += 10" in nested.group(1)
+    assert "dim : du#58; level = level_p + 1" in nested.group(1)
     assert "off --> on : 1#58; [switch]" in text and "off --> on : 2#58; button" in text
 
 
@@ -90,7 +91,8 @@ def test_markdown_page_has_the_mermaid_block_and_data_table():
     assert "```mermaid\nstateDiagram-v2\n" in page
     assert "| input | `switch` | bool | `False` | wall switch |" in page
     assert "| output | `level` | 1 | `0.0` | light level (previous tick: `level_p`) |" in page
-    assert "| `dim` | `bright` | outer | 1 | tick | after(3) | — | louder |" in page
+    assert "| `dim` | `bright` | outer | 1 | tick | after(3) | — | `louder`: `level += 10` |" in page
+    assert "| `dim` (initial) | on | — | `during_dim`: `level = level_p + 1` | — |" in page
 
 
 def test_render_active_highlights_the_active_states():
@@ -210,7 +212,7 @@ class Resumable(TickChart):
 def test_history_states_are_drawn_inside_their_compound_and_not_counted_as_states():
     dot = to_dot(Resumable)
     assert '"h" [label="H", shape="circle"' in _cluster_body(dot, "work")
-    assert '"pause" -> "h" [label="resume"' in dot
+    assert '"pause" -> "h" [label="resume\\l"' in dot
     assert 'state "H" as h' in to_mermaid(Resumable)
     assert "| `h` (shallow history) | work |" in to_markdown(Resumable)
     chart = Resumable()

@@ -10,7 +10,7 @@ import pytest
 from statemachine import State
 
 from ttt_sm.runtime import Data, TickChart
-from ttt_sm.runtime.dot import WHOLE, View, to_dot, views
+from ttt_sm.runtime.dot import WHOLE, View, legend_dot, legend_features, legend_markdown, to_dot, views
 from ttt_sm.runtime.export import export_all, pictures, render_active, svg_from_dot
 
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz dot not installed")
@@ -83,8 +83,8 @@ def test_the_overview_closes_the_sub_charts_and_ends_edges_on_their_inner_states
     # the edges between sub-charts start and end on the rows of the inner states they
     # leave from (idle, lift, rinse) or enter (back), which the boxes list
     edges = _edges(dot)
-    assert '"base":"p_idle":s -> "draw" [label="2: [go]"' in "\n".join(edges)
-    assert '"base":"p_idle":s -> "wipe" [label="1: [dirty]"' in "\n".join(edges)
+    assert '"base":"p_idle":s -> "draw" [label="2: [go]\\l"' in "\n".join(edges)
+    assert '"base":"p_idle":s -> "wipe" [label="1: [dirty]\\l"' in "\n".join(edges)
     box = next(line for line in dot.splitlines() if line.strip().startswith('"base" ['))
     assert 'port="p_back"' in box and "▸ back" in box and "idle ▸" in box
     assert "poke / count_poke" in box  # a targetless transition is listed in its state
@@ -98,8 +98,8 @@ def test_the_same_transition_from_several_states_is_drawn_once_from_a_junction()
     # lift and rinse -> back [done], draw and wipe -> halted [stop]: each pair meets at a dot
     joined = [e for e in edges if e.startswith('"join_')]
     assert len(joined) == 2
-    assert any('"back"' not in e and '"halted" [label="[stop]"' in e for e in joined)
-    assert any('"base":"p_back":w [label="[done]"' in e for e in joined)
+    assert any('"back"' not in e and '"halted" [label="[stop]\\l"' in e for e in joined)
+    assert any('"base":"p_back":w [label="[done]\\l"' in e for e in joined)
     into_join = [e for e in edges if '-> "join_' in e]
     assert len(into_join) == 4 and all('arrowhead="none"' in e for e in into_join)
     # ... and each transition keeps its own id on its segment
@@ -117,26 +117,31 @@ def test_a_sub_chart_is_drawn_open_with_the_states_outside_it_as_linked_stubs():
     stubs = {m.group(1): m.group(2) for m in re.finditer(r'"stub__(\w+)" \[.*?URL="([^"]+)"', dot)}
     assert stubs == {"idle": "Plotter.base.svg", "back": "Plotter.base.svg", "halted": "Plotter.overview.svg"}
     edges = "\n".join(_edges(dot))
-    assert '"stub__idle" -> "draw__start" [label="2: [go]", lhead="cluster_draw"' in edges
-    assert '"lift" -> "stub__back" [label="[done]"' in edges
-    assert '"draw" -> "stub__halted" [label="[stop]", ltail="cluster_draw"' in edges
+    assert ('"stub__idle" -> "draw__start" [label="2: [go]\\l", tooltip="idle → draw: 2: [go]",'
+            ' lhead="cluster_draw"') in edges
+    assert '"lift" -> "stub__back" [label="[done]\\l"' in edges
+    assert '"draw" -> "stub__halted" [label="[stop]\\l", tooltip="draw → halted: [stop]", ltail="cluster_draw"' in edges
     assert "rinse" not in edges  # wipe's own transitions belong to wipe's picture
 
 
 def _legend(dot: str) -> str:
-    return dot[dot.index("Legend"):dot.index("</table></td></tr></table>>")]
+    return dot[dot.index("Legend"):dot.index("</table>>")]
 
 
-def test_every_picture_has_a_legend_of_what_it_draws():
-    overview = _legend(to_dot(Plotter, view=views(Plotter)[0]))
-    assert "transition without an event" in overview and "transition with an event" in overview  # poke
-    assert "sub-chart, closed" in overview and "drawn once from the dot" in overview
-    assert "2: [guard]" in overview and "final state" in overview
-    assert "during / f" not in overview  # stroke's during action is inside a closed sub-chart
-    assert "outside this sub-chart" not in overview and "history" not in overview
-    draw = _legend(to_dot(Plotter, view=View("draw", root="draw")))
-    assert "during / f" in draw and "outside this sub-chart" in draw and "sub-chart, closed" not in draw
-    assert "transition with an event" not in draw and "final state" not in draw
+def test_the_legend_is_drawn_once_apart_from_the_pictures_with_what_they_use():
+    for view in views(Plotter):
+        assert "Legend" not in to_dot(Plotter, view=view)
+    used = legend_features(Plotter)
+    legend = _legend(legend_dot(used))
+    # the overview and the sub-charts' pictures together draw these ...
+    assert "transition without an event" in legend and "sub-chart, closed" in legend
+    assert "drawn once from the dot" in legend and "outside this sub-chart" in legend
+    assert "2: [guard]" in legend and "final state" in legend and "du: f" in legend
+    # ... and no history junction, no connective junction
+    assert "history" not in legend and "connective" not in legend
+    assert "history" in _legend(legend_dot())  # every row, when asked for all
+    rows = legend_markdown(used)
+    assert rows[:2] == ["| on the picture | meaning |", "|---|---|"] and len(rows) == 2 + len(used)
 
 
 @needs_dot
@@ -161,6 +166,6 @@ def test_a_closed_sub_chart_is_highlighted_while_a_state_inside_it_is_active():
     box = {line.strip().split(" ")[0]: line for line in dot.splitlines()
            if line.strip().startswith('"') and " -> " not in line}
     assert 'fillcolor="turquoise"' in box['"draw"'] and 'fillcolor="turquoise"' not in box['"base"']
-    assert "active now" in _legend(dot)
+    assert "Legend" not in dot
     sub = render_active(chart, "dot", View("draw", root="draw"))
     assert re.search(r'"pen_down" \[[^\n]*fillcolor="turquoise"', sub)

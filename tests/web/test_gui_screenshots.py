@@ -38,7 +38,7 @@ def wait_ready(page: Any, top: str | None = None) -> None:
 
 
 def test_the_screenshots_of_the_guide(browser: Any, cockpit: Cockpit, folder: Path) -> None:
-    page = browser.new_page(viewport={"width": 1500, "height": 1000})
+    page = browser.new_page(viewport={"width": 1280, "height": 720})  # a laptop (issue 27)
     try:
         open_cockpit(page, cockpit)
         go_to_tick(page, 0)

@@ -43,7 +43,7 @@ import math
 
 from statemachine import State
 
-from ..runtime import Data, TickChart, action_on
+from ..runtime import Data, TickChart, action_on, does
 from .geometry import (
     O_START,
     arc_end,
@@ -267,6 +267,22 @@ class Control(TickChart):
 
     pi_2 = math.pi / 2
 
+    #: What the action texts on the diagrams name besides the chart's data (docs/runtime.md, "What an action does").
+    action_helpers = {
+        "aim(x, y, z)": "the next move's target: tx, ty, tz = x, y, z (x, y may be given as one point)",
+        "move(v)": "one step of the straight move to (tx, ty, tz) at speed v: each of X_out, Y_out, Z_out its"
+                   " value at the previous tick plus its share of a step v*dt long, the target reached exactly"
+                   " (eq. 3.36)",
+        "inc": "the drawing step per tick along the coordinate the state increments: speed*dt/sqrt(2) for the X"
+               " and the O (45-degree lines), speed*dt/2 for the sine",
+        "field_start(k)": "(x, y) where line k of the field starts: lines 0-3 parallel to X, 4-7 parallel to Y",
+        "field_end(k)": "(x, y) where line k of the field ends",
+        "circle(a)": "the O's point at angle a: (x0 + R*cos(a), y0 + R*sin(a))",
+        "pass_x(k)": "x of the sponge's pass k over the field",
+        "pass_start(k)": "y where the sponge's pass k starts (5 mm beyond the field)",
+        "pass_end(k)": "y where the sponge's pass k ends",
+    }
+
     # ---------------------------------------------------------------- guards
 
     def at_target(self) -> bool:
@@ -304,6 +320,8 @@ class Control(TickChart):
 
     # ------------------------------------------------------- start_stop
 
+    @does("x_start, y_start, z_start = X_now, Y_now, Z_now; X_out, Y_out, Z_out = X_now, Y_now, Z_now;"
+          " phi = 0; aim(X_now, Y_now, z_safe)", summary="X_out, Y_out, Z_out = X_now, Y_now, Z_now")
     def take_start_pose(self) -> None:
         """Remember where the arm stands once initialised: finish returns there."""
         self.x_start, self.y_start, self.z_start = self.X_now, self.Y_now, self.Z_now
@@ -319,6 +337,7 @@ class Control(TickChart):
     def during_go_over(self) -> None:
         self._move(self.travel_speed)
 
+    @does("X_out, Y_out, Z_out = x_wait, y_wait, z_wait; phi = 0; fr_sw = True")
     def on_enter_go_wait(self) -> None:
         # the thesis' wait_1: a step to the waiting pose, smoothed by slow filters
         self.X_out, self.Y_out, self.Z_out, self.phi = self.x_wait, self.y_wait, self.z_wait, 0.0
@@ -337,6 +356,7 @@ class Control(TickChart):
         self.busy = True
         self.ready = False
 
+    @does("ignored_buttons += 1")
     def ignore_button(self) -> None:
         self.ignored_buttons = self.ignored_buttons + 1
 
@@ -368,6 +388,8 @@ class Control(TickChart):
     def aim_travel(self) -> None:
         self._aim(self.X_out, self.Y_out, self.z_travel)
 
+    @does("aim(X_out, Y_out, max(Z_out, z_safe)) if not isnan(X_out) else aim(x_start, y_start, z_start)",
+          summary="aim(X_out, Y_out, max(Z_out, z_safe))")
     def aim_lift(self) -> None:
         """finish: straight up from wherever the pen is, turning phi back to 0 on the way."""
         if math.isnan(self.X_out):
@@ -393,6 +415,7 @@ class Control(TickChart):
         """Start and end (x, y) of field line k: 0-3 parallel to X, 4-7 parallel to Y."""
         return field_line(self.x11, self.y11, self.L, self.cells, k)
 
+    @does("k = 0; aim(field_start(0), z_up)")
     def on_enter_Drawing_playing_field(self) -> None:
         self.k = 0
         x, y, _, _ = self._field_line(0)
@@ -401,25 +424,31 @@ class Control(TickChart):
     def during_to_line(self) -> None:
         self._move(self.travel_speed)
 
+    @does("aim(field_end(k), z_draw)")
     def aim_line_end(self) -> None:
         _, _, x, y = self._field_line(self.k)
         self._aim(x, y, self.z_draw)
 
+    @does("move(speed) (eq. 3.36)")
     def during_line(self) -> None:
         # eq. 3.36: one coordinate changes by inc per tick, the other stays
         self._move(self.speed)
 
+    @does("k = k + 1; aim(field_start(k), z_up)")
     def next_line(self) -> None:
         self.k = self.k + 1
         x, y, _, _ = self._field_line(self.k)
         self._aim(x, y, self.z_up)
 
+    @does("Pl_fld = True; aim(X_out, Y_out, z_travel)")
     def field_done(self) -> None:
         self.Pl_fld = True
         self.aim_travel()
 
     # ------------------------------------------------------- Drawing_X
 
+    @does("x_ini = x11 - (column-1)*L - (L-size)/2 (eq. 3.37); y_ini = y11 - (row-1)*L - (L-size)/2 (eq. 3.38);"
+          " h1 = y_ini - x_ini (eq. 3.39); aim(x_ini, y_ini, z_up)")
     def on_enter_Drawing_X(self) -> None:
         # eqs. 3.37-3.38, with the symbol size as a parameter: L/5 margins for size 3L/5
         self.x_ini, self.y_ini = x_start(self.x11, self.y11, self.L, self.row, self.column, self.size)
@@ -431,15 +460,18 @@ class Control(TickChart):
 
     during_x_to_start = during_o_to_start = during_s_to_start = _travel
 
+    @does("X_out = max(X_out_p - inc, x_ini - size) (eq. 3.40); Y_out = X_out + h1 (eq. 3.41)")
     def during_line_1(self) -> None:
         # eqs. 3.40-3.41: X decreases, Y follows the 45-degree line Y = X + h1
         self.X_out = max(self.X_out_p - self.speed * self.tick_period_s / math.sqrt(2), self.x_ini - self.size)
         self.Y_out = on_x_line_1(self.X_out, self.h1)
 
+    @does("Y_end = Y_out; aim(X_out, Y_out, z_up)")
     def end_line_1(self) -> None:
         self.Y_end = self.Y_out
         self.aim_up()
 
+    @does("h2 = Y_end + x_ini (eq. 3.42); aim(x_ini, Y_end, z_up)")
     def aim_line_2(self) -> None:
         # eq. 3.42: the second line starts at (x_ini, Y_end)
         self.h2 = x_line_2(self.Y_end, self.x_ini)
@@ -448,6 +480,7 @@ class Control(TickChart):
     def during_to_line_2(self) -> None:
         self._move(self.travel_speed)
 
+    @does("X_out = max(X_out_p - inc, x_ini - size) (eq. 3.43); Y_out = -X_out + h2 (eq. 3.44)")
     def during_line_2(self) -> None:
         # eqs. 3.43-3.44: Y = -X + h2; X decreases (the printed '+' would leave the cell)
         self.X_out = max(self.X_out_p - self.speed * self.tick_period_s / math.sqrt(2), self.x_ini - self.size)
@@ -455,6 +488,8 @@ class Control(TickChart):
 
     # ------------------------------------------------------- Drawing_O
 
+    @does("x0 = x11 - (column-1)*L - L/2 (eq. 3.45); y0 = y11 - (row-1)*L - L/2 (eq. 3.46);"
+          " R = size/2 (eq. 3.47); aim(circle(-pi/4), z_up)")
     def on_enter_Drawing_O(self) -> None:
         # eqs. 3.45-3.47; R = size/2 (the printed R = L/4 is the size L/2)
         self.x0, self.y0 = o_centre(self.x11, self.y11, self.L, self.row, self.column)
@@ -462,10 +497,12 @@ class Control(TickChart):
         # part 1 starts at the lower right: eq. 3.48 decreases X along the lower half (eq. 3.49)
         self._aim(*circle_point(self.x0, self.y0, self.R, O_START), self.z_up)
 
+    @does("k = 0; arc_end = -pi/4 - (k+1)*(pi/2 + arc_overlap); aim(circle(arc_end), z_draw)")
     def start_arc_1(self) -> None:
         self.k = 0
         self._aim_arc()
 
+    @does("k = k + 1; arc_end = -pi/4 - (k+1)*(pi/2 + arc_overlap); aim(circle(arc_end), z_draw)")
     def next_arc(self) -> None:
         self.k = self.k + 1
         self._aim_arc()
@@ -478,6 +515,7 @@ class Control(TickChart):
     def _arc_step(self) -> float:
         return self.speed * self.tick_period_s * math.sqrt(0.5)
 
+    @does("X_out = max(X_out_p - inc, tx) (eq. 3.48); Y_out = -sqrt(R^2 - (X_out - x0)^2) + y0 (eq. 3.49)")
     def during_arc_1(self) -> None:
         # eqs. 3.48-3.49: X decreases along the lower half, Y from the circle (the negative root)
         self.X_out = max(self.X_out_p - self._arc_step(), self.tx)
@@ -485,6 +523,7 @@ class Control(TickChart):
         if self.X_out == self.tx:
             self.Y_out = self.ty
 
+    @does("Y_out = min(Y_out_p + inc, ty) (eq. 3.50); X_out = -sqrt(R^2 - (Y_out - y0)^2) + x0 (eq. 3.51)")
     def during_arc_2(self) -> None:
         # eqs. 3.50-3.51: Y increases along the left half, X from the circle (the negative root)
         self.Y_out = min(self.Y_out_p + self._arc_step(), self.ty)
@@ -492,6 +531,7 @@ class Control(TickChart):
         if self.Y_out == self.ty:
             self.X_out = self.tx
 
+    @does("X_out = min(X_out_p + inc, tx); Y_out = sqrt(R^2 - (X_out - x0)^2) + y0")
     def during_arc_3(self) -> None:
         # like part 1, "X_out is incremented" and the root positive: the upper half
         self.X_out = min(self.X_out_p + self._arc_step(), self.tx)
@@ -499,6 +539,7 @@ class Control(TickChart):
         if self.X_out == self.tx:
             self.Y_out = self.ty
 
+    @does("Y_out = max(Y_out_p - inc, ty); X_out = sqrt(R^2 - (Y_out - y0)^2) + x0")
     def during_arc_4(self) -> None:
         # like part 2, "Y_out is decreased" and the root positive: the right half
         self.Y_out = max(self.Y_out_p - self._arc_step(), self.ty)
@@ -508,6 +549,7 @@ class Control(TickChart):
 
     # ------------------------------------------------------- Drawing_sine
 
+    @does("x0 = x11 - (cells*L - sine_length)/2; y0 = y11 - cells*L/2; aim(x0, y0, z_up)")
     def on_enter_Drawing_sine(self) -> None:
         # along the middle row of the field, from its right edge (section 3.5.3)
         self.x0 = self.x11 - (self.cells * self.L - self.sine_length) / 2
@@ -517,6 +559,8 @@ class Control(TickChart):
     def aim_wave_end(self) -> None:
         self.tx = self.x0 - self.sine_length
 
+    @does("X_out = max(X_out_p - inc, tx); Y_out = y0 + sine_amplitude*sin(2*pi*sine_periods*(x0 - X_out)/sine_length)",
+          summary="X_out = max(X_out_p - inc, tx); Y_out = y0 + sine_amplitude*sin(...)")
     def during_wave(self) -> None:
         # X decreases by a set increment; Y follows the sine
         self.X_out = max(self.X_out_p - self.speed * self.tick_period_s * 0.5, self.tx)
@@ -535,6 +579,7 @@ class Control(TickChart):
     def during_erase_lift(self) -> None:
         self._move(self.z_speed * 2)
 
+    @does("phi = min(phi + phi_rate*dt, pi/2)")
     def during_turn_sponge(self) -> None:
         self.phi = min(self.phi + self.phi_rate * self.tick_period_s, self.pi_2)
 
@@ -545,6 +590,7 @@ class Control(TickChart):
         """Passes along Y over the whole field (and 5 mm beyond), alternately one way and back."""
         return pass_ends(self.y11, self.L, self.cells, k)
 
+    @does("k = 0; aim(pass_x(0), pass_start(0), z_travel)")
     def aim_pass_start(self) -> None:
         self.k = 0
         self._aim(self._pass_x(0), self._pass_ends(0)[0], self.z_travel)
@@ -558,6 +604,7 @@ class Control(TickChart):
     def during_sponge_down(self) -> None:
         self._move(self.z_speed)
 
+    @does("aim(X_out, pass_end(k), z_sponge)")
     def aim_pass_end(self) -> None:
         self._aim(self.X_out, self._pass_ends(self.k)[1], self.z_sponge)
 
@@ -570,6 +617,7 @@ class Control(TickChart):
     def during_sponge_up(self) -> None:
         self._move(self.z_speed)
 
+    @does("k = k + 1; aim(pass_x(k), pass_start(k), z_sponge + 0.01)")
     def next_pass(self) -> None:
         self.k = self.k + 1
         self._aim(self._pass_x(self.k), self._pass_ends(self.k)[0], self.z_sponge + 0.01)

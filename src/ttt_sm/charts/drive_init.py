@@ -32,7 +32,7 @@ import math
 
 from statemachine import HistoryState, State
 
-from ..runtime import Data, TickChart
+from ..runtime import Data, TickChart, does
 
 #: Data every DriveInit chart declares alike (thesis fig. 3.2-3.4: pos_in in, pos_out and the offset out).
 _POS_IN = Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised (IK output)")
@@ -61,6 +61,12 @@ class _HomeAndPass(TickChart):
     the chart's own (``on="set_home"``, ``during_pass_pos``).
     """
 
+    #: What the action texts on the diagrams name besides the chart's data (docs/runtime.md, "What an action does").
+    action_helpers = {
+        "step_towards(v, target, inc)": "v moved towards target by at most inc",
+        "watch_encoder()": "moving = True once the encoder turned still_speed*dt in a tick; enc_prev = pos_Encoder",
+    }
+
     # for type checkers: data every DriveInit chart declares, and its period (it is timed)
     tick_period_s: float
     pos_in: float
@@ -71,6 +77,7 @@ class _HomeAndPass(TickChart):
     passing: bool
     gave_up: bool
 
+    @does("offset = offset + index_angle - index_pos; pos_out = pos_out + index_angle - index_pos")
     def set_home(self) -> None:
         """The index switch changed: its latched encoder angle is `index_angle` really."""
         correction = self.index_angle - self.index_pos
@@ -185,6 +192,8 @@ class DriveInit1(_IndexSearch):
 
     # -- actions ------------------------------------------------------------------
 
+    @does("pos_out = enc_prev = pos_Encoder; inc = search_speed*dt; index_start = index; direction = 1;"
+          " moving = False", summary="pos_out = enc_prev = pos_Encoder; inc = search_speed*dt")
     def on_enter_turn_fwd(self) -> None:
         self.inc = self.search_speed * self.tick_period_s
         self.index_start = self.index
@@ -203,6 +212,7 @@ class DriveInit1(_IndexSearch):
             self.moving = True
         self.enc_prev = self.pos_Encoder
 
+    @does("pos_out = enc_prev = pos_Encoder; index_start = index; direction = -1; moving = False")
     def reverse(self) -> None:
         """Turn back from where the drive stands, not from where the setpoint ran to."""
         self.pos_out = self.pos_Encoder
@@ -355,11 +365,13 @@ class DriveInit3(_HomeAndPass):
         self.travel = self.travel + self.inc
         self.inc = max(self.speed_min * self.tick_period_s, self.inc * self.shrink)
 
+    @does("pos_out = pos_out_p - speed_min*dt; travel = travel + speed_min*dt")
     def during_leave_switch(self) -> None:
         step = self.speed_min * self.tick_period_s
         self.pos_out = self.pos_out_p - step
         self.travel = self.travel + step
 
+    @does("pos_out = step_towards(pos_out_p, park, speed_max*dt)")
     def during_back_off(self) -> None:
         self.pos_out = _step_towards(self.pos_out_p, self.park, self.speed_max * self.tick_period_s)
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from statemachine import State
 
-from ..runtime import Data, TickChart, action_on, after, after_s
+from ..runtime import Data, TickChart, action_on, after, after_s, does
 
 #: The Tic-tac-toe GUI's messages (thesis section 3.7, Text box2), and the results.
 MSG_COMPILING = "Wait for the model to be compiled."
@@ -69,10 +69,12 @@ class AlgorithmActivator(TickChart):
     def on_enter_spent(self) -> None:
         self.enable = False
 
+    @does("o_pos_used = -1 if hold else o_pos_used")
     def on_enter_armed(self) -> None:
         if self.hold:
             self.o_pos_used = -1
 
+    @does("ignored_triggers += 1")
     def ignore_trigger(self) -> None:
         self.ignored_triggers = self.ignored_triggers + 1
 
@@ -127,19 +129,28 @@ class Game(TickChart):
     erasing.to(turning_off, cond="erased and not play_again")
     turning_off.to(off, cond="finished")
 
+    #: What the action texts on the diagrams name besides the chart's data (docs/runtime.md, "What an action does").
+    action_helpers = {"result_message(r)": "the result's message: " + "; ".join(
+        f"{k}: {text!r}" for k, text in RESULT_MESSAGES.items())}
+
+    @does(f"message = {MSG_INITIALISING!r}", summary="message = 'The compilation is done'")
     def on_enter_initialising(self) -> None:
         self.message = MSG_INITIALISING
 
+    @does(f"message = {MSG_YOUR_TURN!r}", summary="message = 'If it is your turn to play'")
     def on_enter_your_turn(self) -> None:
         self.message = MSG_YOUR_TURN
 
+    @does(f"message = {MSG_DRAWING!r}")
     def on_enter_drawing(self) -> None:
         self.message = MSG_DRAWING
 
+    @does("message = result_message(result); games = games + 1")
     def on_enter_game_over(self) -> None:
         self.message = RESULT_MESSAGES.get(self.result, "Game over.")
         self.games = self.games + 1
 
+    @does(f"message = {MSG_ERASING!r}; erase = True")
     def on_enter_erasing(self) -> None:
         self.message = MSG_ERASING
         self.erase = True
@@ -150,6 +161,7 @@ class Game(TickChart):
     def new_game(self) -> None:
         self.result = 0
 
+    @does(f"message = {MSG_TURNING_OFF!r}; finish = True")
     def on_enter_turning_off(self) -> None:
         self.message = MSG_TURNING_OFF
         self.finish = True

@@ -58,7 +58,7 @@ import math
 
 from statemachine import State
 
-from ..runtime import Data, TickChart, after, after_s
+from ..runtime import Data, TickChart, after, after_s, does
 
 
 def _per_drive(name: str, unit: str, default: object, doc: str) -> tuple[Data, Data, Data]:
@@ -136,6 +136,16 @@ class Safety(TickChart):
         Data("servo_error_s", "s", 0.02, "... for at most this long"),
         Data("servo_off", "s", 0.0, "how long the pen servo's feedback has been off its model by more than that"),
     )
+
+    #: What the action texts on the diagrams name besides the chart's data (docs/runtime.md, "What an action does").
+    action_helpers = {
+        "first_fault()": "(reason, drive) of the first failed check: the link, then drives 1-3 (encoder jump,"
+                         " overcurrent, stalled encoder, following error, joint limit), then the initialisation",
+        "switch_off(k)": "off_k = True when drive k's fault is an overcurrent or a stalled encoder: its own"
+                         " sensors are in doubt",
+        "count_still(1, 2, 3)": "for each drive k: still_k = still_k + dt while |cmd_speed_k| > moving_speed and"
+                                " speed_k <= stall_ratio*|cmd_speed_k| (ratio 0 while initialising), else 0",
+    }
 
     monitoring = State(initial=True)
 
@@ -240,6 +250,7 @@ class Safety(TickChart):
 
     # -- actions -------------------------------------------------------------------
 
+    @does("reason, fault_drive = first_fault(); switch_off(fault_drive)")
     def note_arm_fault(self) -> None:
         """Record why, and switch off the drive whose own sensors are in doubt."""
         found = self._arm_fault()
@@ -250,11 +261,15 @@ class Safety(TickChart):
         if k and any(reason.startswith(text) for text, off in _KINDS.values() if off):
             setattr(self, f"off_{k}", True)
 
+    @does("reason = 'servo stuck: pen servo at ... rad, commanded ... rad'; fault_drive = 0",
+          summary="reason = 'servo stuck: ...'; fault_drive = 0")
     def note_servo_stuck(self) -> None:
         q = self.servo_q
         self.reason = f"servo stuck: pen servo at {q:.3f} rad, commanded {q + self.servo_err:.3f} rad"
         self.fault_drive = 0
 
+    @does("reason = 'camera lost: no frame from the camera'; fault_drive = 0",
+          summary="reason = 'camera lost: ...'; fault_drive = 0")
     def note_camera_lost(self) -> None:
         self.reason = "camera lost: no frame from the camera"
         self.fault_drive = 0
@@ -270,6 +285,8 @@ class Safety(TickChart):
     def on_exit_lift(self) -> None:
         self.lift_z = math.nan
 
+    @does("reinit = True; holding = False; off_1 = off_2 = off_3 = False; still_1 = still_2 = still_3 = 0;"
+          " servo_off = 0", summary="reinit = True; holding = False; off_1 = off_2 = off_3 = False")
     def on_enter_reinitialising(self) -> None:
         self.reinit = True
         self.holding = False
@@ -283,6 +300,8 @@ class Safety(TickChart):
     def on_exit_safe(self) -> None:
         self.tripped = False
 
+    @does("count_still(1, 2, 3); servo_off = servo_off + dt if abs(servo_err) > max_servo_error else 0",
+          summary="count_still(1, 2, 3)")
     def _count_still(self) -> None:
         """still_k: how long drive k's encoder has run at most stall_ratio of its commanded speed (0 while
         initialising); servo_off: how long the servo's feedback has been off its model."""

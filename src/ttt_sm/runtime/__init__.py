@@ -5,6 +5,7 @@ Charts subclass :class:`TickChart`, declare their data with :class:`Data`, use
 listeners (:class:`Trace`, :class:`Coverage`).  :mod:`.diagram` draws them.
 """
 
+from .action_text import does
 from .chart import TickChart, TickChartMeta
 from .data import Data
 from .errors import (
@@ -43,5 +44,6 @@ __all__ = [
     "UnknownEventError",
     "after",
     "after_s",
+    "does",
     "states_entered_by",
 ]

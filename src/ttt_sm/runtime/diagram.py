@@ -18,6 +18,7 @@ from typing import Any
 
 from statemachine import StateChart
 
+from .action_text import HELPERS, action_text, helpers
 from .structure import ChartStructure, StateInfo, TransitionInfo
 
 ACTIVE_FILL = "turquoise"
@@ -46,15 +47,46 @@ def active_ids(chart: StateChart) -> set[str]:
 # -- shared text -------------------------------------------------------------
 
 
-def state_actions(state: StateInfo) -> list[str]:
-    return (
-        [f"entry / {a}" for a in state.entry]
-        + [f"during / {a}" for a in state.during]
-        + [f"exit / {a}" for a in state.exit]
-    )
+#: Stateflow's keywords of a state's actions.
+KEYWORDS = (("entry", "en"), ("during", "du"), ("exit", "ex"))
 
 
-def handler_lines(state: StateInfo, structure: ChartStructure) -> list[str]:
+def action_lines(cls: type | None, name: str) -> tuple[str, ...]:
+    """What action ``name`` does as the picture writes it (:mod:`.action_text`), else its name."""
+    text = action_text(cls, name) if cls is not None else None
+    return text.lines if text is not None else (name,)
+
+
+def action_full(cls: type | None, name: str) -> str:
+    """The whole text of action ``name`` (its name when it has none)."""
+    text = action_text(cls, name) if cls is not None else None
+    return text.full if text is not None else name
+
+
+def _actions(state: StateInfo) -> list[tuple[str, str]]:
+    return [(short, name) for kind, short in KEYWORDS for name in getattr(state, kind)]
+
+
+def state_actions(state: StateInfo, cls: type | None = None) -> list[str]:
+    """The state's actions as Stateflow writes them in its box: ``en: ...``, ``du: ...``, ``ex: ...``.
+
+    A text of several statements takes a line each, the first after the keyword.
+    """
+    out = []
+    for short, name in _actions(state):
+        lines = action_lines(cls, name)
+        out.append(f"{short}: {lines[0]}")
+        out.extend(f"    {line}" for line in lines[1:])
+    return out
+
+
+def state_actions_full(state: StateInfo, cls: type | None = None) -> list[str]:
+    """The state's actions with their whole texts, one line each (tooltips, the cockpit's panel)."""
+    return [f"{short}: {action_full(cls, name)}" for short, name in _actions(state)]
+
+
+def handler_lines(state: StateInfo, structure: ChartStructure, cls: type | None = None,
+                  full: bool = False) -> list[str]:
     """The state's ``on`` actions (``on button / ignore_button``) and inner self-transitions, listed inside it.
 
     They leave no state and enter none, so they are written in the state's box
@@ -65,10 +97,10 @@ def handler_lines(state: StateInfo, structure: ChartStructure) -> list[str]:
         if t.source != state.id:
             continue
         if t.target is None:
-            first, action = edge_text(t, structure)
+            first, action = edge_text(t, structure, cls, "; ", full)
             lines.append(" ".join(p for p in ("on", first or "every wake-up", action) if p))
         elif t.scope == "inner" and t.target == state.id and not state.is_compound:
-            first, action = edge_text(t, structure)
+            first, action = edge_text(t, structure, cls, "; ", full)
             lines.append(" ".join(p for p in ("↻", first, action) if p))
     return lines
 
@@ -78,15 +110,26 @@ def competing(structure: ChartStructure, t: TransitionInfo) -> int:
     return sum(1 for u in structure.transitions if u.source == t.source and u.scope == t.scope)
 
 
-def edge_text(t: TransitionInfo, structure: ChartStructure) -> tuple[str, str]:
-    """(order, trigger, [guard] and {condition action}; / transition action) of a segment, as Stateflow labels it."""
+def edge_text(t: TransitionInfo, structure: ChartStructure, cls: type | None = None, sep: str = "; ",
+              full: bool = False) -> tuple[str, str]:
+    """(order, trigger, [guard] and {condition action}; / transition action) of a segment, as Stateflow labels it.
+
+    With the chart class ``cls``, an action reads as what it does (:mod:`.action_text`),
+    its statements joined by ``sep``; ``full``: the whole texts, not the picture's summaries.
+    """
+
+    def text(names: tuple[str, ...]) -> str:
+        if full:
+            return "; ".join(action_full(cls, n) for n in names)
+        return sep.join(line for n in names for line in action_lines(cls, n))
+
     order = f"{t.priority}:" if t.scope != "action" and competing(structure, t) > 1 else ""
     trigger = " ".join(t.events) if t.kind == "event" else ""
     guard = f"[{' and '.join(t.guards)}]" if t.guards else ""
-    condition = f"{{{', '.join(t.condition_actions)}}}" if t.condition_actions else ""
+    condition = f"{{{text(t.condition_actions)}}}" if t.condition_actions else ""
     first = " ".join(p for p in (order, trigger, guard, condition) if p)
     done = t.transition_actions + t.after_actions
-    action = f"/ {', '.join(done)}" if done else ""
+    action = f"/ {text(done)}" if done else ""
     return first, action
 
 
@@ -125,6 +168,7 @@ def _scope(structure: ChartStructure, t: TransitionInfo) -> str | None:
 def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = None) -> str:
     """Mermaid ``stateDiagram-v2`` of a chart, compound states nested."""
     structure = structure_of(chart)
+    cls = chart_class(chart)
     active = active or set()
     by_id = {s.id: s for s in structure.states}
     scoped: dict[str | None, list[TransitionInfo]] = {}
@@ -139,7 +183,7 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
         for t in scoped.get(scope, []):
             if t.target is None or (t.scope == "inner" and t.target == t.source and not by_id[t.source].is_compound):
                 continue  # listed in its state (handler_lines)
-            first, action = edge_text(t, structure)
+            first, action = edge_text(t, structure, cls)
             label = " ".join(p for p in (first, action) if p)
             target = t.target or t.source
             suffix = f" : {_m(label)}" if label else ""
@@ -152,7 +196,7 @@ def to_mermaid(chart: StateChart | type[StateChart], active: set[str] | None = N
         for i, state in enumerate(states):
             if parent is not None and parent.parallel and i > 0:
                 out.append(f"{indent}--")
-            actions = state_actions(state) + handler_lines(state, structure)
+            actions = state_actions(state, cls) + handler_lines(state, structure, cls)
             # Mermaid titles a state with its first description line: declare the name
             # as that line, so `s : entry / ...` lines sit under the name, not in its place.
             if state.label != state.id or (actions and not state.is_compound):
@@ -196,11 +240,22 @@ def _cell(value: Any) -> str:
     return text if text else "—"
 
 
+def _actions_cell(cls: type, names: Sequence[str]) -> str:
+    """Actions in a table cell: ``name``: what it does."""
+    parts = []
+    for name in names:
+        text = action_full(cls, name)
+        parts.append(f"`{name}`" + (f": `{text}`" if text != name else ""))
+    return _cell("; ".join(parts))
+
+
 #: Under each Mermaid diagram: how to read it (Mermaid draws no legend of its own).
 MERMAID_LEGEND = (
     "How to read it: a box is titled with the state's name; under it, its actions"
-    " (`entry /` runs when the state is entered, `during /` at every wake-up of the chart"
-    " in which the state stays active, `exit /` when it is left) and its `on` actions"
+    " (`en:` runs when the state is entered, `du:` at every wake-up of the chart"
+    " in which the state stays active, `ex:` when it is left; each written as what it does, in the"
+    " chart's data: `du: pos_out = pos_out_p + inc`, `pos_out_p` the output's value at the previous"
+    " tick; a text ending in `…` is summarised, the tables below give it whole) and its `on` actions"
     " (`on button / ignore_button`: runs after the during action when the event wakes the chart)."
     " Notes beside compound states list theirs. An edge reads"
     " `2: event [guard] {condition action} / transition action`, as in Stateflow: an edge with"
@@ -212,12 +267,14 @@ MERMAID_LEGEND = (
 )
 
 
-def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[str, str]] = ()) -> str:
+def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[str, str]] = (),
+                legend: Sequence[str] = ()) -> str:
     """A Markdown page: pictures, Mermaid diagram, data, states and transitions tables.
 
     ``pictures`` are the chart's Graphviz pictures as (what it shows, file name),
     the first the one to see first: with more than one, it is embedded in the page
-    and all are linked.
+    and all are linked.  ``legend``: the pictures' legend, Markdown table rows
+    (:func:`~.dot.legend_markdown`), written once under them.
     """
     structure = structure_of(chart)
     cls = chart_class(chart)
@@ -232,7 +289,9 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
         out += [f"- [{caption}]({name})" for caption, name in pictures]
         out.append("")
     elif pictures:
-        out += [f"Picture with a legend: [{pictures[0][1]}]({pictures[0][1]}).", ""]
+        out += [f"![{structure.name}]({pictures[0][1]})", ""]
+    if legend:
+        out += ["How to read the pictures:", "", *legend, ""]
     out += ["## Diagram", "",
             "```mermaid", to_mermaid(cls).rstrip("\n"), "```", "", MERMAID_LEGEND, ""]
     decls = cls.declarations() if hasattr(cls, "declarations") else ()
@@ -244,6 +303,12 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
             out.append(f"| {d.kind} | `{d.name}` | {_cell(d.unit)} | `{d.default!r}` | {_cell(doc)} |")
     else:
         out.append("This chart declares no data.")
+    own = {name: doc for name, doc in helpers(cls).items() if name not in HELPERS}
+    if own:
+        out += ["", "## Names in the actions", "",
+                "Besides the data above (an output's value at the previous tick as `<name>_p`) and `dt` (the tick"
+                " period), the actions on the pictures name:", "", "| name | meaning |", "|---|---|"]
+        out += [f"| `{name}` | {_cell(doc)} |" for name, doc in own.items()]
     out += ["", "## States", "", "| state | inside | entry | during | exit |", "|---|---|---|---|---|"]
     for s in structure.states:
         if s.history:
@@ -254,8 +319,8 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
                        " | — | — | — |")
             continue
         out.append(f"| `{s.id}`{' (initial)' if s.initial else ''} | {_cell(s.parent or '')} |"
-                   f" {_cell(', '.join(s.entry))} | {_cell(', '.join(s.during))} |"
-                   f" {_cell(', '.join(s.exit))} |")
+                   f" {_actions_cell(cls, s.entry)} | {_actions_cell(cls, s.during)} |"
+                   f" {_actions_cell(cls, s.exit)} |")
     out += ["", "## Transitions", "",
             "Tried in Stateflow's order at every wake-up of the chart: the outer transitions of the"
             " active state, outermost state first; then its during and `on` actions; then its inner"
@@ -269,6 +334,6 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
         target = f"`{t.target}`" if t.target else "(none)"
         kind = "on" if t.scope == "action" else t.scope
         out.append(f"| `{t.source}` | {target} | {kind} | {t.priority} | {_cell(t.trigger)} |"
-                   f" {_cell(' and '.join(t.guards))} | {_cell(', '.join(t.condition_actions))} |"
-                   f" {_cell(', '.join(t.transition_actions + t.after_actions))} |")
+                   f" {_cell(' and '.join(t.guards))} | {_actions_cell(cls, t.condition_actions)} |"
+                   f" {_actions_cell(cls, t.transition_actions + t.after_actions)} |")
     return "\n".join(out) + "\n"

@@ -14,10 +14,14 @@ a chart with subcharts:
 * the **whole chart**, compound states as nested clusters (what
   :func:`~.export.render_active` highlights).
 
-Every picture carries its title and a legend of what it uses (transitions with
-and without events, execution order, condition and transition actions,
-entry/during/exit, history, connective junctions, ...).  Labels read as in
-Stateflow: ``2: event [guard] {condition action} / transition action``.  A
+Every picture carries its title; the legend of what a chart's pictures use
+(transitions with and without events, execution order, condition and transition
+actions, ``en:``/``du:``/``ex:``, history, connective junctions, ...) is drawn
+once per page: :func:`legend_dot` (the cockpit), :func:`legend_markdown` (the
+chart's Markdown page).  Labels read as in Stateflow:
+``2: event [guard] {condition action} / transition action``; an action reads as
+what it does (:mod:`.action_text`), a long one summarised with ``…`` and whole in
+the element's tooltip.  A
 connective junction is a small circle.  Transitions with the same trigger,
 guard and action into the same state are drawn once, from a small dot their
 sources lead into.  A state's ``on`` actions (``on button / ignore_button``)
@@ -31,6 +35,7 @@ edge of transition ``n`` (its index in :class:`~.structure.ChartStructure`).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -40,10 +45,13 @@ from .diagram import (
     ACTIVE_CLUSTER_FILL,
     ACTIVE_FILL,
     FONT,
+    KEYWORDS,
+    chart_class,
     edge_text,
     handler_lines,
     is_within,
     state_actions,
+    state_actions_full,
     structure_of,
 )
 from .structure import ChartStructure, StateInfo, TransitionInfo
@@ -130,6 +138,12 @@ def _q(text: str) -> str:
     return '"' + escaped + '"'
 
 
+def _left(text: str) -> str:
+    """A quoted DOT label whose lines are left-aligned (``\\l`` after each), as a block of action text reads."""
+    lines = text.split("\n")
+    return '"' + "".join(_q(line)[1:-1] + "\\l" for line in lines) + '"'
+
+
 def _html(text: str) -> str:
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
 
@@ -173,9 +187,11 @@ _LEGEND: tuple[tuple[str, str, str], ...] = (
      "execution order: a source's outer (or inner) transitions are tried in this order, 1 first"),
     ("condition", "<td>{f}</td>", "condition action: f runs as soon as the guard holds, before anything is left"),
     ("action", "<td>/ f</td>", "transition action: f runs once the path reaches a state, between exit and entry"),
-    ("entry", "<td>entry / f</td>", "f runs when the state is entered"),
-    ("during", "<td>during / f</td>", "f runs at every wake-up in which the state stays active"),
-    ("exit", "<td>exit / f</td>", "f runs when the state is left"),
+    ("entry", "<td>en: f</td>", "entry action: f runs when the state is entered"),
+    ("during", "<td>du: f</td>", "during action: f runs at every wake-up in which the state stays active"),
+    ("exit", "<td>ex: f</td>", "exit action: f runs when the state is left"),
+    ("previous", "<td>X_p</td>", "output X's value at the previous tick"),
+    ("summary", "<td>f …</td>", "a long action, summarised: hover for its whole text"),
     ("handler", "<td>on event / f</td>", "the state's on action: f runs after its during action, when the"
                                           " event wakes the chart; the state stays"),
     ("inner", "<td>↻ [guard] / f</td>", "inner transition of the state to itself: f runs, nothing is left"),
@@ -197,16 +213,54 @@ _LEGEND: tuple[tuple[str, str, str], ...] = (
 )
 
 
-def _title_and_legend(title: str, features: set[str]) -> str:
-    rows = [f'<tr><td align="left" colspan="2"><font point-size="16"><b>{_html(title)}</b></font></td></tr>']
-    items = [(symbol, meaning) for feature, symbol, meaning in _LEGEND if feature in features]
-    if items:
-        legend = "".join(f'<tr>{symbol}<td align="left">{_html(meaning)}</td></tr>' for symbol, meaning in items)
-        rows.append(
-            '<tr><td align="left" colspan="2"><table border="1" color="#b0b0b0" cellborder="0" cellspacing="0"'
-            f' cellpadding="2"><tr><td align="left" colspan="2"><b>Legend</b></td></tr>{legend}</table></td></tr>'
-        )
-    return '<<table border="0" cellborder="0" cellspacing="0" cellpadding="3">' + "".join(rows) + "</table>>"
+def _title(title: str) -> str:
+    return f'<<font point-size="16"><b>{_html(title)}</b></font>>'
+
+
+def _legend_table(features: set[str] | None) -> str:
+    items = [(symbol, meaning) for feature, symbol, meaning in _LEGEND if features is None or feature in features]
+    rows = "".join(f'<tr>{symbol}<td align="left">{_html(meaning)}</td></tr>' for symbol, meaning in items)
+    return ('<<table border="0" cellborder="0" cellspacing="0" cellpadding="3">'
+            f'<tr><td align="left" colspan="2"><b>Legend</b></td></tr>{rows}</table>>')
+
+
+def legend_features(chart: StateChart | type[StateChart]) -> set[str]:
+    """What the pictures of a chart use (its legend explains those): ``tick``, ``event``, ``entry``, ..."""
+    structure, cls = structure_of(chart), chart_class(chart)
+    found: set[str] = set()
+    for view in views(chart):
+        picture = _Picture(structure, view, set(), cls)
+        picture.dot()
+        found |= picture.features
+    return found
+
+
+def legend_dot(features: set[str] | None = None) -> str:
+    """A picture of the legend alone (``features``: the rows to show, all by default).
+
+    The charts' pictures carry no legend: a page shows it once (the cockpit, collapsible)
+    and a chart's Markdown page lists it once (:func:`legend_markdown`).
+    """
+    return (f'digraph "legend" {{\n  graph [label={_legend_table(features)}, labelloc="t", labeljust="l",'
+            f' fontname={_q(FONT)}, fontsize="10", margin="0"];\n}}\n')
+
+
+def legend_markdown(features: set[str] | None = None) -> list[str]:
+    """The legend as a Markdown table (symbol, meaning)."""
+    out = ["| on the picture | meaning |", "|---|---|"]
+    for feature, symbol, meaning in _LEGEND:
+        if features is None or feature in features:
+            text = re.sub(r"<[^>]+>", " ", symbol).replace("&lt;", "<").replace("&gt;", ">")
+            out.append(f"| {_LEGEND_WORDS.get(feature, ' '.join(text.split()))} | {meaning} |")
+    return out
+
+
+#: How the Markdown legend names a symbol it cannot draw as text.
+_LEGEND_WORDS = {
+    "tick": "black arrow", "event": "blue arrow", "final": "double border", "closed": "grey box",
+    "stub": "dashed box, grey name", "active": "turquoise box", "initial": "● arrow",
+    "connective": "small circle", "junction": "small dot several arrows meet at",
+}
 
 
 # -- the drawing ---------------------------------------------------------------
@@ -241,13 +295,16 @@ class _Edge:
     #: whether the source lies in the compound state that holds the target (or both at the top)
     local: bool
     transitions: list[int] = field(default_factory=list)
+    #: the label with the actions' whole texts, for the tooltip
+    full: str = ""
 
 
 class _Picture:
     """The DOT text of one view, and what its legend must explain."""
 
-    def __init__(self, structure: ChartStructure, view: View, active: set[str]) -> None:
+    def __init__(self, structure: ChartStructure, view: View, active: set[str], cls: type | None = None) -> None:
         self.structure = structure
+        self.cls = cls
         self.view = view
         self.active = active
         self.by_id = {s.id: s for s in structure.states}
@@ -312,8 +369,9 @@ class _Picture:
             tail, head = self.end(t, t.source, False), self.end(t, t.target, True)
             if tail.node == head.node and tail.node in self.view.closed and t.source != t.target:
                 continue  # inside a closed sub-chart
-            first, action = edge_text(t, self.structure)
+            first, action = edge_text(t, self.structure, self.cls, "\n  ")
             label = "\n".join(p for p in (first, action) if p)
+            self.note_text(label)
             for state_id, end, as_head in ((t.source, tail, False), (t.target, head, True)):
                 if end.node.startswith("stub__") and state_id not in self.stubs:
                     self.stubs.append(state_id)
@@ -324,7 +382,9 @@ class _Picture:
             key = (tail, head, label, t.kind)
             scope = self.by_id[t.target].parent
             local = scope is None or is_within(self.structure, t.source, scope)
-            edge = drawn.setdefault(key, _Edge(tail, head, label, t.kind, t.source, t.target, local))
+            full = " ".join(p for p in edge_text(t, self.structure, self.cls, full=True) if p)
+            edge = drawn.setdefault(key, _Edge(tail, head, label, t.kind, t.source, t.target, local,
+                                               full=f"{t.source} → {t.target}" + (f": {full}" if full else "")))
             edge.transitions.append(t.index)
             self.features.add(t.kind)
             if first[:1].isdigit():
@@ -359,7 +419,8 @@ class _Picture:
             colour = [] if kind == "tick" else [f'color="{EVENT_COLOR}"', f'fontcolor="{EVENT_COLOR}"']
             if len(group) == 1 or not label:
                 for e in group:
-                    attrs = [f"label={_q(label)}"] if label else []
+                    attrs = [f"label={_left(label)}"] if label else []
+                    attrs.append(f"tooltip={_q(e.full)}")
                     attrs += self.clip_attrs(e.tail, e.head)
                     attrs += ['style="solid"'] if kind == "tick" else colour
                     attrs.append(f'id="{_edge_id(e.transitions)}"')
@@ -377,7 +438,8 @@ class _Picture:
                 attrs = self.clip_attrs(e.tail, _End(join)) + ['arrowhead="none"'] + colour
                 attrs.append(f'id="{_edge_id(e.transitions)}"')
                 out.append(f"  {e.tail.ref()} -> {_q(join)} [{', '.join(attrs)}];")
-            attrs = [f"label={_q(label)}"] + self.clip_attrs(_End(join), head) + colour
+            attrs = [f"label={_left(label)}", f"tooltip={_q(chr(10).join(e.full for e in group))}"]
+            attrs += self.clip_attrs(_End(join), head) + colour
             attrs.append(f'id="{_edge_id(all_ids)}-join"')
             out.append(f"  {_q(join)} -> {head.ref()} [{', '.join(attrs)}];")
         return out
@@ -409,12 +471,26 @@ class _Picture:
 
     # -- states
 
+    def note_text(self, text: str) -> None:
+        """What the legend must explain of an action's text: previous values, summaries."""
+        if "…" in text:
+            self.features.add("summary")
+        if "_p " in text or "_p)" in text or "_p," in text or text.endswith("_p"):
+            self.features.add("previous")
+
+    def tooltip(self, state: StateInfo) -> str:
+        """The state's name and its actions' whole texts: what hovering it shows."""
+        lines = state_actions_full(state, self.cls) + handler_lines(state, self.structure, self.cls, full=True)
+        return "\n".join([state.id, *lines])
+
     def lines_of(self, state: StateInfo) -> list[str]:
-        actions = state_actions(state)
-        for kind in ("entry", "during", "exit"):
-            if any(a.startswith(kind + " /") for a in actions):
+        actions = state_actions(state, self.cls)
+        for kind, short in KEYWORDS:
+            if any(a.startswith(short + ":") for a in actions):
                 self.features.add(kind)
-        handlers = handler_lines(state, self.structure)
+        handlers = handler_lines(state, self.structure, self.cls)
+        for line in actions + handlers:
+            self.note_text(line)
         if handlers:
             for t in self.structure.transitions:
                 if t.source == state.id and (t.target is None or t.target == t.source):
@@ -448,14 +524,18 @@ class _Picture:
             if state.id in self.view.closed:
                 self.features.add("closed")
                 ports = self.port_rows(state.id)
-                attrs = [f"label={_closed_label(state.label, self.lines_of(state), ports)}",
+                # closed, as Stateflow draws a subchart: its name and ports; its own actions in its
+                # tooltip and in its own picture
+                attrs = [f"label={_closed_label(state.label, [], ports)}",
                          f'fillcolor="{ACTIVE_FILL if is_active else CLOSED_FILL}"', 'penwidth="2"',
-                         f'URL="{self.structure.name}.{state.id}.svg"', f'tooltip="sub-chart {state.id}"',
+                         f'URL="{self.structure.name}.{state.id}.svg"',
+                         f"tooltip={_q('sub-chart ' + self.tooltip(state))}",
                          state_id]
                 out.append(f"{indent}{_q(state.id)} [{', '.join(attrs)}];")
             elif state.is_compound:
                 style = "rounded,dashed" if parent is not None and parent.parallel else "rounded"
                 attrs = [f"label={_html_label(state.label, self.lines_of(state))}",
+                         f"tooltip={_q(self.tooltip(state))}",
                          f"style={_q(style + (',filled' if is_active else ''))}", 'labeljust="c"', state_id]
                 if is_active:
                     attrs += [f'fillcolor="{ACTIVE_CLUSTER_FILL}"', 'penwidth="2.5"']
@@ -477,7 +557,8 @@ class _Picture:
                 out.append(f'{indent}{_q(state.id)} [label={_q(state.label)}, shape="circle",'
                            f' width="0.3", fixedsize="true", {state_id}];')
             else:
-                attrs = [f"label={_html_label(state.label, self.lines_of(state))}"]
+                attrs = [f"label={_html_label(state.label, self.lines_of(state))}",
+                         f"tooltip={_q(self.tooltip(state))}"]
                 if state.final:
                     self.features.add("final")
                     attrs.append('peripheries="2"')
@@ -495,7 +576,7 @@ class _Picture:
         for state_id in sorted(self.stubs, key=self._order):
             self.features.add("stub")
             state = self.by_id[state_id]
-            where = f'<br/><font point-size="8">in {_html(state.parent)}</font>' if state.parent else ""
+            where = f'<br/><font point-size="9">in {_html(state.parent)}</font>' if state.parent else ""
             out.append(
                 f'  {_q("stub__" + state_id)} [label=<<i>{_html(state.label)}</i>{where}>, style="rounded,dashed",'
                 f' color="{STUB_COLOR}", fontcolor="{STUB_COLOR}", URL="{self.picture_of(state_id)}",'
@@ -517,12 +598,14 @@ class _Picture:
         rankdir = "TB" if has_subcharts else "LR"
         head = [
             f"digraph {_q(self.view.file_stem(s.name))} {{",
-            f"  graph [label={_title_and_legend(self.view.title(s.name), self.features)}, labelloc=\"t\","
+            f"  graph [label={_title(self.view.title(s.name))}, labelloc=\"t\","
             f' labeljust="l", fontname={_q(FONT)}, fontsize="10", rankdir="{rankdir}", compound="true",'
             ' nodesep="0.35", ranksep="0.45"];',
             f'  node [fontname={_q(FONT)}, fontsize="10", shape="box", style="rounded,filled",'
             ' fillcolor="white", penwidth="1.5"];',
-            f'  edge [fontname={_q(FONT)}, fontsize="9"];',
+            # decorate: a label is underlined and tied to its edge by a line, so a guard placed
+            # away from a crowded edge still says which edge it belongs to
+            f'  edge [fontname={_q(FONT)}, fontsize="9", decorate="true"];',
         ]
         return "\n".join(head + body + ["}"]) + "\n"
 
@@ -545,4 +628,4 @@ def to_dot(chart: StateChart | type[StateChart], active: set[str] | None = None,
     structure = structure_of(chart)
     if view.root is not None and view.root not in {x.id for x in structure.states}:
         raise ValueError(f"{structure.name} has no state {view.root!r} to draw as a sub-chart")
-    return _Picture(structure, view, active or set()).dot()
+    return _Picture(structure, view, active or set(), chart_class(chart)).dot()

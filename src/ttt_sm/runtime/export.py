@@ -32,7 +32,7 @@ from statemachine import StateChart
 
 from ..files import write_atomic
 from .diagram import active_ids, chart_class, to_markdown, to_mermaid
-from .dot import WHOLE, View, to_dot, views
+from .dot import WHOLE, View, legend_features, legend_markdown, to_dot, views
 from .errors import GraphvizMissingError
 
 Chart = StateChart | type[StateChart]
@@ -159,7 +159,8 @@ def _expected(chart: Chart, formats: Sequence[str]) -> dict[str, tuple[str, Call
     expected: dict[str, tuple[str, Callable[[], bytes]]] = {}
     if "mermaid" in formats:
         shown = pictures(cls) if "svg" in formats else []
-        expected[cls.__name__ + _SUFFIX["mermaid"]] = ("", lambda: to_markdown(cls, shown).encode("utf-8"))
+        expected[cls.__name__ + _SUFFIX["mermaid"]] = ("", lambda: to_markdown(
+            cls, shown, legend_markdown(legend_features(cls)) if shown else ()).encode("utf-8"))
     for view in views(cls):
         dot_source = to_dot(cls, view=view)
         dot_hash = _sha(dot_source)

@@ -14,7 +14,9 @@ and get what a page, a test and a screen reader need:
   (their indices) and ``data-taken-count``;
 * a stub (a state drawn in another picture): ``data-stub`` and ``data-view``,
   the picture that draws it;
-* all of them ``role="button"``, ``tabindex="0"`` and an ``aria-label``.
+* all of them ``role="button"``, ``tabindex="0"`` and an ``aria-label``;
+* a state or a transition: ``data-detail`` and its ``<title>``, what its actions
+  do with their whole texts (the picture may show a summary ending in ``…``).
 
 The ids are read with an XML parser (Graphviz writes a ``-`` in an id as
 ``&#45;``); the links Graphviz draws for closed sub-charts and stubs (to the
@@ -29,7 +31,7 @@ from collections import OrderedDict
 from xml.dom import minidom
 
 from ..runtime import TickChart
-from ..runtime.dot import WHOLE, View, overview_with, subcharts, to_dot
+from ..runtime.dot import WHOLE, View, legend_dot, legend_features, overview_with, subcharts, to_dot
 from ..runtime.export import svg_from_dot
 from ..runtime.structure import ChartStructure
 from .catalogue import qualified_names, transition_name
@@ -95,12 +97,42 @@ def annotate(svg: str, chart_name: str, structure: ChartStructure) -> str:
     for link in root.getElementsByTagName("a"):
         parent = link.parentNode
         assert isinstance(parent, minidom.Element)  # an <a> below the <svg> element
-        while (child := link.firstChild) is not None:
-            parent.insertBefore(child, link)
-        parent.removeChild(link)
+        _keep_tooltip(link)
+        _unwrap(link)
+        # the group Graphviz wraps a link in (id "a_<id>") goes too: the element's path, polygon
+        # and texts are its own children again, as the page's styles expect (`.edge > path`)
+        if parent.tagName == "g" and parent.getAttribute("id").startswith("a_") and not parent.getAttribute("class"):
+            _unwrap(parent)
     text = root.toxml()
     document.unlink()
     return text
+
+
+def _unwrap(element: minidom.Element) -> None:
+    """Replace an element by its children."""
+    parent = element.parentNode
+    assert isinstance(parent, minidom.Element)  # below the <svg> element
+    while (child := element.firstChild) is not None:
+        parent.insertBefore(child, element)
+    parent.removeChild(element)
+
+
+def _keep_tooltip(link: minidom.Element) -> None:
+    """The tooltip Graphviz put on a link (what a state's or an edge's actions do, whole) kept on the
+    element it belongs to: its ``<title>`` (what a browser shows on hover) and ``data-detail`` (the
+    cockpit's click panel)."""
+    text = link.getAttribute("xlink:title")
+    group: minidom.Node | None = link.parentNode
+    while isinstance(group, minidom.Element) and group.getAttribute("class") not in _KINDS:
+        group = group.parentNode
+    if not text or not isinstance(group, minidom.Element) or group.hasAttribute("data-detail"):
+        return
+    group.setAttribute("data-detail", text)
+    titles = [c for c in group.childNodes if isinstance(c, minidom.Element) and c.tagName == "title"]
+    if titles:
+        while titles[0].firstChild is not None:
+            titles[0].removeChild(titles[0].firstChild)
+        titles[0].appendChild(group.ownerDocument.createTextNode(text))  # type: ignore[union-attr]
 
 
 class Marker:
@@ -153,19 +185,30 @@ class Diagrams:
                 del self._cache[key]
 
     def svg(self, chart: str, key: str = "overview", opened: tuple[str, ...] = ()) -> str:
-        """One picture of a chart, annotated; :class:`DiagramError` names what does not exist."""
+        """One picture of a chart, annotated; :class:`DiagramError` names what does not exist.
+
+        ``key`` ``"legend"``: the legend of what the chart's pictures use (they carry none).
+        """
         cls = self.charts.get(chart)
         if cls is None:
             raise DiagramError(f"no chart {chart!r}; charts: {', '.join(self.charts)}")
         if key == "overview" and not subcharts(cls):
             key = "whole"
-        view = view_of(cls, key, opened)
+        if key == "legend":
+            if opened:
+                raise DiagramError("a legend opens no sub-charts")
+            view = View("legend")  # only its key: the cache's
+        else:
+            view = view_of(cls, key, opened)
         cache_key = (chart, view.key or "whole", view.opened)
         with self._lock:
             if cache_key in self._cache:
                 self._cache.move_to_end(cache_key)
                 return self._cache[cache_key]
-        picture = annotate(svg_from_dot(to_dot(cls, view=view)), chart, cls.structure())
+        if key == "legend":  # what this chart's pictures use, once per page (collapsible)
+            picture = annotate(svg_from_dot(legend_dot(legend_features(cls))), chart, cls.structure())
+        else:
+            picture = annotate(svg_from_dot(to_dot(cls, view=view)), chart, cls.structure())
         with self._lock:
             if self.charts.get(chart) is not cls:  # replaced while it was drawn: not kept
                 return picture

@@ -6,6 +6,7 @@
 // the class running, each check as it comes, and the diagram, fetched again whenever a
 // new chart has loaded.  The frames only mark the states active now.
 
+import { fitReadable } from "./charts/diagram.js";
 import { role } from "./dom.js";
 import { SessionLink } from "./session.js";
 
@@ -104,6 +105,7 @@ async function loadDiagram(slot, loads) {
     return;
   }
   box.innerHTML = text;
+  fitReadable(box);
   box.dataset.version = String(loads);
   box.dataset.loading = "false";
   markActive();

@@ -9,6 +9,10 @@
 import { $$, button, role } from "../dom.js";
 import { openMenu } from "./menu.js";
 
+// The smallest a label may be drawn, in CSS pixels: "fit to width" shrinks a picture no further
+// (a quarter pixel to spare: the page's layout rounds the picture's width).
+const MIN_LABEL_PX = 11.25;
+
 export class DiagramView {
   // link: the SessionLink; say(text, isError): the page's status line;
   // onLoaded(): called when a picture is in place (the coverage colours it);
@@ -40,6 +44,7 @@ export class DiagramView {
       this.chart = name;
       this.view = chart.subcharts.length ? "overview" : "whole";
       this.opened = [];
+      this.loadLegend(name);
     }
     this.drawViewBar();
     this.load();
@@ -120,6 +125,7 @@ export class DiagramView {
     }
     if (seq !== this.loads) return;  // another picture was asked for meanwhile
     box.innerHTML = text;
+    this.readable();
     box.dataset.chart = this.chart;
     box.dataset.view = this.view + (this.opened.length ? "+" + this.opened.join("+") : "");
     const onClick = (e) => this.onClick(e);
@@ -138,6 +144,7 @@ export class DiagramView {
       });
     }
     this.draw([], true);
+    this.reveal();
     this.onLoaded();
     delete box.dataset.loading;
   }
@@ -158,6 +165,7 @@ export class DiagramView {
       if (all || indices.some((i) => String(i) in taken || flashed.has(i))) {
         const count = indices.reduce((sum, i) => sum + (taken[i] || 0), 0);
         el.dataset.takenCount = String(count);
+        drawCount(el, count);
       }
       if (indices.some((i) => flashed.has(i))) {
         el.classList.remove("flash");
@@ -167,11 +175,48 @@ export class DiagramView {
     }
   }
 
+  readable() {
+    fitReadable(this.box);
+  }
+
+  // A picture larger than its box opens scrolled to its first active state, not to an empty corner.
+  reveal() {
+    const box = this.box;
+    const active = box.querySelector('[data-state-id][data-active="true"]:not(.cluster)')
+      || box.querySelector('[data-state-id][data-active="true"]');
+    if (!active || (box.scrollWidth <= box.clientWidth && box.scrollHeight <= box.clientHeight)) return;
+    const a = active.getBoundingClientRect();
+    const b = box.getBoundingClientRect();
+    box.scrollLeft += a.left + a.width / 2 - (b.left + b.width / 2);
+    box.scrollTop += a.top + a.height / 2 - (b.top + b.height / 2);
+  }
+
+  // The legend of what the chart's pictures use: once on the page (collapsible), not in every picture.
+  async loadLegend(name) {
+    const box = role("diagram-legend");
+    if (!box) return;
+    try {
+      const res = await fetch(`/api/diagram/${encodeURIComponent(name)}?view=legend`);
+      if (res.ok && this.chart === name) box.innerHTML = await res.text();
+    } catch (err) {
+      // the legend is a help only: the diagram's own load reports a broken link
+    }
+  }
+
+  // What a clicked state or transition does, its actions' whole texts (a picture may summarise them with "…").
+  showDetail(el) {
+    const panel = role("diagram-detail");
+    if (!panel) return;
+    panel.textContent = el.dataset.detail || "";
+    panel.hidden = !el.dataset.detail;
+  }
+
   // A click on a state, a transition or a stub: its menu (breakpoints, sub-charts).
   onClick(event) {
     event.preventDefault();
     event.stopPropagation();
     const el = event.currentTarget;
+    this.showDetail(el);
     const chart = this.chart;
     const addBreak = (spec) => this.link.send({ type: "break", spec });
     const items = [];
@@ -198,4 +243,47 @@ export class DiagramView {
     }
     openMenu(items, event);
   }
+}
+
+const SVG_NS = "http://www.w3.org/2000/svg";
+
+// The picture in `box` fits the page's width only as far as its smallest label stays MIN_LABEL_PX
+// high: a large chart is then wider than the page, and the box scrolls (the cockpit, the lab page).
+export function fitReadable(box) {
+  const svg = box.querySelector("svg");
+  const view = svg && svg.viewBox.baseVal;
+  if (!view || !view.width) return;
+  const sizes = [...svg.querySelectorAll("text")]
+    .map((t) => parseFloat(t.getAttribute("font-size"))).filter((x) => x > 0);
+  if (!sizes.length) return;
+  svg.style.minWidth = `${Math.ceil((view.width * MIN_LABEL_PX) / Math.min(...sizes))}px`;
+}
+
+// How often an edge was taken, drawn beside its label ("×3"; at the middle of an edge without one).
+function drawCount(edge, count) {
+  let mark = edge.querySelector(":scope > text.taken-count");
+  if (!count) {
+    if (mark) mark.remove();
+    return;
+  }
+  if (!mark) {
+    mark = document.createElementNS(SVG_NS, "text");
+    mark.setAttribute("class", "taken-count");
+    const label = edge.querySelector("text");
+    const path = edge.querySelector("path");
+    if (label) {
+      const b = label.getBBox();
+      mark.setAttribute("x", String(b.x + b.width + 4));
+      mark.setAttribute("y", label.getAttribute("y"));
+      mark.setAttribute("font-size", label.getAttribute("font-size") || "9");
+    } else if (path) {
+      const p = path.getPointAtLength(path.getTotalLength() / 2);
+      mark.setAttribute("x", String(p.x + 4));
+      mark.setAttribute("y", String(p.y));
+      mark.setAttribute("font-size", "9");
+    }
+    mark.setAttribute("font-family", "Helvetica,sans-Serif");
+    edge.append(mark);
+  }
+  mark.textContent = `×${count}`;
 }

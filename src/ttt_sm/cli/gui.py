@@ -166,7 +166,10 @@ def cmd_gui(args: argparse.Namespace) -> int:
         server.handle_exit = stop_on  # type: ignore[method-assign]  # uvicorn installs it for SIGINT, SIGTERM
 
         def session_died(why: str) -> None:  # not a corpse that serves pages: the server stops, the status says so
-            server.should_exit = True
+            try:  # in the dying simulation thread: the pages first get what they were sent (why it died)
+                app.state.flush_pages()
+            finally:  # whatever happened there, the server stops
+                server.should_exit = True
 
         session.death_listeners.append(session_died)
         try:

@@ -74,6 +74,9 @@ CLIENT_QUEUE = 64
 #: reads that page's socket no faster, so a flood waits in its own connection and never takes the server's
 #: thread (and with it the simulation's share of the interpreter) from the other pages.
 MESSAGE_RATE = 500
+#: When the session dies, ``ttt-sm gui`` stops its server once the pages have their messages (the last one
+#: says why), waiting at most this long, s.
+SEND_OUT_S = 5.0
 #: How long a request that needs the session (``/api/arm/ink.png``) waits for it, seconds; then 503.
 SESSION_WAIT_S = 5.0
 #: Such requests waiting for the session at once, at most; one more gets 503 at once.
@@ -288,6 +291,32 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         body = "".join(r.to_json() + "\n" for r in records)
         return Response(body, media_type="application/x-ndjson", headers=headers)
 
+    outboxes: set[asyncio.Queue[str | None]] = set()  # every page's messages waiting for its socket
+    sending = [0]  # messages being written to a socket now
+    loops: list[asyncio.AbstractEventLoop] = []  # the server's loop, once it runs
+
+    async def _sent_out(deadline: float) -> None:
+        loop = asyncio.get_running_loop()
+        while (sending[0] or any(not box.empty() for box in list(outboxes))) and loop.time() < deadline:
+            await asyncio.sleep(0.01)
+
+    def flush_pages(timeout_s: float = SEND_OUT_S) -> bool:
+        """From another thread: wait until every page's messages queued so far are written to its socket, at
+        most ``timeout_s``; whether they were.  ``ttt-sm gui`` calls it when the session died, before it stops
+        the server (whose shutdown drops what a page has not been sent): the pages hear why first."""
+        if not loops or loops[0].is_closed():
+            return False
+        loop = loops[0]
+        # the messages the dying thread sent are handed to the loop with call_soon_threadsafe: this coroutine,
+        # scheduled the same way after them, finds them in the outboxes
+        future = asyncio.run_coroutine_threadsafe(_sent_out(loop.time() + timeout_s), loop)
+        try:
+            future.result(timeout_s + 1.0)
+        except Exception:  # noqa: BLE001  timed out or the loop went: the server stops anyway
+            future.cancel()
+            return False
+        return True
+
     async def ws(websocket: WebSocket) -> None:
         host = websocket.headers.get("host", "")
         if not origin_ok(websocket.headers.get("origin"), host):
@@ -309,6 +338,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
             loop.call_soon_threadsafe(put, text)
 
         cid = session.connect(send_threadsafe)
+        outboxes.add(outbox)
 
         async def pump() -> None:
             nonlocal lagging
@@ -316,7 +346,11 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                 text = await outbox.get()
                 if text is None:
                     return
-                await websocket.send_text(text)
+                sending[0] += 1
+                try:
+                    await websocket.send_text(text)
+                finally:
+                    sending[0] -= 1
                 if lagging and outbox.empty():
                     lagging = False  # dropped frames: join again for a full frame
                     session.submit(cid, parse_command('{"type": "hello"}'))
@@ -351,6 +385,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
             pass
         finally:
             session.disconnect(cid)
+            outboxes.discard(outbox)
             with contextlib.suppress(asyncio.QueueFull):
                 outbox.put_nowait(None)
             sender.cancel()
@@ -359,6 +394,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
 
     @contextlib.asynccontextmanager
     async def lifespan(app: Starlette) -> AsyncIterator[None]:
+        loops[:] = [asyncio.get_running_loop()]
         if manage_session:
             session.start()
         if lab is not None:
@@ -395,5 +431,6 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
     app = Starlette(routes=routes, lifespan=lifespan)
     app.add_middleware(Guard, token=token, hosts=list(hosts))
     app.state.session = session
+    app.state.flush_pages = flush_pages
     app.state.max_message_bytes = MAX_MESSAGE_BYTES
     return app

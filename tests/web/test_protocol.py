@@ -283,7 +283,7 @@ def test_closing_one_page_changes_nothing_for_another(client: TestClient, sessio
         seq_before = a.frame()["seq"]
         assert a.answer(a.send(type="tick"))["ok"]
         assert a.frame()["seq"] > seq_before
-    assert session.clients == 0
+    assert len(session.pages) == 0
 
 
 def test_the_trace_is_saved_when_the_session_stops(tmp_path) -> None:
@@ -377,7 +377,7 @@ def test_frames_are_throttled_and_carry_every_transition_since_the_last() -> Non
     session = _TimedSession(Debugger.build(load_params(), seed=0), speed=None, running=False)
     session.published = []
     frames: list[dict[str, Any]] = []
-    cid = session.connect(lambda text: frames.append(json.loads(text)))
+    cid = session.pages.connect(lambda text: frames.append(json.loads(text)))
     session.start()
     try:
         session.submit(cid, parse_command('{"type": "hello"}'))

@@ -26,9 +26,10 @@ from ttt_sm.debug.errors import DebugError
 from ttt_sm.params import load_params
 from ttt_sm.web import server as server_module
 from ttt_sm.web.coverage import CoverageRuns
+from ttt_sm.web.pages import PAGE_QUEUE
 from ttt_sm.web.protocol import parse_command
 from ttt_sm.web.server import create_app
-from ttt_sm.web.session import PAGE_QUEUE, Session
+from ttt_sm.web.session import Session
 
 from .test_protocol import Page
 
@@ -113,7 +114,7 @@ def test_a_session_whose_thread_dies_tells_every_page_and_its_server_and_refuses
     s = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
     heard: list[dict[str, Any]] = []
     told: queue.Queue[str] = queue.Queue()
-    cid = s.connect(lambda text: heard.append(json.loads(text)))
+    cid = s.pages.connect(lambda text: heard.append(json.loads(text)))
     s.death_listeners.append(told.put)
     s.join(cid, "charts")  # joined: it gets what every page gets
 
@@ -139,8 +140,8 @@ def test_a_session_whose_thread_dies_tells_every_page_and_its_server_and_refuses
 def test_a_page_may_have_16_commands_waiting_and_more_are_refused_at_once(session: Session) -> None:
     flood: list[dict[str, Any]] = []
     other: list[dict[str, Any]] = []
-    a = session.connect(lambda text: flood.append(json.loads(text)))
-    b = session.connect(lambda text: other.append(json.loads(text)))
+    a = session.pages.connect(lambda text: flood.append(json.loads(text)))
+    b = session.pages.connect(lambda text: other.append(json.loads(text)))
     try:
         with Held(session):
             for i in range(40):
@@ -158,8 +159,8 @@ def test_a_page_may_have_16_commands_waiting_and_more_are_refused_at_once(sessio
         session.call(lambda d: None)
         assert flood[-1]["id"] == "again" and flood[-1]["type"] == "reply"
     finally:
-        session.disconnect(a)
-        session.disconnect(b)
+        session.pages.disconnect(a)
+        session.pages.disconnect(b)
 
 
 def test_a_step_of_600000_control_steps_pauses_after_its_budget_of_wall_time(client: TestClient,
@@ -282,14 +283,14 @@ def test_the_servers_own_commands_are_not_bounded_as_a_pages(session: Session) -
 
 def test_a_page_that_has_used_its_share_of_the_session_is_refused_and_another_is_not(
         session: Session, monkeypatch: pytest.MonkeyPatch) -> None:
-    from ttt_sm.web import session as session_module
+    from ttt_sm.web import pages as session_module
 
     monkeypatch.setattr(session_module, "PAGE_BURST_S", 0.0)  # no burst: any use at all is over the share
     monkeypatch.setattr(session_module, "PAGE_SHARE", 1e-9)  # ... and it does not fall back during the test
     greedy: list[dict[str, Any]] = []
     other: list[dict[str, Any]] = []
-    a = session.connect(lambda text: greedy.append(json.loads(text)))
-    b = session.connect(lambda text: other.append(json.loads(text)))
+    a = session.pages.connect(lambda text: greedy.append(json.loads(text)))
+    b = session.pages.connect(lambda text: other.append(json.loads(text)))
     try:
         session.submit(a, parse_command('{"type": "tick", "id": 1}'))
         session.call(lambda d: None)
@@ -297,8 +298,8 @@ def test_a_page_that_has_used_its_share_of_the_session_is_refused_and_another_is
         session.submit(b, parse_command('{"type": "pause", "id": 3}'))
         session.call(lambda d: None)
     finally:
-        session.disconnect(a)
-        session.disconnect(b)
+        session.pages.disconnect(a)
+        session.pages.disconnect(b)
     assert [(m["type"], m["id"]) for m in greedy] == [("reply", 1), ("error", 2)]
     assert "used the session more than one page may" in greedy[1]["error"]
     assert [(m["type"], m["id"]) for m in other] == [("reply", 3)]
@@ -306,12 +307,12 @@ def test_a_page_that_has_used_its_share_of_the_session_is_refused_and_another_is
 
 def test_a_warning_reaches_every_page_and_the_session_runs_on(session: Session) -> None:
     heard: list[dict[str, Any]] = []
-    cid = session.connect(lambda text: heard.append(json.loads(text)))
+    cid = session.pages.connect(lambda text: heard.append(json.loads(text)))
     try:
         session.join(cid, "charts")
         session.warn_pages("tracing stopped: out/gui/trace.jsonl: No space left on device")
     finally:
-        session.disconnect(cid)
+        session.pages.disconnect(cid)
     assert heard[-1] == {"type": "error", "id": None, "command": None, "fatal": False,
                          "error": "tracing stopped: out/gui/trace.jsonl: No space left on device"}
     assert session.error is None and session.call(lambda d: True)
@@ -335,15 +336,15 @@ def test_a_page_over_its_share_has_its_messages_dropped_unparsed_and_is_told_onc
         client: TestClient, session: Session, monkeypatch: pytest.MonkeyPatch) -> None:
     """A flood costs the server a check per message, not a parse and a reply each (issue 28: the robot's pace
     under a flood of 20,000 ``hello``s)."""
-    from ttt_sm.web import session as session_module
+    from ttt_sm.web import pages as session_module
 
     monkeypatch.setattr(session_module, "PAGE_BURST_S", 0.0)  # no burst: any use at all is over the share
     monkeypatch.setattr(session_module, "PAGE_SHARE", 1e-9)  # ... and it does not fall back during the test
     monkeypatch.setattr(session_module, "DROP_NOTICE_S", 1e9)  # one window: the whole test
     flood = 300
-    watcher = session.connect(lambda text: None)  # another page: the one a flood must not starve
+    watcher = session.pages.connect(lambda text: None)  # another page: the one a flood must not starve
     with client.websocket_connect("/ws") as ws:
-        cid = max(session._clients)
+        cid = max(session.pages.ids())
         ws.send_text('{"type": "tick", "id": 1}')
         assert json.loads(ws.receive_text())["id"] == 1  # handled: the page has used the session now ...
         session.call(lambda d: None)  # ... and its use is counted (after the reply went out)
@@ -351,10 +352,10 @@ def test_a_page_over_its_share_has_its_messages_dropped_unparsed_and_is_told_onc
             ws.send_text(json.dumps({"type": "hello", "id": i + 2}) if i % 2 else "{not json")
         notice = json.loads(ws.receive_text())
         deadline = time.monotonic() + 60  # a timeout for a loaded machine, not a measurement
-        while session.page_counts(cid)["dropped"] < flood and time.monotonic() < deadline:
+        while session.pages.counts(cid)["dropped"] < flood and time.monotonic() < deadline:
             time.sleep(0.01)
-        counts = session.page_counts(cid)
-    session.disconnect(watcher)
+        counts = session.pages.counts(cid)
+    session.pages.disconnect(watcher)
     assert counts == {"parsed": 1, "dropped": flood, "refused": 0}  # none parsed, none refused after parsing
     assert notice["type"] == "error" and notice["id"] is None and notice["dropped"] == 1
     assert notice["error"].startswith("refused: 1 message(s) dropped unread: this page's commands have used")
@@ -364,25 +365,25 @@ def test_one_page_alone_with_the_robot_paused_is_never_held_back(
         session: Session, monkeypatch: pytest.MonkeyPatch) -> None:
     # a loaded run of the suite: a replay took over 2 s of the thread, and the page's next Run was refused
     # (the page waited for a breakpoint that never came); nobody else needed the thread
-    from ttt_sm.web import session as session_module
+    from ttt_sm.web import pages as session_module
 
     monkeypatch.setattr(session_module, "PAGE_BURST_S", 0.0)  # any use at all is over the burst
     monkeypatch.setattr(session_module, "PAGE_SHARE", 1e-9)  # ... and it does not fall back during the test
     heard: list[dict[str, Any]] = []
-    alone = session.connect(lambda text: heard.append(json.loads(text)))
+    alone = session.pages.connect(lambda text: heard.append(json.loads(text)))
     try:
         session.submit(alone, parse_command('{"type": "tick", "id": 1}'))
         session.call(lambda d: None)
-        assert not session.refusing(alone, time.perf_counter())
+        assert not session.pages.refusing(alone, time.perf_counter())
         session.submit(alone, parse_command('{"type": "tick", "id": 2}'))
         session.call(lambda d: None)
-        other = session.connect(lambda text: None)  # now someone else needs the thread too: held back
+        other = session.pages.connect(lambda text: None)  # now someone else needs the thread too: held back
         try:
-            assert session.refusing(alone, time.perf_counter())
+            assert session.pages.refusing(alone, time.perf_counter())
         finally:
-            session.disconnect(other)
+            session.pages.disconnect(other)
     finally:
-        session.disconnect(alone)
+        session.pages.disconnect(alone)
     assert [(m["type"], m["id"]) for m in heard] == [("reply", 1), ("reply", 2), ("error", None)]
     assert "used the session more than one page may" in heard[2]["error"]  # told when held back, not before
 
@@ -393,8 +394,8 @@ def test_a_joined_page_that_says_hello_again_gets_its_full_frame_with_the_next_f
     session = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
     got: list[dict[str, Any]] = []
     watched: list[dict[str, Any]] = []
-    cid = session.connect(lambda text: got.append(json.loads(text)))
-    watcher = session.connect(lambda text: watched.append(json.loads(text)))
+    cid = session.pages.connect(lambda text: got.append(json.loads(text)))
+    watcher = session.pages.connect(lambda text: watched.append(json.loads(text)))
     session.start()
     try:
         session.submit(watcher, parse_command('{"type": "hello"}'))

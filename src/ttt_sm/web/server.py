@@ -337,7 +337,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         def send_threadsafe(text: str) -> None:
             loop.call_soon_threadsafe(put, text)
 
-        cid = session.connect(send_threadsafe)
+        cid = session.pages.connect(send_threadsafe)
         outboxes.add(outbox)
 
         async def pump() -> None:
@@ -369,7 +369,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
                 message = await websocket.receive()
                 if message["type"] == "websocket.disconnect":
                     break
-                if session.refusing(cid, time.perf_counter()):
+                if session.pages.refusing(cid, time.perf_counter()):
                     continue  # refused anyway: dropped before it is parsed, the page told once a window
                 raw = message.get("text")
                 if raw is None:
@@ -384,7 +384,7 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
         except WebSocketDisconnect:
             pass
         finally:
-            session.disconnect(cid)
+            session.pages.disconnect(cid)
             outboxes.discard(outbox)
             with contextlib.suppress(asyncio.QueueFull):
                 outbox.put_nowait(None)

@@ -37,14 +37,12 @@ from __future__ import annotations
 
 import contextlib
 import gc
-import itertools
 import logging
 import os
 import queue
 import threading
 import time
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -61,6 +59,7 @@ from .commands import run as run_commands
 from .coverage import CoverageError, CoverageRuns
 from .frames import Frames, Status
 from .operate import Operate
+from .pages import Pages
 from .protocol import Command
 
 log = logging.getLogger(__name__)
@@ -76,60 +75,12 @@ _FAULT_ON = os.environ.get(FAULT_ENV) or None
 FRAME_HZ = 30.0
 #: One ``Debugger.run`` call while running: the run goes on after it (it is not a stop).
 RUN_CHUNK_S = 60.0
-#: Commands of one page waiting for the simulation thread at most; one more is refused with an error reply.
-PAGE_QUEUE = 16
-#: A page whose messages are dropped unread hears of them at most once in this many seconds (wall).
-DROP_NOTICE_S = 1.0
 #: Wall time one command may hold the simulation thread: a ``step``, ``tick`` or ``next`` that runs longer
 #: pauses after it (the reply says how far it came; send it again to go on).
 COMMAND_BUDGET_S = run_commands.COMMAND_BUDGET_S
-#: One page's commands take at most this share of the simulation thread's time, sustained, after a burst
-#: of :data:`PAGE_BURST_S`: past it the page's commands are refused until its use has fallen back (a flood
-#: of ``hello``s, each a full frame, or of replays, each seconds long, no longer takes the robot's time).
-PAGE_SHARE = 0.25
-#: Seconds of the simulation thread a page may use at once before :data:`PAGE_SHARE` holds it back.
-PAGE_BURST_S = 2.0
-#: A page that joined and says hello again gets what runs and a full frame at most once in this many seconds
-#: (the full frame is the biggest thing the session builds: a flood of hellos must not make it one a period).
-FULL_AGAIN_S = 1.0
 #: While the robot runs, the commands take at most this share of the simulation thread's time (a flood of
 #: them is handled between longer stretches of the run, whose pace they do not take).
 COMMAND_SHARE = 0.3
-
-Send = Callable[[str], None]
-
-
-@dataclass
-class _Client:
-    send: Send
-    joined: bool = False
-    page: str = ""
-    #: Commands of this page queued and not yet handled (at most :data:`PAGE_QUEUE`).
-    queued: int = 0
-    #: Commands refused because the page had :data:`PAGE_QUEUE` waiting, or had used its share.
-    refused: int = 0
-    #: Seconds of the simulation thread this page's commands have used, less PAGE_SHARE of the time since.
-    used_s: float = 0.0
-    used_at: float = 0.0
-    #: Messages of this page read and parsed, and those dropped unparsed while it was refused (:meth:`Session.
-    #: refusing`): a flood costs the server a check per message, not a parse and a reply.
-    parsed: int = 0
-    dropped: int = 0
-    #: The dropped messages not yet told to the page, and when it may be told next (one reply a window).
-    untold: int = 0
-    tell_at: float = 0.0
-    #: A page that joined has said hello again: it gets what runs and a full frame with the next frame (one
-    #: frame built for every such page, not one per hello: a flood of them costs no more than a frame a period).
-    full_due: bool = False
-    #: When this page may have the next such full frame (perf_counter): one a :data:`FULL_AGAIN_S` at most.
-    full_at: float = 0.0
-
-    def use(self, now: float, spent: float = 0.0) -> float:
-        """The page's use of the simulation thread now (``spent`` added): it falls by PAGE_SHARE a second."""
-        self.used_s = max(0.0, self.used_s - (now - self.used_at) * PAGE_SHARE) + spent
-        self.used_at = now
-        return self.used_s
-
 
 class _SessionClock:
     """The scheduler's clock while the session runs: the pacing, then a pause when a frame is due."""
@@ -198,9 +149,8 @@ class Session:
         self.mode = "running" if running else "paused"
         #: Why the run stopped last (a frame's ``stop``), or None while it runs.
         self.last_stop: dict[str, Any] | None = None
-        self._clients: dict[int, _Client] = {}
-        self._client_ids = itertools.count(1)
-        self._lock = threading.Lock()
+        #: The pages connected (web/pages.py): their limits, and sending to them.
+        self.pages = Pages(lambda: self.mode == "running")
         self._queue: queue.Queue[tuple[int, Command] | None] = queue.Queue()
         self._wake = False
         self._next_drain_at = 0.0
@@ -242,67 +192,10 @@ class Session:
 
     # -- the pages' side (any thread) -----------------------------------------------------
 
-    def connect(self, send: Send) -> int:
-        """A page connects: ``send(text)`` gets its replies and, once it says hello, the frames."""
-        cid = next(self._client_ids)
-        with self._lock:
-            self._clients[cid] = _Client(send)
-        return cid
-
-    def disconnect(self, cid: int) -> None:
-        """A page is gone; nothing else changes."""
-        with self._lock:
-            self._clients.pop(cid, None)
-
-    def refusing(self, cid: int, now: float) -> bool:
-        """Whether this page's next message is dropped unread: it has :data:`PAGE_QUEUE` commands waiting, or
-        has used more than its share (the refusals of :meth:`submit`, decided before the message is parsed).
-
-        The server calls it for every message it reads.  A dropped message is counted; the page hears of
-        them in one ``error`` a :data:`DROP_NOTICE_S` window (its ``dropped`` count), not one reply each."""
-        with self._lock:
-            client = self._clients.get(cid)
-            if client is None:
-                return False
-            why = self._held_back(cid, client, now)
-            if why is None:
-                client.parsed += 1
-                return False
-            client.dropped += 1
-            client.untold += 1
-            if now < client.tell_at:
-                return True
-            told, client.untold, client.tell_at = client.untold, 0, now + DROP_NOTICE_S
-        self.send_to(cid, {"type": "error", "id": None, "command": None, "dropped": told,
-                           "error": f"refused: {told} message(s) dropped unread: {why}"})
-        return True
-
-    def _held_back(self, cid: int, client: _Client, now: float) -> str | None:
-        """Why this page's next command is refused now, or None: it has :data:`PAGE_QUEUE` commands waiting,
-        or it has used more than :data:`PAGE_BURST_S` of the simulation thread (less its share since) while
-        someone else needs the thread (the robot running, or another page connected).  One page alone with a
-        paused robot is never held back for its use: a replay that takes seconds on a slow or busy machine
-        must not make the next Run or Pause a refusal.  Called with the lock held; counts the use up to `now`."""
-        used = client.use(now)
-        if client.queued >= PAGE_QUEUE:
-            return (f"this page has {PAGE_QUEUE} commands waiting for the session already (the most one page may"
-                    " have); wait for their replies")
-        if used > PAGE_BURST_S and (self.mode == "running" or any(k != cid for k in self._clients)):
-            wait = (used - PAGE_BURST_S) / PAGE_SHARE
-            return (f"this page's commands have used the session more than one page may ({PAGE_SHARE:.0%} of"
-                    f" its time, after a burst of {PAGE_BURST_S:g} s); send it again in {max(wait, 0.1):.1f} s")
-        return None
-
-    def page_counts(self, cid: int) -> dict[str, int]:
-        """A page's messages parsed, dropped unread, and commands refused after parsing (tests, the probe)."""
-        with self._lock:
-            c = self._clients.get(cid)
-            return {} if c is None else {"parsed": c.parsed, "dropped": c.dropped, "refused": c.refused}
-
     def submit(self, cid: int, command: Command) -> None:
         """Queue a checked command; the simulation thread handles it between two control steps.
 
-        A page with :data:`PAGE_QUEUE` commands waiting gets this one refused (an ``error`` reply at once);
+        A page with :data:`.pages.PAGE_QUEUE` commands waiting gets this one refused (an ``error`` reply at once);
         a session that no longer runs refuses every command."""
         spec = SPECS.get(command.type)
         if self.error is not None:
@@ -314,18 +207,10 @@ class Session:
             except Exception:  # noted in the server's thread: a bug there must not end the connection
                 log.exception("command %s failed", command.type)
             return
-        with self._lock:
-            client = self._clients.get(cid)
-            if client is None and cid != 0:  # a page gone (cid 0: the server's own, the bench's: not bounded)
-                return
-            why = self._held_back(cid, client, time.perf_counter()) if client is not None else None
-            if client is not None:
-                if why is not None:
-                    client.refused += 1
-                else:
-                    client.queued += 1
+        go, why = self.pages.admit(cid, time.perf_counter())
         if why is not None:
             self.reply_error(cid, f"{command.type}: refused: {why}", command)
+        if not go:  # refused, or a page gone (cid 0: the server's own, the bench's: not bounded)
             return
         self._queue.put((cid, command))
         self._wake = True
@@ -334,11 +219,6 @@ class Session:
         """Send one page an error message (a message that did not pass :mod:`.protocol`, say)."""
         self.send_to(cid, {"type": "error", "id": command.id if command else msg_id,
                            "command": command.type if command else None, "error": error})
-
-    @property
-    def clients(self) -> int:
-        with self._lock:
-            return len(self._clients)
 
     # -- life -------------------------------------------------------------------------------
 
@@ -370,7 +250,7 @@ class Session:
             self.camera_feed.stop()
         if self.debugger.trace_file is not None:
             how, data = self.ending or (("error", {"message": self.error}) if self.error else ("finished", {}))
-            return self.debugger.end_trace(how, **data, clients=self.clients)
+            return self.debugger.end_trace(how, **data, clients=len(self.pages))
         if self.trace_path is not None:
             return self.debugger.save_trace(self.trace_path)
         return None
@@ -426,11 +306,10 @@ class Session:
 
     def join(self, cid: int, page: str) -> None:
         """Page ``cid`` joins: it gets what runs, a full frame, the coverage shown, then every frame."""
-        with self._lock:
-            client = self._clients.get(cid)
-            if client is None:
-                return
-            again = client.joined
+        client = self.pages.get(cid)
+        if client is None:
+            return
+        again = client.joined
         if self._info_text is None:  # what the session runs does not change: serialized once, not per hello
             self._info_text = dumps(jsonable({"type": "session", "info": self.info}))
         if again:  # what runs and a full frame come with the next frame, built once for every page that asked
@@ -442,8 +321,7 @@ class Session:
             self.send_to(cid, {"type": "coverage", **self.coverage.shown})
         if self.trace_stopped is not None:
             self.send_to(cid, {"type": "error", "id": None, "command": None, "error": self.trace_stopped})
-        with self._lock:
-            client.joined, client.page = True, page
+        self.pages.joined(cid, page)
 
     def publish(self) -> None:
         """Send every page that joined the next frame (full after a replay or a new game): the one place that
@@ -452,15 +330,7 @@ class Session:
         frame = self.frames.next(self._status(), self._resync, now)
         self._resync = False
         text = dumps(jsonable(frame))
-        with self._lock:
-            targets = []
-            for c in self._clients.values():
-                due = c.full_due and now >= c.full_at
-                if due:
-                    c.full_due, c.full_at = False, now + FULL_AGAIN_S
-                if c.joined:
-                    targets.append((c.send, due))
-            waiting = any(c.full_due for c in self._clients.values())
+        targets, waiting = self.pages.frame_targets(now)
         full_text = None
         for send, due in targets:
             if due:
@@ -533,18 +403,11 @@ class Session:
 
     def send_to(self, cid: int, message: dict[str, Any]) -> None:
         """Send one page a message."""
-        with self._lock:
-            client = self._clients.get(cid)
-        if client is not None:
-            client.send(dumps(jsonable(message)))
+        self.pages.send_to(cid, message)
 
     def broadcast(self, message: dict[str, Any]) -> None:
         """Send every page that joined a message."""
-        text = dumps(jsonable(message))
-        with self._lock:
-            targets = [c.send for c in self._clients.values() if c.joined]
-        for send in targets:
-            send(text)
+        self.pages.broadcast(message)
 
     # -- the simulation thread ----------------------------------------------------------------
 
@@ -675,7 +538,7 @@ class Session:
         self.clock.restart()
 
     def _status(self) -> Status:
-        return Status(self.mode, self.speed, self.last_stop, self.clients, self.error)
+        return Status(self.mode, self.speed, self.last_stop, len(self.pages), self.error)
 
     def _handle(self, cid: int, cmd: Command) -> None:
         """One command, in the simulation thread: its reply, or its failure as an error reply to its page.
@@ -690,10 +553,7 @@ class Session:
             cmd.args["fn"](self.debugger)
             self._dirty = True
             return
-        with self._lock:
-            client = self._clients.get(cid)
-            if client is not None:
-                client.queued = max(0, client.queued - 1)
+        client = self.pages.taken(cid)
         spec = SPECS.get(cmd.type)
         if spec is None:
             self.reply_error(cid, f"{cmd.type}: not handled by this session", cmd)
@@ -719,8 +579,7 @@ class Session:
         finally:
             self._command_deadline = None
             if client is not None:
-                with self._lock:
-                    client.use(time.perf_counter(), time.perf_counter() - started)
+                self.pages.used(client, time.perf_counter(), time.perf_counter() - started)
         self._dirty = True
 
 

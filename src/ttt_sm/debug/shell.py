@@ -16,7 +16,7 @@ import shlex
 import sys
 import traceback
 from collections.abc import Iterable
-from typing import IO, Any
+from typing import IO
 
 from ..app.robot import RobotError
 from ..runtime import UnknownDataError, UnknownEventError
@@ -24,59 +24,19 @@ from ..runtime.jsonable import dumps
 from . import views
 from .debugger import Debugger
 from .errors import DebugError
-from .expr import Condition, parse_condition
+from .expr import Condition
+from .shell_args import parse_count, parse_duration, parse_seconds
+from .shell_complete import SHOW, Completion
+from .shell_inputs import InputCommands
+from .shell_stops import StopCommands
 
 PROMPT = "(ttt-sm) "
 #: What a command may raise for a request it cannot take: printed as one ``error:`` line.
 USER_ERRORS = (DebugError, RobotError, UnknownEventError, UnknownDataError)
 _REPEATABLE = ("step", "tick", "next")
-_SHOW = ("charts", "data", "signals", "trace", "breakpoints", "inputs", "snapshot", "timeline", "game")
 
 
-def _count(arg: str, what: str, default: int = 1) -> int:
-    if not arg.strip():
-        return default
-    try:
-        n = int(arg)
-    except ValueError:
-        raise DebugError(f"{what}: expected a whole number, got {arg.strip()!r}") from None
-    return n
-
-
-def _seconds(arg: str, what: str, default: float) -> float:
-    if not arg.strip():
-        return default
-    try:
-        return float(arg)
-    except ValueError:
-        raise DebugError(f"{what}: expected simulated seconds, got {arg.strip()!r}") from None
-
-
-def _duration(arg: str, what: str, default: float, tick_s: float) -> float:
-    """Simulated seconds from ``0.5``, ``0.5s``, ``500ms`` or ``250 ticks`` (chart ticks of ``tick_s``)."""
-    text = arg.strip().lower()
-    if not text:
-        return default
-    number, factor = text, 1.0
-    for suffix, scale in (("ticks", tick_s), ("tick", tick_s), ("ms", 1e-3), ("s", 1.0)):
-        if text.endswith(suffix):
-            number, factor = text[:-len(suffix)].strip(), scale
-            break
-    try:
-        return float(number) * factor
-    except ValueError:
-        raise DebugError(f"{what}: expected simulated time, e.g. {what} 0.5 (seconds), {what} 0.5s,"
-                         f" {what} 500ms or {what} 250 ticks; got {arg.strip()!r}") from None
-
-
-def _chart_dot(arg: str, what: str) -> tuple[str, str]:
-    chart, dot, name = arg.partition(".")
-    if not dot or not chart or not name or " " in name:
-        raise DebugError(f"{what}: expected Chart.input, got {arg!r}")
-    return chart, name
-
-
-class DebugShell(cmd.Cmd):
+class DebugShell(StopCommands, InputCommands, Completion, cmd.Cmd):
     """The debugger's commands; ``help COMMAND`` prints a command's docstring."""
 
     intro = ""
@@ -214,7 +174,7 @@ class DebugShell(cmd.Cmd):
         """run [TIME]: run until a breakpoint hits or TIME passes (default 60 s); Ctrl-C pauses.
         TIME is simulated: 0.5 or 0.5s (seconds), 500ms, 250 ticks (chart ticks, 2 ms each);
         the run stops between two control steps."""
-        self.stopped(views.stop_lines(self.dbg.run(_duration(arg, "run", 60.0, self._tick_s()))))
+        self.stopped(views.stop_lines(self.dbg.run(parse_duration(arg, "run", 60.0, self._tick_s()))))
 
     def do_continue(self, arg: str) -> None:
         """continue [TIME]: the same as run: on from here until a breakpoint (default 60 s)."""
@@ -223,7 +183,7 @@ class DebugShell(cmd.Cmd):
     def do_step(self, arg: str) -> None:
         """step [N]: run N control steps (default 1; a chart tick starts every second one);
         step -N: go N control steps back (a replay, as back)."""
-        n = _count(arg, "step")
+        n = parse_count(arg, "step")
         if n < 0:
             self.stopped([self.dbg.step_back(-n).describe()])
             return
@@ -232,106 +192,15 @@ class DebugShell(cmd.Cmd):
     def do_back(self, arg: str) -> None:
         """back [N]: go N chart ticks back (default 1): a replay to right after that tick.
         The inputs you gave later are kept and applied again when you run forward."""
-        self.stopped([self.dbg.back(_count(arg, "back")).describe()])
+        self.stopped([self.dbg.back(parse_count(arg, "back")).describe()])
 
     def do_tick(self, arg: str) -> None:
         """tick [N]: run up to and through the next N chart ticks (default 1)."""
-        self.stopped(views.stop_lines(self.dbg.tick(_count(arg, "tick"))))
+        self.stopped(views.stop_lines(self.dbg.tick(parse_count(arg, "tick"))))
 
     def do_next(self, arg: str) -> None:
         """next [TIME]: run until any chart takes a transition (at most TIME, default 10 s; units as run)."""
-        self.stopped(views.stop_lines(self.dbg.next(_duration(arg, "next", 10.0, self._tick_s()))))
-
-    # -- display ------------------------------------------------------------------
-
-    def do_display(self, arg: str) -> None:
-        """display EXPR: show EXPR after every stop (run, step, tick, next, back, replay);
-        display alone shows them now.  EXPR as in break when: DriveInit1.pos_out, q_true[1],
-        DriveInit1.pos_out - DriveInit1.pos_Encoder, DriveInit1.index and not DriveInit1.stop.
-        watch is the same command; undisplay N removes one."""
-        if not arg.strip():
-            self.say(*(self.display_lines() or ["  (nothing displayed: display EXPR adds one)"]))
-            return
-        condition = parse_condition(arg, self.dbg.names)
-        n = self._next_display
-        self._next_display += 1
-        self.displays[n] = condition
-        self.say(*self._display_line(n, condition))
-
-    do_watch = do_display
-
-    def do_undisplay(self, arg: str) -> None:
-        """undisplay N... | undisplay all: stop showing display expressions."""
-        if arg.strip() == "all":
-            self.displays.clear()
-            self.say("nothing displayed now")
-            return
-        for n in self._ids(arg, "undisplay"):
-            if self.displays.pop(n, None) is None:
-                raise DebugError(f"undisplay: no display {n}; displays: "
-                                 f"{', '.join(map(str, self.displays)) or 'none'}")
-            self.say(f"display {n} removed")
-
-    def display_lines(self) -> list[str]:
-        return [line for n, c in self.displays.items() for line in self._display_line(n, c)]
-
-    def _display_line(self, n: int, condition: Condition) -> list[str]:
-        try:
-            value = condition.value()
-        except DebugError as exc:
-            return [f"  {n}: {condition.text} = ? ({exc})"]
-        chart, dot, name = condition.text.partition(".")
-        unit = ""
-        if dot and chart in self.dbg.robot.charts and name.isidentifier():
-            unit = self.dbg.datum_decl(chart, name).unit
-        return [f"  {n}: {condition.text} = {views.fmt_value(value, unit)}"]
-
-    # -- breakpoints --------------------------------------------------------------
-
-    def do_break(self, arg: str) -> None:
-        """break KIND SPEC: add a breakpoint; break alone lists them.
-        break enter Chart.state | break exit Chart.state
-        break transition Chart source->target   (* for any state)
-        break event Chart.event                 (tick: any tick transition)
-        break when CONDITION   e.g. DriveInit1.pos_Encoder > 1.0 and not DriveInit1.index
-                               (hits when it becomes true; signals: q_true[1], t, ...;
-                                numbers may carry deg, mm, ms)"""
-        if not arg.strip():
-            self.say(*views.breakpoint_lines(self.dbg.breakpoints))
-            return
-        bp = self.dbg.add_breakpoint(arg)
-        self.say(f"breakpoint {bp.id}: {bp.spec}")
-
-    def _ids(self, arg: str, what: str) -> list[int]:
-        try:
-            ids = [int(a) for a in arg.split()]
-        except ValueError:
-            raise DebugError(f"{what}: expected breakpoint numbers, got {arg.strip()!r}") from None
-        if not ids:
-            raise DebugError(f"{what}: which breakpoint? (break lists them)")
-        return ids
-
-    def do_delete(self, arg: str) -> None:
-        """delete ID... | delete all: remove breakpoints."""
-        if arg.strip() == "all":
-            self.dbg.delete(None)
-            self.say("all breakpoints deleted")
-            return
-        for bp_id in self._ids(arg, "delete"):
-            self.dbg.delete(bp_id)
-            self.say(f"breakpoint {bp_id} deleted")
-
-    def do_enable(self, arg: str) -> None:
-        """enable ID...: enable breakpoints."""
-        for bp_id in self._ids(arg, "enable"):
-            self.dbg.enable(bp_id)
-            self.say(f"breakpoint {bp_id} enabled")
-
-    def do_disable(self, arg: str) -> None:
-        """disable ID...: disable breakpoints (kept, not checked)."""
-        for bp_id in self._ids(arg, "disable"):
-            self.dbg.disable(bp_id)
-            self.say(f"breakpoint {bp_id} disabled")
+        self.stopped(views.stop_lines(self.dbg.next(parse_duration(arg, "next", 10.0, self._tick_s()))))
 
     # -- looking ------------------------------------------------------------------
 
@@ -369,14 +238,14 @@ class DebugShell(cmd.Cmd):
             words = rest.split()
             if not 1 <= len(words) <= 2:
                 raise DebugError(f"show timeline: expected CHART [SECONDS]; charts: {', '.join(self.dbg.chart_names)}")
-            seconds = _seconds(words[1], "show timeline", 0.0) if len(words) == 2 else None
+            seconds = parse_seconds(words[1], "show timeline", 0.0) if len(words) == 2 else None
             self.say(*views.timeline_lines(self.dbg, self.dbg.timeline(words[0], seconds)))
         elif what == "game":
             self.say(*views.game_lines(self.dbg))
         elif what == "signals":
             self.say(*views.signal_lines(self.dbg))
         elif what == "trace":
-            self.say(*views.trace_lines(self.dbg.trace.records, _count(rest, "show trace", 10)))
+            self.say(*views.trace_lines(self.dbg.trace.records, parse_count(rest, "show trace", 10)))
         elif what == "breakpoints":
             self.say(*views.breakpoint_lines(self.dbg.breakpoints))
         elif what == "inputs":
@@ -385,8 +254,8 @@ class DebugShell(cmd.Cmd):
         elif what == "snapshot":
             self.say(dumps(self.dbg.robot.snapshot(), sort_keys=True))
         else:
-            raise DebugError(f"show what? {what!r} is not one of: {', '.join(_SHOW)}" if what
-                             else f"show what? one of: {', '.join(_SHOW)}")
+            raise DebugError(f"show what? {what!r} is not one of: {', '.join(SHOW)}" if what
+                             else f"show what? one of: {', '.join(SHOW)}")
 
     def do_trace(self, arg: str) -> None:
         """trace [N]: the last N transitions (default 10); trace save FILE: all kept, as JSON Lines."""
@@ -405,7 +274,7 @@ class DebugShell(cmd.Cmd):
                 else ": start the debugger with --trace FILE to keep them all)") if trace.dropped else ""
             self.say(f"{len(trace.records)} transitions written to {path}{older}")
             return
-        self.say(*views.trace_lines(self.dbg.trace.records, _count(arg, "trace", 10)))
+        self.say(*views.trace_lines(self.dbg.trace.records, parse_count(arg, "trace", 10)))
 
     def do_diagram(self, arg: str) -> None:
         """diagram CHART [FILE]: the chart's diagram, active states highlighted
@@ -415,141 +284,6 @@ class DebugShell(cmd.Cmd):
             raise DebugError(f"diagram: expected CHART [FILE]; charts: {', '.join(self.dbg.chart_names)}")
         path = self.dbg.diagram(words[0], words[1] if len(words) == 2 else None)
         self.say(f"{words[0]} diagram written to {path}")
-
-    # -- changing things ------------------------------------------------------------
-
-    def _set(self, arg: str, force: bool) -> None:
-        what = "force" if force else "set"
-        words = arg.split()
-        if len(words) != 2:
-            raise DebugError(f"{what}: expected Chart.input VALUE, e.g. {what} DriveInit1.stop 1")
-        chart, name = _chart_dot(words[0], what)
-        value = self.dbg.set_input(chart, name, words[1], force=force)
-        decl = self.dbg.datum_decl(chart, name)
-        note = " (forced until release)" if force else ""
-        self.say(f"{chart}.{name} = {views.fmt_value(value, decl.unit)}{note}")
-
-    def do_set(self, arg: str) -> None:
-        """set Chart.input VALUE: set a chart input (1/0 for flags; numbers may carry deg, mm).
-        Inputs the wiring feeds every chart step (index, pos_Encoder, ...) are overwritten
-        at the next one: force them instead."""
-        self._set(arg, False)
-
-    def do_force(self, arg: str) -> None:
-        """force Chart.input VALUE: set an input and keep it against the wiring until release."""
-        self._set(arg, True)
-
-    def do_release(self, arg: str) -> None:
-        """release [Chart.input]: stop forcing one input, or all of them."""
-        if arg.strip():
-            chart, name = _chart_dot(arg.strip(), "release")
-            released = self.dbg.release(chart, name)
-        else:
-            released = self.dbg.release()
-        names = ", ".join(f"{c}.{n}" for c, n in released)
-        self.say(f"released {names}" if released else "nothing was forced")
-
-    def do_post(self, arg: str) -> None:
-        """post CHART EVENT [NAME=VALUE ...]: post an event, handled at the chart's next tick."""
-        try:
-            words = shlex.split(arg)
-        except ValueError as exc:  # an unclosed quote
-            raise DebugError(f"post: {exc} in {arg!r}") from None
-        if len(words) < 2:
-            raise DebugError("post: expected CHART EVENT, e.g. post Homing stop")
-        data: dict[str, Any] = {}
-        for item in words[2:]:
-            key, eq, text = item.partition("=")
-            if not eq or not key.isidentifier():
-                raise DebugError(f"post: event data must be NAME=VALUE, got {item!r}")
-            try:
-                data[key] = float(text)
-            except ValueError:
-                data[key] = text
-        self.dbg.post(words[0], words[1], **data)
-        self.say(f"posted {words[1]} to {words[0]}; handled at its next tick")
-
-    def do_replay(self, arg: str) -> None:
-        """replay TICK | replay step N [--drop]: rebuild the robot and run it again to chart tick TICK.
-        The robot is rebuilt from its parameters, seed and start pose; the inputs you set,
-        forced and posted up to there are re-applied at the same control steps, and the state
-        reached is compared with the one the session saw there before: configurations, chart
-        data and twin state, float for float.  The inputs you gave after it are kept: a run
-        forward applies them again at their steps (show inputs lists them as ahead);
-        --drop drops them instead."""
-        words = arg.split()
-        drop = "--drop" in words
-        words = [w for w in words if w != "--drop"]
-        if not words:
-            raise DebugError("replay: to which chart tick? e.g. replay 1510 (or replay step 3021)")
-        if words[0] == "step":
-            if len(words) != 2:
-                raise DebugError("replay step: which control step? e.g. replay step 3021")
-            self.stopped([self.dbg.replay_to_step(_count(words[1], "replay step"), drop=drop).describe()])
-            return
-        if len(words) != 1:
-            raise DebugError(f"replay: expected TICK [--drop], got {arg.strip()!r}")
-        self.stopped([self.dbg.replay(_count(words[0], "replay"), drop=drop).describe()])
-
-    # -- completion (Tab, on a terminal) ---------------------------------------------------
-
-    def _states(self) -> list[str]:
-        index = self.dbg.watch.index
-        return [f"{c}.{s}" for c in self.dbg.chart_names for s in index.states(c)]
-
-    def _data(self, inputs_only: bool = False) -> list[str]:
-        out = []
-        for name, chart in self.dbg.robot.charts.items():
-            out += [f"{name}.{d.name}" for d in chart.declarations() if not inputs_only or d.kind == "input"]
-        return out
-
-    def _events(self) -> list[str]:
-        index = self.dbg.watch.index
-        return [f"{c}.{e}" for c in self.dbg.chart_names for e in index.events(c)]
-
-    @staticmethod
-    def _matching(text: str, names: Iterable[str]) -> list[str]:
-        return [n for n in names if n.startswith(text)]
-
-    def complete_break(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
-        """Tab: the kind, then Chart.state (enter, exit), Chart.event, Chart.datum (when), a state (transition)."""
-        words = line[:begidx].split()
-        if len(words) <= 1:
-            return self._matching(text, ("enter", "exit", "transition", "event", "when"))
-        kind = words[1]
-        if kind in ("enter", "exit"):
-            return self._matching(text, self._states())
-        if kind == "event":
-            return self._matching(text, self._events())
-        if kind == "when":
-            return self._matching(text, self._data())
-        if kind == "transition":
-            if len(words) == 2:
-                return self._matching(text, self.dbg.chart_names)
-            return self._matching(text, [*self.dbg.watch.index.states(words[2]), "*"]) \
-                if words[2] in self.dbg.chart_names else []
-        return []
-
-    def complete_display(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
-        return self._matching(text, self._data())
-
-    complete_watch = complete_display
-
-    def complete_set(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
-        return self._matching(text, self._data(inputs_only=True)) if len(line[:begidx].split()) <= 1 else []
-
-    complete_force = complete_release = complete_set
-
-    def complete_show(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
-        words = line[:begidx].split()
-        if len(words) <= 1:
-            return self._matching(text, _SHOW)
-        return self._matching(text, self.dbg.chart_names) if words[1] in ("data", "timeline") else []
-
-    def complete_diagram(self, text: str, line: str, begidx: int, endidx: int) -> list[str]:
-        return self._matching(text, self.dbg.chart_names) if len(line[:begidx].split()) <= 1 else []
-
-    complete_post = complete_diagram
 
     # -- leaving ----------------------------------------------------------------------
 

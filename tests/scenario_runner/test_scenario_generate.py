@@ -246,3 +246,42 @@ def test_mutate_reports_the_kill_ratio(tmp_path, capsys) -> None:
     # a robot scenario is not run against mutants: said, not silently passed
     assert main(["scenario", "mutate", "DriveInit3", "tests/scenarios/drive_1_turns_back_at_a_hard_stop.yaml"]) == 2
     assert "runs DriveInit3 bare" in _one_error_line(capsys)
+
+
+def _x_drops():
+    from ttt_sm.charts.control import Control
+    from ttt_sm.scenario.mutate import mutants
+
+    return [m for m in mutants(Control) if m.override and m.description.startswith("XDrawing.")]
+
+
+def test_the_actions_control_mixes_in_are_drop_mutants() -> None:
+    """Control's actions live in a module per sub-chart (charts/control_drawing.py, ...), mixed into the chart
+    class: each is still a ``drop`` mutant, the chart with the method overridden to do nothing."""
+    from ttt_sm.charts.control import Control
+    from ttt_sm.scenario.mutate import build, mutants
+
+    found = mutants(Control)
+    mixed = {m.description.split(":")[0] for m in found if m.override}
+    actions = {f"{base.__name__}.{name}" for base in Control.__mro__[1:] if base.__module__.startswith(
+        "ttt_sm.charts.control_") for name in vars(base) if name.startswith(("on_enter_", "on_exit_", "during_"))
+        and getattr(getattr(base, name), "__name__", "") == name}
+    assert mixed == actions and len(mixed) >= 30
+    x_drops = _x_drops()
+    assert len(x_drops) >= 3 and all(m.file.endswith("control_drawing.py") for m in x_drops)
+    dropped = build(Control, x_drops[0])(tick_period_s=DT, chart_name="Control")
+    assert getattr(dropped, x_drops[0].override).__doc__ == "The dropped action: does nothing."
+    assert getattr(Control(tick_period_s=DT), x_drops[0].override).__doc__ != "The dropped action: does nothing."
+
+
+@pytest.mark.soak
+def test_the_generated_scenarios_kill_the_drops_of_the_actions_control_mixes_in(tmp_path) -> None:
+    from ttt_sm.charts.control import Control
+    from ttt_sm.scenario.mutate import build, first_failure, runs_chart
+
+    x_drops = _x_drops()
+    scenarios = [s for s in (load_scenario(p) for p in write(generate(Control, DT), tmp_path, "test"))
+                 if runs_chart(s, "Control")]
+    assert scenarios and first_failure(scenarios, "Control", Control, PARAMS) is None  # the chart passes them
+    for m in x_drops:
+        assert first_failure(scenarios, "Control", build(Control, m), PARAMS) is not None, m.description

@@ -23,6 +23,7 @@ printed at the end, also when the run is interrupted (then with
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from typing import Any
 
@@ -280,7 +281,8 @@ def cmd_scenario_mutate(args: argparse.Namespace) -> int:
                     **counts, "mutants_found": [r.to_dict() for r in results]})
         return 0
     for r in results:
-        print(f"{r.status.upper():10s} {r.mutant.kind:4s} line {r.mutant.line}: {r.mutant.description}")
+        where = f"{os.path.basename(r.mutant.file)}:{r.mutant.line}" if r.mutant.file else f"line {r.mutant.line}"
+        print(f"{r.status.upper():10s} {r.mutant.kind:4s} {where}: {r.mutant.description}")
         if r.status != "killed":
             print(f"           {r.detail}")
     print(f"{cls.__name__}: {counts['killed']} of {counts['killed'] + counts['survived']} mutants killed"

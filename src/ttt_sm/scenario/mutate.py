@@ -10,7 +10,10 @@ one change a person might make by mistake:
 - ``swap``: two transitions from the same state written in the other order
   (Stateflow tries them in the order written: the priority changes);
 - ``drop``: an action left out (a transition's ``on=``, or the body of an
-  ``on_enter_``/``on_exit_``/``during_`` method of the class).
+  ``on_enter_``/``on_exit_``/``during_`` method of the class, or of a class
+  the chart mixes in: Control's actions live in a module per sub-chart,
+  :mod:`ttt_sm.charts.control_drawing` and its neighbours; such a mutant is
+  the chart with the method overridden by one that does nothing).
 
 Each mutant runs the scenarios that run the chart bare (a robot scenario is
 not run against mutants: the robot builds its own charts).  A mutant is
@@ -30,7 +33,7 @@ import sys
 import textwrap
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, cast
 
 from ..params import ArmParams
 from ..runtime import TickChart
@@ -51,6 +54,10 @@ class Mutant:
     line: int
     description: str
     apply: Callable[[ast.ClassDef], None] = field(compare=False, repr=False)
+    #: A method the chart inherits from a class it mixes in, overridden to do nothing (``drop`` only).
+    override: str | None = None
+    #: The file of ``line`` when it is not the chart class's own (a mixed-in class's method).
+    file: str = ""
 
 
 @dataclass
@@ -62,8 +69,11 @@ class MutantResult:
     detail: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        return {"kind": self.mutant.kind, "line": self.mutant.line, "mutant": self.mutant.description,
-                "status": self.status, "detail": self.detail}
+        out = {"kind": self.mutant.kind, "line": self.mutant.line, "mutant": self.mutant.description,
+               "status": self.status, "detail": self.detail}
+        if self.mutant.file:
+            out["file"] = self.mutant.file
+        return out
 
 
 def _class_def(cls: type) -> tuple[ast.ClassDef, str, int]:
@@ -139,7 +149,34 @@ def mutants(cls: type[TickChart]) -> list[Mutant]:
                 node = _find(root, where)
                 node.body = [ast.Pass()]
             found.append(Mutant("drop", line(item), f"{item.name}: does nothing", drop))
-    return sorted(found, key=lambda m: (m.line, m.kind, m.description))
+    found += _mixed_in_drops(cls, tree)
+    return sorted(found, key=lambda m: (m.file, m.line, m.kind, m.description))
+
+
+def _mixed_in_drops(cls: type[TickChart], tree: ast.ClassDef) -> list[Mutant]:
+    """``drop`` of each action method the chart inherits from a plain class it mixes in (not from another
+    chart class it extends, nor the runtime's: those are that chart's)."""
+    own = {item.name for item in tree.body if isinstance(item, ast.FunctionDef)}
+    runtime = set(TickChart.__mro__)
+    found = []
+    for base in cls.__mro__[1:]:
+        if base in runtime or issubclass(base, TickChart):
+            continue
+        for name, fn in vars(base).items():
+            # a method defined under its own name (not an alias of a helper), not redefined nearer the chart
+            if not (name.startswith(_ACTION_PREFIXES) and inspect.isfunction(fn) and fn.__name__ == name) \
+                    or name in own or getattr(cls, name, None) is not fn:
+                continue
+            method = cast(Callable[..., Any], fn)
+            source, start = inspect.getsourcelines(method)
+            line = start + next(k for k, text in enumerate(source) if text.lstrip().startswith("def "))
+            found.append(Mutant("drop", line, f"{base.__name__}.{name}: does nothing", _unchanged, override=name,
+                                file=inspect.getsourcefile(method) or base.__module__))
+    return found
+
+
+def _unchanged(root: ast.ClassDef) -> None:
+    """The chart's own source as it is (a mutant that overrides a mixed-in method instead)."""
 
 
 def _text_flips(tree: ast.ClassDef, text: ast.Constant, line: int) -> list[Mutant]:
@@ -200,6 +237,13 @@ def build(cls: type[TickChart], mutant: Mutant) -> type[TickChart]:
     exec(compile(module, file, "exec"), namespace)  # noqa: S102 - the project's own chart source, changed
     built = namespace[cls.__name__]
     assert isinstance(built, type) and issubclass(built, TickChart)
+    if mutant.override is not None:
+        def nothing(self: Any) -> None:
+            """The dropped action: does nothing."""
+
+        nothing.__name__ = nothing.__qualname__ = mutant.override
+        built = type(built.__name__, (built,), {mutant.override: nothing, "__module__": built.__module__,
+                                                "__qualname__": built.__qualname__})
     return built
 
 

@@ -129,7 +129,7 @@ function drawPace(f) {
   if (p.slips) parts.push(`${p.slips} slip${p.slips === 1 ? "" : "s"}, ${p.lost_s.toFixed(2)} s lost`);
   if (f.latency.p95_ms !== null) parts.push(`frame latency p95 ${f.latency.p95_ms.toFixed(0)} ms`);
   const pace = role("pace");
-  pace.textContent = parts.join(" · ") || "on time";
+  pace.textContent = parts.join(" · ") || (f.speed === "max" ? "not paced" : "on time");
   pace.dataset.overruns = String(p.overruns);
   pace.dataset.alarm = String(f.speed !== "max" && p.slips > 0);
   const speed = f.speed === "max" ? "as fast as it goes" : `at x${f.speed}`;
@@ -168,8 +168,14 @@ setInterval(askTimeline, 1000);
 // the focus) nor with Ctrl, Alt or Meta (the browser's own shortcuts).
 const SHORTCUTS = { r: "run", p: "pause", s: "step", t: "tick", n: "next" };
 
+const TEXT_INPUTS = ["text", "search", "number", "email", "url", "password", "tel"];
+
+// Whether `el` takes typed letters: a text box, a text area, a list box (its letters pick an option).
+// The time slider and the check boxes do not: a key works again once one of them is used.
 function typing(el) {
-  return !!el && (el.isContentEditable || ["INPUT", "TEXTAREA", "SELECT"].includes(el.tagName));
+  if (!el) return false;
+  if (el.isContentEditable || el.tagName === "TEXTAREA" || el.tagName === "SELECT") return true;
+  return el.tagName === "INPUT" && TEXT_INPUTS.includes(el.type);
 }
 
 function addShortcuts() {

@@ -104,7 +104,7 @@ def test_a_click_breakpoint_stops_the_run_at_the_tick_the_state_is_entered(page:
     go_to_tick(page, 0)
     show(page, "DriveInit1")
     page.locator('[data-role="diagram"] [data-state="DriveInit1.run.initialise.turn_back"]').click()
-    page.get_by_role("menuitem", name="Break on entering DriveInit1.run.initialise.turn_back").click()
+    page.get_by_role("menuitem", name="Break on entering DriveInit1.turn_back").click()
     page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
     page.get_by_role("button", name="Run", exact=True).click()
     page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
@@ -204,7 +204,7 @@ def test_a_click_on_a_transition_breaks_when_it_is_taken(page: Any, cockpit: Coc
     show(page, "DriveInit1")
     edge = page.locator('[data-role="diagram"] [data-transition~="DriveInit1.turn_fwd->turn_back"]').first
     edge.locator("text").first.click()  # its label, as a person clicks it
-    page.get_by_role("menuitem", name="Break when DriveInit1.turn_fwd->turn_back is taken").click()
+    page.get_by_role("menuitem", name="Break when DriveInit1 turn_fwd->turn_back is taken").click()
     page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
     page.get_by_role("button", name="Run", exact=True).click()
     page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")
@@ -327,7 +327,7 @@ def test_a_leaving_breakpoint_by_click_and_the_timeline_of_the_shown_chart(page:
     assert cockpit.session.call(lambda d: len(d.inputs.ahead)) == 0
     show(page, "DriveInit1")
     page.locator('[data-state="DriveInit1.run.initialise.turn_fwd"]').click()
-    page.get_by_role("menuitem", name="Break on leaving DriveInit1.run.initialise.turn_fwd").click()
+    page.get_by_role("menuitem", name="Break on leaving DriveInit1.turn_fwd").click()
     page.wait_for_selector('[data-role="breakpoints"] li[data-breakpoint]')
     page.get_by_role("button", name="Run", exact=True).click()
     page.wait_for_function("document.querySelector('[data-role=status]').dataset.kind === 'breakpoint'")

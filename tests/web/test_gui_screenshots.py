@@ -28,7 +28,7 @@ def folder(tmp_path: Path) -> Path:
 def wait_ready(page: Any, top: str | None = None) -> None:
     """Wait for the diagram; scroll the side bar up and the diagram to its top, or to state ``top``."""
     page.wait_for_function("!document.querySelector('[data-role=diagram]').dataset.loading")
-    page.evaluate("document.querySelector('.side').scrollTop = 0;"
+    page.evaluate("window.scrollTo(0, 0); document.querySelector('.side').scrollTop = 0;"
                   " document.querySelector('[data-role=diagram]').scrollTop = 0")
     if top is not None:  # past the legend, to the states a picture is about
         page.evaluate("(top) => { const d = document.querySelector('[data-role=diagram]');"

@@ -27,13 +27,19 @@ def datum_decl(robot: Robot, chart: str, name: str) -> Data:
 
 def parse_input_value(decl: Data, label: str, text: str) -> Any:
     """A value typed for a datum: ``1``/``0``/``true``/``false``/``on``/``off`` for flags,
-    else a number with an optional unit (``170deg``, ``20mm``), converted to SI."""
+    else a number with an optional unit (``170deg``, ``20mm``, a rate ``20mm/s``, the datum's own
+    unit ``0.5A``), converted to SI."""
     word = text.strip().lower()
     if decl.unit == "bool":
         flags = {"1": True, "0": False, "true": True, "false": False, "on": True, "off": False}
         if word not in flags:
             raise DebugError(f"{label} is a flag: give 1 or 0 (true/false), not {text!r}")
         return flags[word]
+    own = decl.unit.lower()
+    if own.endswith("/s") and word.endswith("/s"):  # a rate typed with its time unit: 20mm/s, 5deg/s
+        word, own = word[:-2].rstrip(), own[:-2]
+    if own not in UNITS and own not in ("1", "") and word.endswith(own):  # its own unit, SI already: 0.5A
+        word = word[:-len(own)].rstrip()
     number, factor = word, 1.0
     for suffix in sorted(UNITS, key=len, reverse=True):
         if word.endswith(suffix):

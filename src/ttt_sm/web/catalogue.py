@@ -10,11 +10,12 @@ with its index in the chart's structure, the number its diagram edge carries
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from ..debug.debugger import Debugger
 from ..debug.views import SIGNAL_DOCS, SIGNAL_UNITS
-from ..runtime import TickChart
+from ..runtime import Data, TickChart
 from ..runtime.dot import subcharts, views
 from ..runtime.structure import ChartStructure
 
@@ -41,6 +42,54 @@ def transition_name(chart_name: str, source: str, target: str | None) -> str | N
     return None if target is None else f"{chart_name}.{source}->{target}"
 
 
+def input_placeholder(decl: Data) -> str:
+    """What an input's box shows before anything is typed: a typical value of it, with its unit, as
+    ``set`` takes it (``0deg`` for an angle, ``20mm/s`` for a speed, ``1 / 0`` for a flag).
+
+    The typical value is the declared default (within the declared limits); angles in degrees and
+    lengths in millimetres, as a person types them (:func:`~ttt_sm.debug.names.parse_input_value`).
+    """
+    unit = decl.unit
+    if unit == "bool":
+        return "1 / 0"
+    value = decl.default
+    if not isinstance(value, (int, float)):
+        return ""
+    if decl.limits is not None and not decl.limits[0] <= value <= decl.limits[1]:
+        value = decl.limits[0]
+    base, rate = (unit[:-2], "/s") if unit.endswith("/s") else (unit, "")
+    if base == "rad":
+        return f"{math.degrees(value):.4g}deg{rate}"
+    if base == "m":
+        return f"{value * 1000:.4g}mm{rate}"
+    number = str(value) if isinstance(value, int) else f"{value:.4g}"
+    return number if unit in ("1", "") else f"{number}{unit}"
+
+
+def input_title(decl: Data) -> str:
+    """An input box's tooltip: its unit, the units it may be typed in, its limits."""
+    if decl.unit == "bool":
+        return "a flag: 1 or 0 (true / false)"
+    parts = [f"unit {decl.unit}" if decl.unit not in ("1", "") else "a number"]
+    base, rate = (decl.unit[:-2], "/s") if decl.unit.endswith("/s") else (decl.unit, "")
+    if base == "rad":
+        parts.append(f"type deg{rate} or rad{rate}")
+    elif base == "m":
+        parts.append(f"type mm{rate} or m{rate}")
+    if decl.limits is not None:
+        parts.append(f"from {decl.limits[0]:g} to {decl.limits[1]:g}")
+    return ", ".join(parts)
+
+
+def describe_datum(d: Data) -> dict[str, Any]:
+    """One datum as the pages list it; an input also with its box's placeholder and tooltip."""
+    out = {"name": d.name, "kind": d.kind, "unit": d.unit, "doc": d.doc}
+    if d.kind == "input":
+        out["placeholder"] = input_placeholder(d)
+        out["title"] = input_title(d)
+    return out
+
+
 def view_list(chart: TickChart | type[TickChart]) -> list[dict[str, str]]:
     """The pictures of a chart (:func:`~ttt_sm.runtime.dot.views`) as the pages offer them."""
     out = []
@@ -65,7 +114,7 @@ def describe_chart(name: str, chart: TickChart) -> dict[str, Any]:
         "transitions": [{"index": t.index, "source": t.source, "target": t.target,
                          "name": transition_name(name, t.source, t.target), "label": t.label,
                          "trigger": t.trigger} for t in structure.transitions],
-        "data": [{"name": d.name, "kind": d.kind, "unit": d.unit, "doc": d.doc} for d in chart.declarations()],
+        "data": [describe_datum(d) for d in chart.declarations()],
         "events": list(structure.user_events),
         "subcharts": list(subcharts(type(chart))),
         "views": view_list(chart),

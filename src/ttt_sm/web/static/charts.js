@@ -46,7 +46,7 @@ function onMessage(m) {
   switch (m.type) {
     case "session": return onSession(m.info);
     case "frame": return onFrame(m);
-    case "reply": return say(m.text || "ok");
+    case "reply": return coverage.takeReply(m) || say(m.text || "ok");
     case "error": return say(m.error, true);
     case "coverage": return coverage.take(m);
     case "coverage_suggestion": return coverage.takeSuggestion(m);
@@ -105,20 +105,40 @@ function drawHeader(f) {
   mode.dataset.mode = f.mode;
   const speed = role("speed");
   if (document.activeElement !== speed) speed.value = String(f.speed);
-  const p = f.pace;
-  const parts = [];
-  if (f.mode === "running") parts.push(`x${p.realtime_factor.toFixed(1)} real time`);
-  if (f.speed !== "max") parts.push(`behind by ${p.lag_ms.toFixed(1)} ms (max ${p.lag_max_ms.toFixed(1)} ms)`);
-  parts.push(`${p.overruns} overrun${p.overruns === 1 ? "" : "s"}`);
-  if (p.slips) parts.push(`${p.slips} slip${p.slips === 1 ? "" : "s"}, ${p.lost_s.toFixed(2)} s lost`);
-  if (f.latency.p95_ms !== null) parts.push(`frame latency p95 ${f.latency.p95_ms.toFixed(0)} ms`);
-  const pace = role("pace");
-  pace.textContent = parts.join(" · ");
-  pace.dataset.overruns = String(p.overruns);
+  drawPace(f);
   if ("safety" in f) drawSafety(f.safety);
   if ("drive1" in f) drawDrive1(f.drive1);
   if (f.stop) say(f.stop.text, false, f.stop.kind);
   if (f.error) say(f.error, true);
+}
+
+// How the simulation keeps its pace.  An overrun (a control period begun a whole period late) is
+// expected when the run is not paced to the wall clock or its periods are shorter than the machine's
+// bursts of steps (as fast as it goes; x2 and above): it is said in words, not coloured.  Only a slip
+// matters (the paced run fell more than 0.25 s behind and gave that time up): then the line is
+// coloured (data-alarm).
+const OVERRUNS_EXPECTED_AT = 2;
+
+function drawPace(f) {
+  const p = f.pace;
+  const expected = f.speed === "max" || f.speed >= OVERRUNS_EXPECTED_AT;
+  const parts = [];
+  if (f.mode === "running") parts.push(`x${p.realtime_factor.toFixed(1)} real time`);
+  if (f.speed !== "max") parts.push(`behind by ${p.lag_ms.toFixed(1)} ms (max ${p.lag_max_ms.toFixed(1)} ms)`);
+  if (p.overruns) parts.push(`${p.overruns} overrun${p.overruns === 1 ? "" : "s"}${expected ? " (expected)" : ""}`);
+  if (p.slips) parts.push(`${p.slips} slip${p.slips === 1 ? "" : "s"}, ${p.lost_s.toFixed(2)} s lost`);
+  if (f.latency.p95_ms !== null) parts.push(`frame latency p95 ${f.latency.p95_ms.toFixed(0)} ms`);
+  const pace = role("pace");
+  pace.textContent = parts.join(" · ") || (f.speed === "max" ? "not paced" : "on time");
+  pace.dataset.overruns = String(p.overruns);
+  pace.dataset.alarm = String(f.speed !== "max" && p.slips > 0);
+  const speed = f.speed === "max" ? "as fast as it goes" : `at x${f.speed}`;
+  pace.title = "How the simulation keeps its pace to the wall clock."
+    + ` Overruns: control periods (1 ms of simulated time) begun a whole period late; ${speed}`
+    + (expected ? " they are expected (the steps run in bursts between sleeps) and cost nothing."
+      : " a few are harmless.")
+    + " Slips: times the run fell more than 0.25 s behind and gave that time up instead of racing to"
+    + " catch up; at a paced speed they mean the machine could not keep it, and the line turns orange.";
 }
 
 // -- the chart shown -------------------------------------------------------------------
@@ -143,9 +163,40 @@ setInterval(askTimeline, 1000);
 
 // -- the toolbar ---------------------------------------------------------------------------
 
+// Keyboard shortcuts for the toolbar, each its command's first letter (docs/gui.md "Keys"): a key
+// presses its button, as a click does.  Never while typing (an input, a text area, a list box has
+// the focus) nor with Ctrl, Alt or Meta (the browser's own shortcuts).
+const SHORTCUTS = { r: "run", p: "pause", s: "step", t: "tick", n: "next" };
+
+const TEXT_INPUTS = ["text", "search", "number", "email", "url", "password", "tel"];
+
+// Whether `el` takes typed letters: a text box, a text area, a list box (its letters pick an option).
+// The time slider and the check boxes do not: a key works again once one of them is used.
+function typing(el) {
+  if (!el) return false;
+  if (el.isContentEditable || el.tagName === "TEXTAREA" || el.tagName === "SELECT") return true;
+  return el.tagName === "INPUT" && TEXT_INPUTS.includes(el.type);
+}
+
+function addShortcuts() {
+  for (const [key, cmd] of Object.entries(SHORTCUTS)) {
+    const b = $(`[data-cmd="${cmd}"]`);
+    b.setAttribute("aria-keyshortcuts", key);
+    b.title = `${b.title} (key ${key})`;
+  }
+  document.addEventListener("keydown", (e) => {
+    if (e.ctrlKey || e.altKey || e.metaKey || typing(e.target) || typing(document.activeElement)) return;
+    const cmd = SHORTCUTS[e.key];
+    if (!cmd || (e.repeat && (cmd === "run" || cmd === "pause"))) return;
+    e.preventDefault();
+    $(`[data-cmd="${cmd}"]`).click();
+  });
+}
+
 for (const b of $$("[data-cmd]")) {
   b.addEventListener("click", () => link.send({ type: b.dataset.cmd }));
 }
+addShortcuts();
 addSafety($("header"), link);
 addDrive1Stop($(".safety-group"), link);
 role("speed").addEventListener("change", (e) => {

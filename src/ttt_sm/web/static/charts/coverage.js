@@ -33,12 +33,21 @@ export class CoverageView {
         say(`${file.name} is not JSON: ${err.message}`, true);
         return;
       }
-      link.send({ type: "coverage_load", report });
+      this.asked.add(link.send({ type: "coverage_load", report }));
     });
     role("coverage-clear").addEventListener("click", () => link.send({ type: "coverage_clear" }));
     role("suggestion-copy").addEventListener("click", () => this.copy());
     role("suggestion-close").addEventListener("click", () => this.closeSuggestion());
     this.saveUrl = null;    // the object URL of the Save link, revoked when another replaces it
+    this.asked = new Set(); // ids of the reports this page loaded: their replies say what is shown
+  }
+
+  // A reply to this page's command: true when it is a report's "loaded", which the status line says as
+  // the coverage shown of the chart shown (it comes after the colours), so that it follows the tabs.
+  takeReply(m) {
+    if (!this.asked.delete(m.id) || !this.coverage) return false;
+    this.sayShown(true);
+    return true;
   }
 
   // The menu items of a click on transition edge `el` of chart `chart` (described as in the session's
@@ -109,13 +118,22 @@ export class CoverageView {
   show(chart) {
     this.chart = chart;
     this.drawSummary();
+    this.sayShown(false);
+  }
+
+  // The status line's word on the coverage shown follows the chart shown: it names that chart's
+  // states and transitions (when the status line still holds it, not a later message).
+  sayShown(fresh) {
+    if (!this.coverage || !(fresh || role("status").dataset.kind === "coverage")) return;
+    this.say(`coverage shown: ${role("coverage-summary").textContent}`, false, "coverage");
   }
 
   // The session's "coverage" message.
   take(m) {
     this.coverage = m.cleared ? null : m;
     this.draw();
-    this.say(m.cleared ? "coverage cleared" : `coverage shown: ${role("coverage-summary").textContent}`);
+    if (m.cleared) this.say("coverage cleared");
+    else this.sayShown(true);
   }
 
   // Colour the diagram's states and transitions (or take the colours off).

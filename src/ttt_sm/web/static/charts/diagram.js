@@ -211,33 +211,34 @@ export class DiagramView {
     panel.hidden = !el.dataset.detail;
   }
 
-  // A click on a state, a transition or a stub: its menu (breakpoints, sub-charts).
+  // A click on a state, a transition or a stub: its menu (breakpoints, sub-charts).  A breakpoint's
+  // item names the state or transition as the breakpoint list and `ttt-sm debug` name it (its spec:
+  // `enter DriveInit1.turn_back`, `transition DriveInit1 turn_fwd->turn_back`), not by its path.
   onClick(event) {
     event.preventDefault();
     event.stopPropagation();
     const el = event.currentTarget;
     this.showDetail(el);
     const chart = this.chart;
-    const addBreak = (spec) => this.link.send({ type: "break", spec });
     const items = [];
+    const addBreak = (label, spec) => items.push([label, () => this.link.send({ type: "break", spec }), spec]);
     if (el.dataset.stub) {
       const [, ...path] = el.dataset.stub.split(".");
-      items.push([`Open the picture of ${el.dataset.stub}`, () => this.setView(el.dataset.view, [])]);
       const id = path[path.length - 1];
-      items.push([`Break on entering ${el.dataset.stub}`, () => addBreak(`enter ${chart}.${id}`)]);
+      items.push([`Open the picture of ${el.dataset.stub}`, () => this.setView(el.dataset.view, [])]);
+      addBreak(`Break on entering ${chart}.${id}`, `enter ${chart}.${id}`);
     } else if (el.dataset.stateId) {
       const id = el.dataset.stateId;
-      const q = el.dataset.state;
       if (el.dataset.subchart) {
         items.push([`Open ${id} in place`, () => this.setView("overview", [...new Set([...this.opened, id])])]);
         items.push([`Open ${id} on its own`, () => this.setView(id, [])]);
       }
-      items.push([`Break on entering ${q}`, () => addBreak(`enter ${chart}.${id}`)]);
-      items.push([`Break on leaving ${q}`, () => addBreak(`exit ${chart}.${id}`)]);
+      addBreak(`Break on entering ${chart}.${id}`, `enter ${chart}.${id}`);
+      addBreak(`Break on leaving ${chart}.${id}`, `exit ${chart}.${id}`);
     } else if (el.dataset.transition) {
       for (const name of el.dataset.transition.split(" ")) {
         const arrow = name.slice(chart.length + 1);
-        items.push([`Break when ${name} is taken`, () => addBreak(`transition ${chart} ${arrow}`)]);
+        addBreak(`Break when ${chart} ${arrow} is taken`, `transition ${chart} ${arrow}`);
       }
       items.push(...this.moreItems(el, chart));
     }

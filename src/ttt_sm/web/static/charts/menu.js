@@ -2,13 +2,15 @@
 
 import { button, role } from "../dom.js";
 
-// Open the menu where `event` happened: `items` are [label, action] pairs, then Cancel.
+// Open the menu where `event` happened: `items` are [label, action] or [label, action, tooltip]
+// (a breakpoint's: the spec it adds, as the breakpoint list shows it), then Cancel.
 export function openMenu(items, event) {
   const menu = role("menu");
   menu.replaceChildren();
-  for (const [label, action] of items) {
+  for (const [label, action, tip] of items) {
     const b = button(label, () => { closeMenu(); action(); });
     b.setAttribute("role", "menuitem");
+    if (tip) b.title = `adds the breakpoint: ${tip}`;
     menu.append(b);
   }
   const cancel = button("Cancel", closeMenu);

@@ -53,7 +53,8 @@ export class DataWatch {
     input.name = "value";
     input.size = 7;
     input.setAttribute("aria-label", `value for ${chartName}.${d.name}`);
-    input.placeholder = d.unit === "bool" ? "1 / 0" : d.unit === "rad" ? "90deg" : d.unit === "m" ? "20mm" : "";
+    input.placeholder = d.placeholder ?? "";  // a typical value with its unit (the session's, from the declaration)
+    if (d.title) input.title = d.title;
     const doSet = button("Set", () => this.sendSet(d.name, input.value, false), `Set ${chartName}.${d.name}`);
     const doForce = button("Force", () => this.sendSet(d.name, input.value, true), `Force ${chartName}.${d.name}`);
     const doRelease = button("Release", () => this.link.send({ type: "release", chart: chartName, name: d.name }),
@@ -98,11 +99,28 @@ export class DataWatch {
       const name = tr.dataset.datum.slice(chart.length + 1);
       const v = $('[data-role="value"]', tr);
       const text = values[name] ?? "";
-      if (v.textContent !== text) v.textContent = text;
+      if (v.textContent !== text) drawValue(v, text);
       tr.dataset.changed = changed.has(name) ? "true" : "false";
       tr.dataset.forced = forced.has(tr.dataset.datum) ? "true" : "false";
     }
   }
+}
+
+// A value's text in `el`, in pieces that each stay on one line: a quantity and the same in other units
+// ("-0.000232926 rad", "(-0.01 deg)") break only between them, so the column wraps there instead of
+// being cut at the side bar's edge (1280x720).  A piece longer than a line (a text, a vector) wraps anywhere.
+const KEEP_WHOLE = 24;
+
+function drawValue(el, text) {
+  // split with the spaces kept (odd items): the text drawn is the session's, character for character
+  const pieces = text.split(/(\s+(?=\())/);
+  el.replaceChildren(...pieces.map((piece, i) => {
+    if (i % 2) return document.createTextNode(piece);
+    const span = document.createElement("span");
+    span.className = piece.length <= KEEP_WHOLE ? "piece whole" : "piece";
+    span.textContent = piece;
+    return span;
+  }));
 }
 
 export class Signals {
@@ -154,7 +172,7 @@ export class Signals {
     for (const tr of $$("tr", body)) {
       const text = this.values[tr.dataset.signal] ?? "";
       const v = $('[data-role="value"]', tr);
-      if (v.textContent !== text) v.textContent = text;
+      if (v.textContent !== text) drawValue(v, text);
       tr.dataset.changed = this.changed.has(tr.dataset.signal) ? "true" : "false";
     }
   }

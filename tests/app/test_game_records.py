@@ -69,7 +69,7 @@ def _dark_pixels(png: str) -> int:
 
 def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_has_its_own_name(
         tmp_path, monkeypatch):
-    import ttt_sm.app.game as game_module
+    import ttt_sm.app.game_report as game_module
 
     titles: list[str] = []
 

@@ -20,6 +20,8 @@ with the ``interrupted`` event; every game is bounded in simulated time
 Beside the session: who plays against the robot (:mod:`.person`), the engine
 chosen by name (:mod:`.engines`), how a game ends (:mod:`.game_outcome`), and
 the game inside the chart steps, its stages and driver (:mod:`.game_stages`).
+Mixed into the session: the GUI person's clicks (:mod:`.game_gui`) and the
+record's events, the board pictures and the report (:mod:`.game_report`).
 """
 from __future__ import annotations
 
@@ -32,26 +34,24 @@ from typing import Any, cast
 
 from ..arm import Arm
 from ..charts.game import AlgorithmActivator, Game
-from ..files import RecordWriteError
 from ..game.bitboard import cell_index
 from ..params import ArmParams
 from ..runtime.listeners import Trace
 from ..runtime.recordfile import interruption
-from ..twin.board_picture import save_board_picture
 from ..twin.truth import GroundTruth
 from ..vision import MoveError, OrientationError, percent_process
 from ..vision.percent import check_own_marks
 from .camera_link import CameraLink, CameraLost
 from .engines import engine_for
+from .game_gui import GuiInputs
 from .game_outcome import GameError, GameInterrupted, outcome_in_words, result_of
-from .game_record import GameRecord, checkpoint, params_digest
-from .game_stages import NO_PRECISION, Flow, GameDriver, GameStage, PenPathStage, Wait
+from .game_record import GameRecord
+from .game_report import GameReporting
+from .game_stages import Flow, GameDriver, GameStage, PenPathStage, Wait
 from .person import Cell, Person, RemotePerson, SimulatedPerson, board_picture
 from .robot import Robot
 from .wires import GAME_WIRES
 
-#: How long the game waits for a person at a GUI to draw and click Play, simulated s.
-PERSON_WAIT_S = 24 * 3600.0
 #: Longest a game may run, in simulated seconds, unless told otherwise: a whole game of 25 moves
 #: takes about 450 s (a usual one about 190 s), so only a game that is stuck reaches it.
 DEFAULT_TIME_LIMIT_S = 1200.0
@@ -60,7 +60,7 @@ DEFAULT_TIME_LIMIT_S = 1200.0
 CAMERA_LIFT_S = 3.0
 
 
-class GameSession:
+class GameSession(GuiInputs, GameReporting):
     """One game on the simulated robot.
 
     ``q_start`` and ``settle_s`` are the :class:`Robot`'s: the pose before the
@@ -312,82 +312,6 @@ class GameSession:
             robot.run_until(lambda: robot.tripped and math.isnan(robot.safety.lift_z), CAMERA_LIFT_S)
         return GameError(f"safety stop: {robot.safety.reason}" if robot.tripped else f"camera lost: {exc}")
 
-    # -- a person at a GUI (RemotePerson): their clicks, checked against where the game stands --
-
-    @property
-    def symbol_locked(self) -> bool:
-        """The robot's symbol cannot change any more: a move has been made (or drawn)."""
-        return bool(self.moves or self.drawn)
-
-    def set_robot_symbol(self, symbol: str) -> None:
-        """The GUI's Symbol button: the robot plays ``symbol`` ('X' or 'O'), only before the first move."""
-        if symbol not in ("X", "O"):
-            raise ValueError(f"the robot's symbol must be X or O, got {symbol!r}")
-        if self.symbol_locked and symbol != self.robot_symbol:
-            raise GameError(f"the manipulator plays {self.robot_symbol}: the symbol cannot change after the"
-                            " first move")
-        if symbol != self.robot_symbol:
-            self._event("symbol", robot_symbol=symbol)
-        self.robot_symbol = symbol
-        self.person_symbol = "X" if symbol == "O" else "O"
-
-    def set_engine(self, name: str) -> None:
-        """The game algorithm the manipulator plays with ("strong" or "thesis"), before the first move only."""
-        if self.symbol_locked and name != self.engine_name:
-            raise GameError(f"the manipulator plays with the {self.engine_name} engine: the engine cannot change"
-                            " after the first move")
-        self.engine = engine_for(name)
-        if name != self.engine_name:
-            self._event("engine", engine=name)
-        self.engine_name = name
-
-    def person_input(self, name: str, **data: Any) -> None:
-        """One input of the person at a GUI, by name: ``cell`` (row, column), ``play``, ``symbol`` (symbol),
-        ``engine`` (engine).  A debugger records each with its control step and applies it again there
-        when it replays (the person's clicks are inputs from outside the simulation)."""
-        if name == "cell":
-            self.person_draws((int(data["row"]), int(data["column"])))
-        elif name == "play":
-            self.press_play()
-        elif name == "symbol":
-            self.set_robot_symbol(str(data["symbol"]))
-        elif name == "engine":
-            self.set_engine(str(data["engine"]))
-        else:
-            raise ValueError(f"unknown input of the person {name!r}; inputs: cell, play, symbol, engine")
-
-    def person_draws(self, cell: Cell) -> None:
-        """The simulated hand draws the person's symbol in ``cell`` on the whiteboard (the camera must see it)."""
-        row, column = cell
-        if not (1 <= row <= 5 and 1 <= column <= 5):
-            raise ValueError(f"cell (row {row}, column {column}) is not on the 5x5 field")
-        if self.remote and self.awaiting != "draw":
-            raise GameError("it is not your turn to draw: " + (
-                "click Play for the manipulator to move" if self.awaiting == "play" else self.game.message))
-        there = self.truth[cell_index(row, column)]
-        if self.remote and there != ".":  # the page's hand draws only where it can: it cannot wipe a mark off
-            whose = "the manipulator's" if there == self.robot_symbol and cell in self.robot_cells else "an"
-            raise GameError(f"cell ({row}, {column}) holds {whose} {there} already: click an empty cell")
-        self.robot.board.draw_symbol(self.person_symbol, row, column)
-        self._place(cell, self.person_symbol, "truth")
-        self._event("person_drew", row=row, column=column)
-        if self.remote:
-            self.drawn.append(cell)
-
-    def press_play(self) -> None:
-        """The GUI's Play button: the manipulator moves (after the person drew theirs, or to open the game)."""
-        if self.awaiting == "play" or (self.awaiting == "draw" and self.drawn):
-            self.play_pressed = True
-            return
-        if self.awaiting == "draw":
-            raise GameError("it is your turn: draw your move (click a cell), then click Play")
-        raise GameError(f"Play is not taken now: {self.game.message}")
-
-    def _remote_wait(self, what: str, symbol: str) -> Wait:
-        """Wait for the person's Play click, or the symbols to change before the first move, or Stop."""
-        return Wait(lambda: self.play_pressed or self.person_symbol != symbol or self._stopped(),
-                    PERSON_WAIT_S, what)
-
     def play(self, max_moves: int = 25) -> dict[str, Any]:
         """Play one game to its end (or until the person gives up); return the report."""
         if self.driver is not None:
@@ -419,49 +343,6 @@ class GameSession:
             gc.unfreeze()
         self.end_record("finished", outcome=report["outcome"], boundary=True)
         return report
-
-    def record_start(self, max_moves: int) -> None:
-        """The record's first line: what a replay of the record needs."""
-        self._event("game", seed=self.robot.seed, robot_symbol=self.robot_symbol, engine=self.engine_name,
-                    person=getattr(self.person, "name", type(self.person).__name__), camera=self.camera.mode,
-                    params_sha256=params_digest(self.params), time_limit_s=self.time_limit_s, max_moves=max_moves)
-
-    def end_record(self, how: str, **data: Any) -> None:
-        """The record's last event (where the game stood, and its state), and the board picture of the moment."""
-        if self.record.ended is not None:
-            return
-        self._ending = True
-        wait = self._wait
-        where = {"waiting_for": wait.what if wait is not None else "the start of the game",
-                 "control": sorted(self.robot.active("Control")), "game": sorted(self.robot.active("Game"))}
-        if how != "finished" and self.record.failed is None:  # the record's disk failed: that is what is said
-            try:
-                self._save_board("final" if "final" not in self.pictures else "erased", ending=how)
-            except RecordWriteError as exc:  # how the game ended matters more than its picture
-                self.pictures["not_written"] = f"{exc.filename}: {exc.strerror}"
-        self._event(how, **data, **({} if how == "finished" else where), pictures=dict(self.pictures),
-                    state=self.checkpoint())
-        self.record.close()
-
-    def _save_board(self, which: str, ending: str | None = None) -> None:
-        """The board picture ``board_<which>.png`` in ``out_dir`` (nothing without one)."""
-        if self.out_dir is None:
-            return
-        robot = self.robot
-        ink = robot.board.ink_area_mm2()
-        if which == "final":
-            how = {None: outcome_in_words(self.outcome, self.robot_symbol, self.person_symbol),
-                   "interrupted": "the game interrupted",
-                   "error": "the game stopped by an error"}[ending]
-            title = f"The whiteboard at the end of the game: {how}, {len(self.moves)} moves played"
-        else:
-            title = "The whiteboard after erasing" if ending is None else \
-                f"The whiteboard while erasing: {'interrupted' if ending == 'interrupted' else 'an error'}"
-        path = save_board_picture(
-            robot.board, self.out_dir / f"board_{which}.png", title,
-            f"the robot plays {self.robot_symbol} (blue ink), the person {self.person_symbol} (black ink); "
-            f"seed {robot.seed}, simulated time {robot.t:.1f} s, {ink:.0f} mm² of ink on the board")
-        self.pictures[which] = str(path)
 
     def drive(self, max_moves: int = 25) -> GameDriver:
         """Play the game from inside the chart steps from now on: whoever steps the robot plays it.
@@ -505,48 +386,10 @@ class GameSession:
         yield Wait(lambda: self.game.ended, 600.0, "erasing and turning off")
         self._save_board("erased")
 
-    def report(self, wall_s: float) -> dict[str, Any]:
-        """What a game reports (docs/play.md, "What it reports"); `wall_s`: the wall time it took."""
-        robot = self.robot
-        outcome = self.outcome or "abandoned"
-        ink_left = robot.board.ink_area_mm2()
-        winner = {self.robot_symbol: "robot", self.person_symbol: "person", "given_up": "robot"}.get(outcome, outcome)
-        return {
-            "winner": winner,
-            "outcome": outcome,
-            "moves": self.moves,
-            "robot_symbol": self.robot_symbol,
-            "detections_correct": self.detections_correct,
-            "detections_wrong": self.detections_wrong,
-            "sim_time_s": round(robot.t, 3),
-            "wall_time_s": round(wall_s, 3),
-            "realtime_factor": round(robot.t / wall_s, 1),
-            "setup_wall_s": round(self.setup_wall_s, 3),
-            "erased": ink_left == 0.0,
-            "erase_cause": self.erase_cause,
-            "ink_left_mm2": round(ink_left, 3),
-            "camera": self.camera.mode,
-            "camera_link": self.camera.stats(),
-            "camera_wall_s": round(self.camera.read_wall_s, 3),
-            "ignored_play_clicks": self.activator.ignored_triggers,
-            **(NO_PRECISION if self.pen_path is None else self.pen_path.precision()),
-        }
-
     @property
     def detected_count(self) -> int:
         """The Session block's `detected`: the person's symbols the camera has detected."""
         return self.o_pos.bit_count()
-
-    def checkpoint(self) -> dict[str, Any]:
-        """The state of the game now, as its record keeps it (:func:`.game_record.checkpoint`)."""
-        return checkpoint(self.robot, self.state())
-
-    def state(self) -> dict[str, Any]:
-        """The session's own state (boards, moves, flags), plain data: what a replay must reproduce too."""
-        return {"board": self.board, "truth": self.truth, "moves": [dict(m) for m in self.moves],
-                "o_pos": self.o_pos, "result": self.result_code, "outcome": self.outcome,
-                "pending_move": self.pending_move, "erase_started": self.erase_started,
-                "erased_seen": self.erased_seen, "detections": [self.detections_correct, self.detections_wrong]}
 
     def _click_play(self) -> None:
         self.robot.post("AlgorithmActivator", "trigger")

@@ -37,6 +37,7 @@ from ..charts.game import (
     RESULT_MESSAGES,
 )
 from ..debug.debugger import Debugger
+from ..game.rules import parse_board, winning_line
 
 #: Person messages a frame carries at most (the newest).
 MESSAGES_SHOWN = 8
@@ -88,6 +89,8 @@ def game_view(debugger: Debugger) -> dict[str, Any] | None:
         "photos": game.photos,
         "outcome": game.outcome,
         "result": None if game.outcome is None else outcome_in_words(game.outcome, robot, person),
+        # the four in a row the game ended on (the board the game believes), marked on the page's board
+        "winning_line": winning_cells(game.board) if game.outcome in (robot, person) else None,
         "ended": bool(game.game.ended),
         "error": None if driver is None or driver.error is None else str(driver.error),
         "told": told,
@@ -98,6 +101,12 @@ def game_view(debugger: Debugger) -> dict[str, Any] | None:
         "record_ended": game.record.ended,
         "can_start_over": bool(game.game.ended or (driver is not None and driver.error is not None)),
     }
+
+
+def winning_cells(board: str) -> list[list[int]] | None:
+    """The four cells (1-based ``[row, column]``) of the four in a row on ``board``, or None (no win)."""
+    line = winning_line(parse_board(board))
+    return None if line is None else [list(c) for c in line]
 
 
 def photo_png(debugger: Debugger) -> bytes | None:

@@ -260,7 +260,7 @@ function svgEl(name, attrs, parent) {
 function buildXY(scene) {
   if (xy.svg || !scene) return;
   const [bx0, bx1, by0, by1] = scene.board;
-  const m = 14;  // room for the axis labels, mm
+  const m = 16;  // room for the axis labels, mm
   const fig = document.createElement("figure");
   fig.className = "graph xy";
   fig.dataset.graph = "xy";
@@ -271,7 +271,9 @@ function buildXY(scene) {
   legend.className = "legend";
   legend.textContent = "the ink on the whiteboard, seen from above; red: the pen tip (FK of the encoders)";
   cap.append(title, legend);
-  const svg = svgEl("svg", { viewBox: `${bx0 - m} ${-by1 - 4} ${bx1 - bx0 + m + 4} ${by1 - by0 + m + 4}`,
+  fig.append(cap);
+  // the board and beyond it the waiting pose (beside the board's near corner), where the tip idles
+  const svg = svgEl("svg", { viewBox: `${bx0 - m} ${-by1 - 4} ${bx1 - bx0 + 2 * m} ${by1 - by0 + m + 12}`,
                              role: "img", "data-role": "xy-view", preserveAspectRatio: "xMidYMid meet",
                              "aria-label": "what was drawn: the whiteboard's ink from above, X right, Y up, mm" },
                      fig);

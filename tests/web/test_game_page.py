@@ -31,6 +31,7 @@ from ttt_sm.web.session import Session
 from .conftest import Cockpit, served, text_of
 
 SHOT = "gui_game.png"
+WON_SHOT = "gui_game_won.png"
 #: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
 LONG = 240_000
 
@@ -170,6 +171,12 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
         # ... and who won stays said after Text box2 has moved on
         words = outcome_in_words(state["outcome"], state["robot"], state["person"])
         assert text_of(page, "result") == f"Result: {words}."
+        if state["outcome"] in (state["robot"], state["person"]):  # a win: its four in a row marked on the board
+            marked = page.locator('[data-role=board] button[data-win="true"]')
+            assert marked.count() == 4 and set(marked.all_inner_texts()) == {state["outcome"]}
+            shots = os.environ.get("TTT_SM_SCREENSHOTS")
+            if shots:
+                page.screenshot(path=str(Path(shots) / WON_SHOT), full_page=False)
         state = game_state(game_cockpit)
         person = [m for m in state["moves"] if m["by"] == "person"]
         assert len(person) == person_moves
@@ -366,7 +373,5 @@ def test_the_winning_four_in_a_row_is_marked_on_the_board(browser: Any, game_coc
                                      "l => ['x1', 'y1', 'x2', 'y2'].map(a => Number(l.getAttribute(a)))")
         assert ends == [0.5, 0.5, 3.5, 3.5]
         assert text_of(page, "result") == "Result: the robot (O) won."
-        if os.environ.get("TTT_SM_SCREENSHOTS"):
-            page.screenshot(path=str(Path(os.environ["TTT_SM_SCREENSHOTS"]) / "gui_game_won.png"), full_page=False)
     finally:
         page.close()

@@ -25,7 +25,7 @@ from typing import Any
 import cv2
 
 from ..app.game import GameSession
-from ..app.game_outcome import outcome_in_words
+from ..app.game_outcome import outcome_in_words, winning_cells
 from ..app.person import RemotePerson
 from ..charts.game import (
     MSG_COMPILING,
@@ -37,7 +37,6 @@ from ..charts.game import (
     RESULT_MESSAGES,
 )
 from ..debug.debugger import Debugger
-from ..game.rules import parse_board, winning_line
 
 #: Person messages a frame carries at most (the newest).
 MESSAGES_SHOWN = 8
@@ -57,6 +56,11 @@ TEXT_BOX1_LOCKED = "The manipulator plays {robot}, you play {person}: the symbol
 def game_of_debugger(debugger: Debugger) -> GameSession | None:
     """The game the session's robot plays, or None (a session without ``--game``)."""
     return debugger.game
+
+
+def not_started(game: GameSession) -> bool:
+    """Whether the Game chart still waits at power-on (its first message): Run has not started the robot."""
+    return str(game.game.message) == MSG_COMPILING
 
 
 def game_view(debugger: Debugger) -> dict[str, Any] | None:
@@ -101,12 +105,6 @@ def game_view(debugger: Debugger) -> dict[str, Any] | None:
         "record_ended": game.record.ended,
         "can_start_over": bool(game.game.ended or (driver is not None and driver.error is not None)),
     }
-
-
-def winning_cells(board: str) -> list[list[int]] | None:
-    """The four cells (1-based ``[row, column]``) of the four in a row on ``board``, or None (no win)."""
-    line = winning_line(parse_board(board))
-    return None if line is None else [list(c) for c in line]
 
 
 def photo_png(debugger: Debugger) -> bytes | None:

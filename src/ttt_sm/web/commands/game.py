@@ -11,11 +11,10 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ...app.game import GameSession
-from ...charts.game import MSG_COMPILING
 from ...debug.debugger import Debugger
 from ...debug.replay import GameRecipe
 from ..fields import integer, one_of
-from ..game import ENGINES, game_of_debugger
+from ..game import ENGINES, game_of_debugger, not_started
 from .spec import Cockpit, Reply, command
 
 
@@ -63,7 +62,7 @@ def stop(session: Cockpit, cid: int) -> Reply:
     game = _game(debugger, "game_stop")
     if game.game.ended:
         raise ValueError("game_stop: the game is over and the arm off already")
-    if session.mode != "running" and str(game.game.message) == MSG_COMPILING:
+    if session.mode != "running" and not_started(game):
         # Not started: a stop posted now would wait for Run and turn the arm off at once (a game of no moves).
         raise ValueError("game_stop: the robot has not been started, so there is nothing to stop;"
                          " click Run to start the game")

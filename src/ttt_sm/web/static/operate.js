@@ -126,9 +126,13 @@ function axisRange(lo, hi, minSpan) {
   const pad = (hi - lo) * 0.08;
   lo -= pad;
   hi += pad;
-  const raw = (hi - lo) / 3;
-  const p = Math.pow(10, Math.floor(Math.log10(raw)));
-  const step = [1, 2, 5, 10].map((m) => m * p).find((s) => s >= raw);
+  // the largest round step (1, 2 or 5 times a power of ten) that puts at least three ticks on the axis
+  let base = Math.pow(10, Math.ceil(Math.log10(hi - lo))), step = base;
+  for (let k = 0; k < 40; k++) {
+    step = base * [1, 0.5, 0.2][k % 3];
+    if (Math.floor(hi / step) - Math.ceil(lo / step) + 1 >= 3) break;
+    if (k % 3 === 2) base /= 10;
+  }
   const decimals = Math.max(0, -Math.floor(Math.log10(step) + 1e-9));
   const ticks = [];
   for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) ticks.push(v);

@@ -386,7 +386,7 @@ def test_idle_graphs_keep_a_least_span_the_x_y_view_holds_the_ink_and_the_simula
         page = browser.new_page(viewport={"width": 1280, "height": 720})
         try:
             open_operate(page, cockpit)
-            page.wait_for_function("document.querySelector('[data-graph=z_axis] canvas').dataset.yTicks",
+            page.wait_for_function("document.querySelector('[data-graph=z_axis] canvas')?.dataset.yTicks",
                                    timeout=30_000)
             for graph, span in MIN_SPAN.items():
                 canvas = page.locator(f'[data-graph="{graph}"] canvas')
@@ -397,7 +397,7 @@ def test_idle_graphs_keep_a_least_span_the_x_y_view_holds_the_ink_and_the_simula
             # The X-Y view: a cross drawn by hand in the middle cell is in the whiteboard's picture there.
             key = session.call(lambda d: (d.robot.board.draw_symbol("X", 3, 3), list(d.robot.board.ink_version))[1])
             page.reload()
-            page.wait_for_function("(key) => document.querySelector('[data-role=xy-ink]').dataset.key === key",
+            page.wait_for_function("(key) => document.querySelector('[data-role=xy-ink]')?.dataset.key === key",
                                    arg=":".join(str(k) for k in key), timeout=30_000)
             board, field = session.info["arm"]["board"], session.info["arm"]["field"]
             # the ink picture's pixel under the field's centre (x = 0, y = the field's middle), read in the page

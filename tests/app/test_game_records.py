@@ -27,6 +27,7 @@ import numpy as np
 import pytest
 
 from ttt_sm.app.game import GameSession
+from ttt_sm.app.game_outcome import winning_cells
 from ttt_sm.app.game_record import ENDINGS, read_record
 from ttt_sm.app.game_replay import replay_record
 from ttt_sm.app.person import SimulatedPerson, TerminalPerson
@@ -90,6 +91,10 @@ def test_the_final_board_picture_is_taken_before_the_erase_and_the_erased_one_ha
     assert titles[0].startswith(f"The whiteboard at the end of the game: {words},"), titles
     assert any(line.startswith(f"result: {words}; erasing and turning off; the board as the game ended:\n")
                for line in said), said
+    # ... and under the board, the four in a row it was won with
+    four = " ".join(f"({r}, {c})" for r, c in winning_cells(session.board) or [])
+    assert four and any(line.startswith("result: ") and line.endswith(f"\n  the four in a row: {four}")
+                        for line in said), said
     assert Path(files["board_png"]).name == "board_final.png"
     assert Path(files["board_erased_png"]).name == "board_erased.png"
     # the person's black ink and the robot's dark blue are on the final board, not on the erased one

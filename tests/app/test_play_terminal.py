@@ -78,3 +78,29 @@ def test_make_play_s_command_plays_a_whole_game_with_the_person_typing(tmp_path)
     assert moves >= 4  # four in a row takes at least four moves of the winner
     assert "The manipulator wins." in text or "You win." in text or "Draw" in text
     assert "erased: True" in text and (tmp_path / "game.jsonl").exists()
+
+
+def test_at_a_terminal_no_message_runs_into_the_status_line(tmp_path):
+    """The status line (rewritten with \\r) is ended with a new line before the next message is written."""
+    import ttt_sm
+    env = dict(os.environ, PYTHONPATH=str(Path(ttt_sm.__file__).parents[1]))  # this checkout's ttt_sm
+    main_fd, child_fd = pty.openpty()
+    proc = subprocess.Popen([sys.executable, "-m", "ttt_sm.cli", "play", "--camera", "direct", "--out",
+                             str(tmp_path)], stdin=child_fd, stdout=child_fd, stderr=child_fd, close_fds=True,
+                            cwd=tmp_path, env=env)
+    os.close(child_fd)
+    buffer: list[str] = []
+    try:
+        found = _read_until(main_fd, re.compile(r"Your move \(X\): "), buffer, 120.0)
+    finally:
+        proc.terminate()
+        proc.wait(timeout=60)
+        os.close(main_fd)
+    text = "".join(buffer)
+    assert found is not None, text[-2000:]
+    status = re.findall(r"\r\x1b\[K  (t = \d+ s simulated: [^\r\n]*)", text)
+    assert status, text[-2000:]  # the status line was on show while the field was drawn
+    # After an erase only a status text comes, and the last one is ended by a new line, not by the message.
+    after_erase = re.findall(r"\x1b\[K(.{0,12})", text)
+    assert all(a.startswith("  t = ") for a in after_erase), after_erase
+    assert re.search(r"  t = \d+ s simulated: [^\r\n]*field\r?\nIf it is your turn", text), text[-600:]

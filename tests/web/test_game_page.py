@@ -31,6 +31,7 @@ from ttt_sm.web.session import Session
 from .conftest import Cockpit, served, text_of
 
 SHOT = "gui_game.png"
+WON_SHOT = "gui_game_won.png"
 #: Waits in the page, ms: the simulation runs as fast as it goes but the machine may be busy.
 LONG = 240_000
 
@@ -170,6 +171,12 @@ def test_a_whole_game_played_by_clicking(browser: Any, game_cockpit: Cockpit, tm
         # ... and who won stays said after Text box2 has moved on
         words = outcome_in_words(state["outcome"], state["robot"], state["person"])
         assert text_of(page, "result") == f"Result: {words}."
+        if state["outcome"] in (state["robot"], state["person"]):  # a win: its four in a row marked on the board
+            marked = page.locator('[data-role=board] button[data-win="true"]')
+            assert marked.count() == 4 and set(marked.all_inner_texts()) == {state["outcome"]}
+            shots = os.environ.get("TTT_SM_SCREENSHOTS")
+            if shots:
+                page.screenshot(path=str(Path(shots) / WON_SHOT), full_page=False)
         state = game_state(game_cockpit)
         person = [m for m in state["moves"] if m["by"] == "person"]
         assert len(person) == person_moves
@@ -322,5 +329,49 @@ def test_a_blocked_drive_mid_stroke_shows_the_safety_stop_and_its_reason(browser
         # the game cannot go on, and says so where the page says what the game told
         page.wait_for_function("document.querySelector('[data-role=told]').textContent.includes('safety stop')",
                                timeout=30_000)
+    finally:
+        page.close()
+
+
+def test_stop_before_run_says_so_and_the_next_run_starts_a_real_game(browser: Any, game_cockpit: Cockpit) -> None:
+    page = browser.new_page(viewport={"width": 1280, "height": 720})
+    try:
+        open_game(page, game_cockpit)
+        page.get_by_role("button", name="Stop", exact=True).click()
+        # What happened is said, in the page's words: nothing was stopped.
+        page.wait_for_function("document.querySelector('[data-role=reply]').textContent.includes('not been started')",
+                               timeout=30_000)
+        assert text_of(page, "reply") == ("the robot has not been started, so there is nothing to stop;"
+                                          " click Run to start the game")
+        assert page.locator('[data-role="reply"]').get_attribute("data-error") == "true"
+        # No stop waits for Run: once the robot runs, the Game chart initialises instead of turning the arm off.
+        active, message, ended = game_cockpit.session.call(
+            lambda d: (d.tick(50), sorted(d.robot.active("Game")), str(d.game.game.message), d.game.game.ended)[1:])
+        assert (active, ended) == (["initialising"], False), message
+    finally:
+        page.close()
+
+
+#: A game the manipulator (O) won on the diagonal from (1, 1) to (4, 4); X moved first.
+WON_ON_THE_DIAGONAL = "OXXX." "XO..." "..O.." "...O." "....."
+
+
+def test_the_winning_four_in_a_row_is_marked_on_the_board(browser: Any, game_cockpit: Cockpit) -> None:
+    def won(d: Debugger) -> None:  # the game's state at its end, as the game's flow leaves it
+        d.game.board = d.game.truth = WON_ON_THE_DIAGONAL
+        d.game.outcome = "O"
+    game_cockpit.session.call(won)
+    page = browser.new_page(viewport={"width": 1280, "height": 720})
+    try:
+        open_game(page, game_cockpit)
+        wait_board(page, WON_ON_THE_DIAGONAL)
+        marked = page.eval_on_selector_all('[data-role=board] button[data-win="true"]',
+                                           "bs => bs.map(b => [Number(b.dataset.row), Number(b.dataset.column)])")
+        assert marked == [[1, 1], [2, 2], [3, 3], [4, 4]]
+        # ... and a line drawn through them, from the first cell's centre to the last's
+        ends = page.eval_on_selector("[data-role=board] svg.win-line line",
+                                     "l => ['x1', 'y1', 'x2', 'y2'].map(a => Number(l.getAttribute(a)))")
+        assert ends == [0.5, 0.5, 3.5, 3.5]
+        assert text_of(page, "result") == "Result: the robot (O) won."
     finally:
         page.close()

@@ -369,3 +369,53 @@ def test_stop_drive_1_is_a_toggle_on_the_operational_page_and_the_cockpit(
             "set DriveInit1.stop True", "set DriveInit1.stop False"]
     finally:
         page.close()
+
+
+#: The least span of each graph's vertical axis (operate.js's GRAPHS' minSpan), in the graph's unit.
+MIN_SPAN = {"z_axis": 1.0, "second_drive": 0.2, "third_drive": 0.2, "following_error": 0.5}
+
+
+def test_idle_graphs_keep_a_least_span_the_x_y_view_holds_the_ink_and_the_simulation_speed_is_set_here(
+        browser: Any) -> None:
+    """At power-on the arm hardly moves: the graphs show the noise as the flat line it is, with ticks that
+    differ; the X-Y view shows the ink on the whiteboard; the Simulation speed list sets the session's speed."""
+    session = Session(Debugger.build(load_params(), seed=0), speed=None, running=False)
+    with served(session) as cockpit:
+        session.operate.plot_history()  # the graphs' samples are taken from here on
+        session.call(lambda d: d.tick(500))  # 1 s after power-on: the drives start to initialise
+        page = browser.new_page(viewport={"width": 1280, "height": 720})
+        try:
+            open_operate(page, cockpit)
+            page.wait_for_function("document.querySelector('[data-graph=z_axis] canvas')?.dataset.yTicks",
+                                   timeout=30_000)
+            for graph, span in MIN_SPAN.items():
+                canvas = page.locator(f'[data-graph="{graph}"] canvas')
+                labels = str(canvas.get_attribute("data-y-ticks")).split(" / ")
+                lo, hi = (float(v) for v in str(canvas.get_attribute("data-y-range")).split())
+                assert hi - lo >= span, (graph, lo, hi)
+                assert len(labels) >= 2 and len(set(labels)) == len(labels), (graph, labels)
+            # The X-Y view: a cross drawn by hand in the middle cell is in the whiteboard's picture there.
+            key = session.call(lambda d: (d.robot.board.draw_symbol("X", 3, 3), list(d.robot.board.ink_version))[1])
+            page.reload()
+            page.wait_for_function("(key) => document.querySelector('[data-role=xy-ink]')?.dataset.key === key",
+                                   arg=":".join(str(k) for k in key), timeout=30_000)
+            board, field = session.info["arm"]["board"], session.info["arm"]["field"]
+            # the ink picture's pixel under the field's centre (x = 0, y = the field's middle), read in the page
+            dark = page.evaluate("""async ([[bx0, bx1, by0, by1], [fx0, fx1, fy0, fy1]]) => {
+                const img = new Image(); img.src = document.querySelector('[data-role=xy-ink]').getAttribute('href');
+                await img.decode();
+                const c = document.createElement('canvas'); c.width = img.width; c.height = img.height;
+                const ctx = c.getContext('2d'); ctx.drawImage(img, 0, 0);
+                const s = img.width / (bx1 - bx0), x = ((fx0 + fx1) / 2 - bx0) * s, y = (by1 - (fy0 + fy1) / 2) * s;
+                return Array.from(ctx.getImageData(x - 2, y - 2, 5, 5).data).filter((v, i) => i % 4 === 0)
+                  .some((v) => v < 128); }""", [board, field])
+            assert dark
+            # The simulation's speed, chosen here, is the session's (the session's `speed` command).
+            speed = page.get_by_role("combobox", name="Simulation speed")
+            assert speed.input_value() == "max"
+            speed.select_option("0.5")
+            page.wait_for_function("document.querySelector('[data-role=reply]').textContent === 'x0.5'",
+                                   timeout=30_000)
+            assert session.speed == 0.5
+        finally:
+            page.close()

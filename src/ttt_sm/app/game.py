@@ -44,7 +44,7 @@ from ..vision.percent import check_own_marks
 from .camera_link import CameraLink, CameraLost
 from .engines import engine_for
 from .game_gui import GuiInputs
-from .game_outcome import GameError, GameInterrupted, outcome_in_words, result_of
+from .game_outcome import GameError, GameInterrupted, outcome_in_words, result_of, winning_cells
 from .game_record import GameRecord
 from .game_report import GameReporting
 from .game_stages import Flow, GameDriver, GameStage, PenPathStage, Wait
@@ -381,8 +381,10 @@ class GameSession(GuiInputs, GameReporting):
         self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3, "given_up": 4}.get(outcome, 3)
         self._event("result", outcome=outcome)
         self._save_board("final")  # the board as the game ended, before the sponge
+        line = winning_cells(self.board)
+        won = "" if line is None else "\n  the four in a row: " + " ".join(f"({r}, {c})" for r, c in line)
         self.say(f"result: {outcome_in_words(outcome, self.robot_symbol, self.person_symbol)}; "
-                 f"erasing and turning off; the board as the game ended:\n{board_picture(self.board)}")
+                 f"erasing and turning off; the board as the game ended:\n{board_picture(self.board)}{won}")
         yield Wait(lambda: self.game.ended, 600.0, "erasing and turning off")
         self._save_board("erased")
 

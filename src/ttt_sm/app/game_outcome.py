@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..game.rules import is_full, parse_board, winner
+from ..game.rules import is_full, parse_board, winner, winning_line
 
 
 class GameError(RuntimeError):
@@ -24,6 +24,12 @@ def result_of(board: str) -> str | None:
     if won is not None:
         return won
     return "draw" if is_full(b) else None
+
+
+def winning_cells(board: str) -> list[list[int]] | None:
+    """The four cells (1-based ``[row, column]``) of the four in a row on ``board``, or None (no win)."""
+    line = winning_line(parse_board(board))
+    return None if line is None else [list(c) for c in line]
 
 
 def outcome_in_words(outcome: str | None, robot_symbol: str, person_symbol: str) -> str:

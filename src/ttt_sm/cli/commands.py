@@ -21,6 +21,7 @@ from .common import (
     add_command,
     clear_status,
     emit,
+    end_status,
     out_dir,
     print_json,
     progress,
@@ -105,7 +106,7 @@ def cmd_play(args: argparse.Namespace) -> int:
         try:
             params = load_arm(args.params)
             conn = open_arm(args, params)
-            say = progress(True)
+            say = progress(True, keep_status=True)
             opponent = args.opponent
             stdin_open = sys.stdin is not None and not sys.stdin.closed
             if opponent == "auto":
@@ -113,7 +114,7 @@ def cmd_play(args: argparse.Namespace) -> int:
             elif opponent == "terminal" and not stdin_open:
                 raise CliError("--opponent terminal: standard input is closed, so no one can type a move;"
                                " give it a terminal, or play against --opponent simulated")
-            person = (TerminalPerson(before_write=clear_status) if opponent == "terminal"
+            person = (TerminalPerson(before_write=end_status) if opponent == "terminal"
                       else SimulatedPerson(args.seed, say, args.person))
             say(f"ttt-sm play: the robot plays {args.robot_symbol} ({args.engine} engine) against a "
                 f"{'person at this terminal' if opponent == 'terminal' else f'simulated person ({args.person})'}; "

@@ -264,11 +264,19 @@ def trace_file(path: str, what: str = "--trace") -> Path:
 _status_shown = False
 
 
-def progress(enabled: bool) -> Callable[[str], None]:
-    """A ``say(msg)`` that writes progress lines to standard error (or nothing)."""
+def progress(enabled: bool, keep_status: bool = False) -> Callable[[str], None]:
+    """A ``say(msg)`` that writes progress lines to standard error (or nothing).
+
+    A status line on show is taken off first, or with ``keep_status`` ended
+    where it stands (:func:`end_status`), so the line comes after it, never
+    on it.
+    """
     def say(msg: str) -> None:
         if enabled:
-            clear_status()
+            if keep_status:
+                end_status()
+            else:
+                clear_status()
             print(msg, file=sys.stderr, flush=True)
     return say
 
@@ -297,6 +305,21 @@ def clear_status() -> None:
     global _status_shown
     if _status_shown and sys.stderr is not None:
         sys.stderr.write("\r\033[K")
+        sys.stderr.flush()
+        _status_shown = False
+
+
+def end_status() -> None:
+    """End the status line with a new line, so that what is written next starts a line of its own.
+
+    The status line is rewritten in place with ``\\r``; erasing it before a
+    message leaves the two on one line in a log of the terminal (``script``, a
+    CI log: ``...drawing the fieldIf it is your turn``).  Ended, the last
+    status stays on show above the message.
+    """
+    global _status_shown
+    if _status_shown and sys.stderr is not None:
+        sys.stderr.write("\n")
         sys.stderr.flush()
         _status_shown = False
 

@@ -25,7 +25,7 @@ from typing import Any
 import cv2
 
 from ..app.game import GameSession
-from ..app.game_outcome import outcome_in_words
+from ..app.game_outcome import outcome_in_words, winning_cells
 from ..app.person import RemotePerson
 from ..charts.game import (
     MSG_COMPILING,
@@ -58,6 +58,11 @@ def game_of_debugger(debugger: Debugger) -> GameSession | None:
     return debugger.game
 
 
+def not_started(game: GameSession) -> bool:
+    """Whether the Game chart still waits at power-on (its first message): Run has not started the robot."""
+    return str(game.game.message) == MSG_COMPILING
+
+
 def game_view(debugger: Debugger) -> dict[str, Any] | None:
     """The ``game`` part of a frame: what the Tic-tac-toe page shows, plain data (None: no game)."""
     game = game_of_debugger(debugger)
@@ -88,6 +93,8 @@ def game_view(debugger: Debugger) -> dict[str, Any] | None:
         "photos": game.photos,
         "outcome": game.outcome,
         "result": None if game.outcome is None else outcome_in_words(game.outcome, robot, person),
+        # the four in a row the game ended on (the board the game believes), marked on the page's board
+        "winning_line": winning_cells(game.board) if game.outcome in (robot, person) else None,
         "ended": bool(game.game.ended),
         "error": None if driver is None or driver.error is None else str(driver.error),
         "told": told,

@@ -14,7 +14,7 @@ from ...app.game import GameSession
 from ...debug.debugger import Debugger
 from ...debug.replay import GameRecipe
 from ..fields import integer, one_of
-from ..game import ENGINES, game_of_debugger
+from ..game import ENGINES, game_of_debugger, not_started
 from .spec import Cockpit, Reply, command
 
 
@@ -62,8 +62,15 @@ def stop(session: Cockpit, cid: int) -> Reply:
     game = _game(debugger, "game_stop")
     if game.game.ended:
         raise ValueError("game_stop: the game is over and the arm off already")
+    if session.mode != "running" and not_started(game):
+        # Not started: a stop posted now would wait for Run and turn the arm off at once (a game of no moves).
+        raise ValueError("game_stop: the robot has not been started, so there is nothing to stop;"
+                         " click Run to start the game")
     debugger.post(game.game.chart_name, "stop")
-    return {"text": "Stop: the manipulator returns to its start pose avoiding the board, then stops"}
+    text = "Stop: the manipulator returns to its start pose avoiding the board, then stops"
+    if session.mode != "running":
+        text += " (the session is paused: it does so once it runs)"
+    return {"text": text}
 
 
 @command("game_engine", engine=one_of(*ENGINES))

@@ -130,6 +130,7 @@ function drawGame(g) {
     b.disabled = !(g.plays_here && g.awaiting === "draw") || there !== ".";  // the hand cannot wipe a mark
     b.title = by === "drawn" ? "drawn; the camera reads it when you click Play" : "";
   }
+  drawWinningLine(g.winning_line);
   $('[data-cmd="play"]').disabled = !(g.plays_here && g.awaiting);
   const engine = role("engine");
   engine.value = g.engine;
@@ -151,6 +152,36 @@ function drawGame(g) {
     }
   }
   if (g.percentages) drawReading(role("reading"), g.percentages, g.read);
+}
+
+// The four in a row the game ended on: its cells marked (data-win) and a line drawn through them.
+function drawWinningLine(line) {
+  const board = role("board");
+  const win = new Set((line || []).map(([r, c]) => `${r},${c}`));
+  for (const b of board.querySelectorAll("button")) {
+    const on = win.has(`${b.dataset.row},${b.dataset.column}`);
+    b.dataset.win = on ? "true" : "false";
+    if (on) b.title = "part of the winning four in a row";
+  }
+  board.dataset.winningLine = line ? line.map(([r, c]) => `${r},${c}`).join(" ") : "";
+  let svg = board.querySelector("svg.win-line");
+  if (!line) {
+    if (svg) svg.remove();
+    return;
+  }
+  if (!svg) {
+    svg = document.createElementNS("http://www.w3.org/2000/svg", "svg");
+    svg.setAttribute("class", "win-line");
+    svg.setAttribute("viewBox", "0 0 5 5");
+    svg.setAttribute("preserveAspectRatio", "none");
+    svg.setAttribute("aria-hidden", "true");
+    svg.appendChild(document.createElementNS("http://www.w3.org/2000/svg", "line"));
+    board.appendChild(svg);
+  }
+  const [[r0, c0], [r1, c1]] = [line[0], line[line.length - 1]];
+  const l = svg.firstChild;
+  l.setAttribute("x1", c0 - 0.5); l.setAttribute("y1", r0 - 0.5);
+  l.setAttribute("x2", c1 - 0.5); l.setAttribute("y2", r1 - 0.5);
 }
 
 function drawFrame(f) {

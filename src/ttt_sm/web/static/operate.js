@@ -16,14 +16,17 @@ const CAPACITY = 3000;
 //: The graphs show the last this many simulated seconds.
 const WINDOW_S = 20;
 
+//: minSpan: the least span of a graph's vertical axis, in its unit: an idle arm's noise (a few µm,
+//: a few mA) is drawn as the flat line it is, not blown up to fill the graph (1 mm; 0.2 A; 0.5 deg,
+//: about 0.01 rad).  Desired and measured share one axis.
 const GRAPHS = [
-  { id: "x_axis", title: "X axis", unit: "mm", series: [["x_desired_mm", "desired", "#1f4e9c"], ["x_fk_mm", "FK of the encoders", "#d33"]] },
-  { id: "y_axis", title: "Y axis", unit: "mm", series: [["y_desired_mm", "desired", "#1f4e9c"], ["y_fk_mm", "FK of the encoders", "#d33"]] },
-  { id: "z_axis", title: "Z axis", unit: "mm", series: [["z_desired_mm", "desired", "#1f4e9c"], ["z_fk_mm", "FK of the encoders", "#d33"]] },
-  { id: "first_drive", title: "First drive", unit: "A", series: [["current_1_a", "motor current", "#1d7a1d"]] },
-  { id: "second_drive", title: "Second drive", unit: "A", series: [["current_2_a", "motor current", "#1d7a1d"]] },
-  { id: "third_drive", title: "Third drive", unit: "A", series: [["current_3_a", "motor current", "#1d7a1d"]] },
-  { id: "following_error", title: "Following error", unit: "deg", series: [["following_error_1_deg", "drive 1", "#1f4e9c"], ["following_error_2_deg", "drive 2", "#d33"], ["following_error_3_deg", "drive 3", "#1d7a1d"]] },
+  { id: "x_axis", title: "X axis", unit: "mm", minSpan: 1, series: [["x_desired_mm", "desired", "#1f4e9c"], ["x_fk_mm", "FK of the encoders", "#d33"]] },
+  { id: "y_axis", title: "Y axis", unit: "mm", minSpan: 1, series: [["y_desired_mm", "desired", "#1f4e9c"], ["y_fk_mm", "FK of the encoders", "#d33"]] },
+  { id: "z_axis", title: "Z axis", unit: "mm", minSpan: 1, series: [["z_desired_mm", "desired", "#1f4e9c"], ["z_fk_mm", "FK of the encoders", "#d33"]] },
+  { id: "first_drive", title: "First drive", unit: "A", minSpan: 0.2, series: [["current_1_a", "motor current", "#1d7a1d"]] },
+  { id: "second_drive", title: "Second drive", unit: "A", minSpan: 0.2, series: [["current_2_a", "motor current", "#1d7a1d"]] },
+  { id: "third_drive", title: "Third drive", unit: "A", minSpan: 0.2, series: [["current_3_a", "motor current", "#1d7a1d"]] },
+  { id: "following_error", title: "Following error", unit: "deg", minSpan: 0.5, series: [["following_error_1_deg", "drive 1", "#1f4e9c"], ["following_error_2_deg", "drive 2", "#d33"], ["following_error_3_deg", "drive 3", "#1d7a1d"]] },
 ];
 
 const MEANS = { X: "the X's side", O: "the O's diameter", sine: "the sine wave's peak to peak", staircase: "" };
@@ -111,19 +114,29 @@ function buildGraphs() {
   }
 }
 
-function niceRange(lo, hi) {
-  if (!Number.isFinite(lo)) return [-1, 1];
-  if (hi - lo < 1e-9) {
-    const pad = Math.max(Math.abs(lo) * 0.05, 0.01);
-    return [lo - pad, hi + pad];
+// The vertical axis of a graph: the data's range, at least `minSpan` wide (centred on the data), with
+// a margin, and ticks at a round step whose labels differ ("159.5 / 160 / 160.5", never "160 / 160 / 160").
+function axisRange(lo, hi, minSpan) {
+  if (!Number.isFinite(lo) || !Number.isFinite(hi)) { lo = -minSpan / 2; hi = minSpan / 2; }
+  if (hi - lo < minSpan) {
+    const mid = (lo + hi) / 2;
+    lo = mid - minSpan / 2;
+    hi = mid + minSpan / 2;
   }
   const pad = (hi - lo) * 0.08;
-  return [lo - pad, hi + pad];
-}
-
-function fmt(v) {
-  const a = Math.abs(v);
-  return a >= 100 ? v.toFixed(0) : a >= 10 ? v.toFixed(1) : a >= 1 ? v.toFixed(2) : v.toFixed(3);
+  lo -= pad;
+  hi += pad;
+  // the largest round step (1, 2 or 5 times a power of ten) that puts at least three ticks on the axis
+  let base = Math.pow(10, Math.ceil(Math.log10(hi - lo))), step = base;
+  for (let k = 0; k < 40; k++) {
+    step = base * [1, 0.5, 0.2][k % 3];
+    if (Math.floor(hi / step) - Math.ceil(lo / step) + 1 >= 3) break;
+    if (k % 3 === 2) base /= 10;
+  }
+  const decimals = Math.max(0, -Math.floor(Math.log10(step) + 1e-9));
+  const ticks = [];
+  for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) ticks.push(v);
+  return { lo, hi, ticks, labels: ticks.map((v) => (Math.abs(v) < step / 1e6 ? 0 : v).toFixed(decimals)) };
 }
 
 function drawGraph(g) {
@@ -151,7 +164,11 @@ function drawGraph(g) {
       if (v > hi) hi = v;
     }
   }
-  [lo, hi] = niceRange(lo, hi);
+  const axis = axisRange(lo, hi, g.minSpan);
+  lo = axis.lo;
+  hi = axis.hi;
+  canvas.dataset.yTicks = axis.labels.join(" / ");
+  canvas.dataset.yRange = `${lo} ${hi}`;
   const x = (t) => left + ((t - tStart) / WINDOW_S) * (w - left - right);
   const y = (v) => top + (1 - (v - lo) / (hi - lo)) * (h - top - bottom);
   ctx.strokeStyle = "#ddd";
@@ -160,13 +177,13 @@ function drawGraph(g) {
   ctx.lineWidth = 1;
   ctx.textAlign = "right";
   ctx.textBaseline = "middle";
-  for (const v of [lo, (lo + hi) / 2, hi]) {
+  axis.ticks.forEach((v, i) => {
     ctx.beginPath();
     ctx.moveTo(left, y(v));
     ctx.lineTo(w - right, y(v));
     ctx.stroke();
-    ctx.fillText(fmt(v), left - 4, y(v));
-  }
+    ctx.fillText(axis.labels[i], left - 4, y(v));
+  });
   ctx.textAlign = "center";
   ctx.textBaseline = "top";
   for (let s = Math.ceil(tStart / 5) * 5; s <= tEnd; s += 5) {
@@ -198,6 +215,7 @@ function redraw() {
   if (state.dirty) {
     state.dirty = false;
     for (const g of GRAPHS) drawGraph(g);
+    drawTip();
     stats.redraws++;
   }
   // The frames are drawn: acknowledged for the latency figures (the session's clock).
@@ -225,6 +243,107 @@ function download(g) {
   a.click();
   a.remove();
   setTimeout(() => URL.revokeObjectURL(url), 10_000);
+}
+
+// -- what was drawn, X-Y ----------------------------------------------------------------------
+// The whiteboard seen from above in the X, Y of the graphs (mm): the board, the field, the ink on
+// it (the board's own picture, /api/arm/ink.png, fetched again when the frame's arm.ink key
+// changes) and the pen tip where the encoders put it.  It holds what is on the board, whenever it
+// was drawn: it does not scroll away with the graphs' 20 s.
+
+const SVG = "http://www.w3.org/2000/svg";
+const xy = { svg: null, ink: null, tip: null, key: null, busy: false, again: false, url: null };
+
+function svgEl(name, attrs, parent) {
+  const e = document.createElementNS(SVG, name);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  parent.appendChild(e);
+  return e;
+}
+
+function buildXY(scene) {
+  if (xy.svg || !scene) return;
+  const [bx0, bx1, by0, by1] = scene.board;
+  const m = 16;  // room for the axis labels, mm
+  const fig = document.createElement("figure");
+  fig.className = "graph xy";
+  fig.dataset.graph = "xy";
+  const cap = document.createElement("figcaption");
+  const title = document.createElement("b");
+  title.textContent = "What was drawn, X-Y, mm";
+  const legend = document.createElement("span");
+  legend.className = "legend";
+  legend.textContent = "the ink on the whiteboard, seen from above; red: the pen tip (FK of the encoders)";
+  cap.append(title, legend);
+  fig.append(cap);
+  // the board and beyond it the waiting pose (beside the board's near corner), where the tip idles
+  const svg = svgEl("svg", { viewBox: `${bx0 - m} ${-by1 - 4} ${bx1 - bx0 + 2 * m} ${by1 - by0 + m + 12}`,
+                             role: "img", "data-role": "xy-view", preserveAspectRatio: "xMidYMid meet",
+                             "aria-label": "what was drawn: the whiteboard's ink from above, X right, Y up, mm" },
+                     fig);
+  svgEl("rect", { x: bx0, y: -by1, width: bx1 - bx0, height: by1 - by0, class: "board" }, svg);
+  xy.ink = svgEl("image", { x: bx0, y: -by1, width: bx1 - bx0, height: by1 - by0, preserveAspectRatio: "none",
+                            "data-role": "xy-ink" }, svg);
+  const [fx0, fx1, fy0, fy1] = scene.field;
+  const grid = svgEl("g", { class: "field" }, svg);
+  for (let i = 0; i <= scene.cells; i++) {
+    const x = fx0 + ((fx1 - fx0) * i) / scene.cells, y = fy0 + ((fy1 - fy0) * i) / scene.cells;
+    svgEl("line", { x1: x, y1: -fy0, x2: x, y2: -fy1 }, grid);
+    svgEl("line", { x1: fx0, y1: -y, x2: fx1, y2: -y }, grid);
+  }
+  const axis = svgEl("g", { class: "axis" }, svg);
+  const step = 50;
+  for (let x = Math.ceil(bx0 / step) * step; x <= bx1; x += step) {
+    svgEl("line", { x1: x, y1: -by0, x2: x, y2: -by0 + 2 }, axis);
+    svgEl("text", { x, y: -by0 + 9, "text-anchor": "middle" }, axis).textContent = String(x);
+  }
+  for (let y = Math.ceil(by0 / step) * step; y <= by1; y += step) {
+    svgEl("line", { x1: bx0 - 2, y1: -y, x2: bx0, y2: -y }, axis);
+    svgEl("text", { x: bx0 - 3, y: -y + 2.5, "text-anchor": "end" }, axis).textContent = String(y);
+  }
+  xy.tip = svgEl("circle", { r: 1.8, cx: 0, cy: 0, class: "tip", visibility: "hidden", "data-role": "xy-tip" }, svg);
+  xy.svg = svg;
+  role("graphs").prepend(fig);
+}
+
+function drawXY(arm) {
+  if (!xy.svg || !arm) return;
+  const key = arm.ink.join(":");
+  if (key !== xy.key) {
+    xy.key = key;
+    refreshInk();
+  }
+}
+
+function drawTip() {
+  if (!xy.tip || !ring.n || ring.index.x_fk_mm === undefined) return;
+  const x = ring.at(ring.index.x_fk_mm, ring.n - 1), y = ring.at(ring.index.y_fk_mm, ring.n - 1);
+  if (!Number.isFinite(x) || !Number.isFinite(y)) return;
+  xy.tip.setAttribute("cx", x);
+  xy.tip.setAttribute("cy", -y);
+  xy.tip.setAttribute("visibility", "visible");
+}
+
+// One request at a time; the latest key wins.
+async function refreshInk() {
+  if (xy.busy) { xy.again = true; return; }
+  xy.busy = true;
+  const key = xy.key;
+  try {
+    const response = await fetch(`/api/arm/ink.png?k=${encodeURIComponent(key)}`, { cache: "no-store" });
+    if (response.ok) {
+      const url = URL.createObjectURL(await response.blob());
+      xy.ink.setAttribute("href", url);
+      xy.ink.dataset.key = key;
+      if (xy.url) URL.revokeObjectURL(xy.url);
+      xy.url = url;
+    }
+  } catch (e) {
+    // the server went away: the next frame (if any) asks again
+  } finally {
+    xy.busy = false;
+    if (xy.again) { xy.again = false; setTimeout(refreshInk, 150); }
+  }
 }
 
 // -- the controls ---------------------------------------------------------------------------
@@ -319,13 +438,21 @@ function drawStaircase(p) {
 
 function drawFrame(f) {
   drawCommon(f);
+  if (f.speed !== undefined) {
+    const speed = role("sim-speed");
+    if (document.activeElement !== speed) speed.value = String(f.speed);
+  }
   if (f.operate) drawOperate(f.operate);
   if (f.plot) takePlot(f.plot);
+  if (f.full) xy.key = null;  // a page that joins, a replay: the ink is fetched again whatever its key
+  if ("arm" in f) drawXY(f.arm);
   if (f.error) say(f.error, true);
 }
 
 function onMessage(m) {
-  if (m.type === "frame") {
+  if (m.type === "session") {
+    buildXY(m.info.arm);
+  } else if (m.type === "frame") {
     drawFrame(m);
     state.toAck.push(m.seq);
   } else if (m.type === "reply") {
@@ -347,6 +474,10 @@ speed = pair("Speed", "", "speed", "speed-box", describeSettings);
 role("symbol").addEventListener("change", describeSettings);
 describeSettings();
 $('[data-cmd="run"]').addEventListener("click", () => link.send({ type: "run" }));
+role("sim-speed").addEventListener("change", (e) => {
+  const v = e.target.value;
+  link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });
+});
 $('[data-cmd="stop"]').addEventListener("click", () => link.send({ type: "operate_stop" }));
 $('[data-cmd="trigger"]').addEventListener("click", () => {
   const symbol = role("symbol").value;

@@ -121,6 +121,8 @@ def test_and_or_short_circuit() -> None:
     ("C.message == 'You win.", "unexpected character \"'\" (text in quotes ends with the quote it starts"
                                " with)", 14),
     ('"a\' == 1', "text in quotes ends with the quote it starts with", 1),
+    # found by the soak fuzz: a whole number beyond any float with a unit raised OverflowError
+    ("1" + "0" * 400 + " deg", "a number of 401 digits in deg is too large", 1),
 ])
 def test_syntax_errors_name_the_column(text: str, message: str, column: int) -> None:
     with pytest.raises(ExprError) as info:

@@ -278,7 +278,10 @@ class _Parser:
             unit = self.tok
             if unit.kind == "name" and unit.text in UNITS:
                 self.pos += 1
-                value = value * UNITS[unit.text]
+                try:
+                    value = value * UNITS[unit.text]
+                except OverflowError:  # a whole number beyond any float, with a unit that makes it one
+                    raise self.error(f"a number of {len(tok.text)} digits in {unit.text} is too large", tok) from None
                 self.units.append(unit.text)
             elif unit.kind == "name" and unit.text not in KEYWORDS:
                 raise self.error(f"unknown unit {unit.text!r}; units: {', '.join(UNITS)}", unit)

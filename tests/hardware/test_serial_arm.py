@@ -130,7 +130,14 @@ def test_in_realtime_the_firmware_stops_the_arm_when_the_pc_falls_silent(tmp_pat
             assert not arm.link_ok and arm.link_fault.startswith("the firmware stopped the drives (safe_stop")
             fw = emu.firmware
             assert fw.state == 2 and fw.steps > 50 and fw.setpoints_ok <= 1
-            assert arm.rearm() and fw.state == 1 and arm.link_ok  # START again: the drives run
+            late = fw.rejections()[L.Reason.LATE]
+            rearmed = arm.rearm()  # START again, then 0.2 s of setpoints in real time while the drives settle
+            if not rearmed and fw.rejections()[L.Reason.LATE] > late:
+                # the watchdog did its job again: the PC's setpoints came late (a loaded machine), which this
+                # real-time case cannot tell from a fault; the gated tests check the same re-arming exactly
+                pytest.skip(f"this machine did not keep real time: the firmware refused"
+                            f" {fw.rejections()[L.Reason.LATE] - late} late setpoint frame(s) while re-arming")
+            assert rearmed and fw.state == 1 and arm.link_ok  # the drives run
         finally:
             arm.close()
 

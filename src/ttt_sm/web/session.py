@@ -473,8 +473,6 @@ class Session:
                     return
                 if item is None:
                     return
-                if item[1].type == _FAULT_ON:
-                    raise RuntimeError(f"{FAULT_ENV}={_FAULT_ON}: the test's fault in the simulation thread")
                 self._handle(*item)
                 if self.mode == "running" and time.perf_counter() - started > budget and not self._queue.empty():
                     self._wake = True  # the rest after a stretch of the run
@@ -549,6 +547,8 @@ class Session:
         exception's name.  If the robot moved (or was rebuilt) before it broke, it
         may be half way through a step: :meth:`robot_raised` holds it.
         """
+        if cmd.type == _FAULT_ON:  # the test hook: outside the handling below, as a bug of the loop would be
+            raise RuntimeError(f"{FAULT_ENV}={_FAULT_ON}: the test's fault in the simulation thread")
         if cmd.type == "_call":
             cmd.args["fn"](self.debugger)
             self._dirty = True

@@ -8,7 +8,7 @@
 // session's messages to them, keeps the frames in order and draws the header.
 
 import { $, $$, button, role } from "./dom.js";
-import { addDrive1Stop, addSafety, drawDrive1, drawSafety } from "./page.js";
+import { addDrive1Stop, addSafety, addSpeed, drawDrive1, drawSafety, drawSpeed } from "./page.js";
 import { SessionLink } from "./session.js";
 import { Breakpoints } from "./charts/breakpoints.js";
 import { CoverageView } from "./charts/coverage.js";
@@ -103,8 +103,7 @@ function drawHeader(f) {
   const mode = role("mode");
   mode.textContent = f.mode;
   mode.dataset.mode = f.mode;
-  const speed = role("speed");
-  if (document.activeElement !== speed) speed.value = String(f.speed);
+  drawSpeed(role("speed"), f.speed);
   drawPace(f);
   if ("safety" in f) drawSafety(f.safety);
   if ("drive1" in f) drawDrive1(f.drive1);
@@ -199,9 +198,6 @@ for (const b of $$("[data-cmd]")) {
 addShortcuts();
 addSafety($("header"), link);
 addDrive1Stop($(".safety-group"), link);
-role("speed").addEventListener("change", (e) => {
-  const v = e.target.value;
-  link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });
-});
+addSpeed(role("speed"), link);
 
 link.connect();

@@ -8,7 +8,7 @@
 // are plain canvases drawn here; their data live in a ring buffer of fixed size.
 
 import { $, role } from "./dom.js";
-import { addDrive1Stop, drawCommon, pageHeader, sayReply as say } from "./page.js";
+import { addDrive1Stop, addSpeed, drawCommon, drawSpeed, pageHeader, sayReply as say } from "./page.js";
 import { SessionLink } from "./session.js";
 
 //: Samples kept per column (2 minutes at 25 a simulated second); the oldest are overwritten.
@@ -438,10 +438,7 @@ function drawStaircase(p) {
 
 function drawFrame(f) {
   drawCommon(f);
-  if (f.speed !== undefined) {
-    const speed = role("sim-speed");
-    if (document.activeElement !== speed) speed.value = String(f.speed);
-  }
+  if (f.speed !== undefined) drawSpeed(role("sim-speed"), f.speed);
   if (f.operate) drawOperate(f.operate);
   if (f.plot) takePlot(f.plot);
   if (f.full) xy.key = null;  // a page that joins, a replay: the ink is fetched again whatever its key
@@ -474,10 +471,7 @@ speed = pair("Speed", "", "speed", "speed-box", describeSettings);
 role("symbol").addEventListener("change", describeSettings);
 describeSettings();
 $('[data-cmd="run"]').addEventListener("click", () => link.send({ type: "run" }));
-role("sim-speed").addEventListener("change", (e) => {
-  const v = e.target.value;
-  link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });
-});
+addSpeed(role("sim-speed"), link);
 $('[data-cmd="stop"]').addEventListener("click", () => link.send({ type: "operate_stop" }));
 $('[data-cmd="trigger"]').addEventListener("click", () => {
   const symbol = role("symbol").value;

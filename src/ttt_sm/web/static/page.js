@@ -77,6 +77,19 @@ export function addDrive1Stop(after, link) {
   after.after(button);
 }
 
+// A speed list (x0.1 .. x10, or "max": as fast as it goes) sets the session's speed; drawSpeed follows the
+// session's, which another page may change (not while the list is being used).
+export function addSpeed(select, link) {
+  select.addEventListener("change", () => {
+    const v = select.value;
+    link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });
+  });
+}
+
+export function drawSpeed(select, speed) {
+  if (document.activeElement !== select) select.value = String(speed);
+}
+
 // A frame's `drive1` part: whether drive 1's stop is set (the toggle pressed) and its chart stopped.
 export function drawDrive1(d) {
   const button = role("drive1-stop");

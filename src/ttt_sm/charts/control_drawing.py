@@ -8,9 +8,8 @@ geometry (the field's lines, the X's and the O's points) is :mod:`.geometry`'s.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
-from ..runtime import does
+from ..runtime import ChartActions, does
 from .geometry import (
     O_START,
     arc_end,
@@ -27,13 +26,8 @@ from .geometry import (
     x_start,
 )
 
-if TYPE_CHECKING:  # to the type checker each mixin is the chart (its data, its helpers); at run time a plain
-    from ..runtime import TickChart as _Chart  # class whose methods Control inherits
-else:
-    _Chart = object
 
-
-class FieldDrawing(_Chart):
+class FieldDrawing(ChartActions):
     """``Drawing_playing_field``: 4 lines parallel to X and 4 parallel to Y (eq. 3.36)."""
 
     def _field_line(self, k: int) -> tuple[float, float, float, float]:
@@ -71,7 +65,7 @@ class FieldDrawing(_Chart):
         self.aim_travel()
 
 
-class XDrawing(_Chart):
+class XDrawing(ChartActions):
     """``Drawing_X`` in cell (row, column): two lines at 45 degrees (eqs. 3.37-3.44)."""
 
     @does("x_ini = x11 - (column-1)*L - (L-size)/2 (eq. 3.37); y_ini = y11 - (row-1)*L - (L-size)/2 (eq. 3.38);"
@@ -114,7 +108,7 @@ class XDrawing(_Chart):
         self.Y_out = on_x_line_2(self.X_out, self.h2)
 
 
-class ODrawing(_Chart):
+class ODrawing(ChartActions):
     """``Drawing_O`` in cell (row, column): four arcs, each a bit over a quarter (eqs. 3.45-3.51)."""
 
     @does("x0 = x11 - (column-1)*L - L/2 (eq. 3.45); y0 = y11 - (row-1)*L - L/2 (eq. 3.46);"
@@ -177,7 +171,7 @@ class ODrawing(_Chart):
             self.X_out = self.tx
 
 
-class SineDrawing(_Chart):
+class SineDrawing(ChartActions):
     """``Drawing_sine``: the sine wave of section 3.5.3 along the field's middle row."""
 
     @does("x0 = x11 - (cells*L - sine_length)/2; y0 = y11 - cells*L/2; aim(x0, y0, z_up)")

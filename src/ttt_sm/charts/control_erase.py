@@ -7,18 +7,11 @@ its start pose.  Mixed into :class:`~.control.Control`, whose data these actions
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
-from ..runtime import does
+from ..runtime import ChartActions, does
 from .geometry import pass_ends, pass_x
 
-if TYPE_CHECKING:  # to the type checker each mixin is the chart (its data, its helpers); at run time a plain
-    from ..runtime import TickChart as _Chart  # class whose methods Control inherits
-else:
-    _Chart = object
 
-
-class Erasing(_Chart):
+class Erasing(ChartActions):
     """``Erase``: the sponge's passes over the field."""
 
     tick_period_s: float
@@ -87,7 +80,7 @@ class Erasing(_Chart):
         self.phi = max(self.phi - self.phi_rate * self.tick_period_s, 0.0)
 
 
-class Finishing(_Chart):
+class Finishing(ChartActions):
     """``finishing``: back to the start pose."""
 
     tick_period_s: float

@@ -9,17 +9,11 @@ in the chart's local data `tx`, `ty`, `tz`; the pen goes down and up at `z_speed
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
-from ..runtime import does
-
-if TYPE_CHECKING:  # to the type checker each mixin is the chart (its data, its helpers); at run time a plain
-    from ..runtime import TickChart as _Chart  # class whose methods Control inherits
-else:
-    _Chart = object
+from ..runtime import ChartActions, does
 
 
-class PenMoves(_Chart):
+class PenMoves(ChartActions):
     """``start_stop``'s actions (from the start pose to the waiting pose, waiting) and the shared pen moves."""
 
     # for the type checker: data an action updates from its own previous value, and the period

@@ -6,7 +6,7 @@ listeners (:class:`Trace`, :class:`Coverage`).  :mod:`.diagram` draws them.
 """
 
 from .action_text import does
-from .chart import TickChart, TickChartMeta
+from .chart import ChartActions, TickChart, TickChartMeta
 from .data import Data
 from .errors import (
     ChartDefinitionError,
@@ -32,6 +32,7 @@ __all__ = [
     "duration",
     "every",
     "EventDataError",
+    "ChartActions",
     "ChartStructure",
     "Data",
     "GraphvizMissingError",

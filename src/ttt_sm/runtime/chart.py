@@ -482,6 +482,15 @@ class TickChart(ChartClock, ChartData, Execution, StateChart, metaclass=TickChar
 
 
 
+if TYPE_CHECKING:  # to the type checker, a class of actions is the chart it is mixed into (its data, helpers)
+    ChartActions = TickChart
+else:
+    class ChartActions:
+        """Base of a class of a chart's actions kept in a module of their own and mixed into the chart class
+        (``class Control(PenMoves, XDrawing, ..., TickChart)``): at run time a plain class whose methods the
+        chart inherits; to a type checker the chart itself, so the actions read and write its data."""
+
+
 def _clock_of(seg: Seg) -> str:
     """The state whose clock a segment's temporal guards read (the chart's own at the top level)."""
     return seg.clock.id if seg.clock is not None else _CHART_CLOCK

@@ -23,7 +23,6 @@ from ttt_sm.hardware.native import NativeFirmware, board_for
 from ttt_sm.params import load_params
 from ttt_sm.twin import layout
 from ttt_sm.twin.cascade import CascadeController
-from ttt_sm.twin.tuning import design_gains
 
 P = load_params()
 PEN_UP = 0.9
@@ -54,11 +53,6 @@ def c_frame(lib, kind: int, seq: int, body: bytes) -> bytes:
     out = (ctypes.c_uint8 * (L.MAX_ENCODED + 1))()
     n = lib.lib.ttt_frame_encode(kind, seq, _u8(body), len(body), out)
     return bytes(out[:n])
-
-
-@pytest.fixture(scope="module")
-def gains():
-    return design_gains(P)
 
 
 @pytest.fixture(params=["float", "double"])

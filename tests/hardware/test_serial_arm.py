@@ -25,18 +25,12 @@ from ttt_sm.params import load_params
 from ttt_sm.twin import layout
 from ttt_sm.twin.plant import REST_POSE
 from ttt_sm.twin.sim import ArmSim
-from ttt_sm.twin.tuning import design_gains
 
 P = load_params()
 #: Largest |encoder angle difference| (rad) between the arm behind the link and the in-process twin.
 #: The firmware computes in float32 and the setpoints cross the link as float32.  Measured: 8.4e-5,
 #: 3.9e-5, 5.2e-5 rad (4, 2 and 2 encoder counts) for drives 1, 2, 3.
 LINK_VS_TWIN_RAD = 3e-4
-
-
-@pytest.fixture(scope="module")
-def gains():
-    return design_gains(P)
 
 
 @pytest.fixture

@@ -130,6 +130,28 @@ def add_command(sub: Any, name: str, func: Command, help_: str) -> argparse.Argu
     return sp
 
 
+def add_group(sub: Any, name: str, help_: str) -> tuple[argparse.ArgumentParser, Any]:
+    """Add command group ``name`` (``ttt-sm NAME ACTION ...``): its parser and the subparsers of its actions.
+
+    The action chosen is in ``args.NAME_command``.
+    """
+    sp: argparse.ArgumentParser = sub.add_parser(name, help=help_, description=help_)
+    return sp, sp.add_subparsers(dest=f"{name}_command", required=True)
+
+
+def save_png(fig: Any, path: str) -> None:
+    """A matplotlib figure laid out, saved whole or not at all as a PNG (docs/reliability.md), then closed."""
+    import matplotlib.pyplot as plt
+
+    from ..files import save_figure
+
+    fig.tight_layout()
+    try:
+        save_figure(fig, path, dpi=90, format="png")
+    finally:
+        plt.close(fig)
+
+
 #: A value that starts with a minus and a digit: a negative number, or a list of numbers.
 _NEGATIVE_VALUE = re.compile(r"^-\.?\d")
 

@@ -239,26 +239,21 @@ class _Parser:
         return operands[0] if not ops else ("compare", tuple(ops), tuple(operands))
 
     def parse_sum(self) -> Node:
-        node = self.parse_product()
-        levels = 0  # a chain a + b + c nests to the left: each operator is a level of the tree
-        while self.tok.kind == "op" and self.tok.text in ("+", "-"):
-            op = self.tok.text
-            self.pos += 1
-            self.deeper()
-            levels += 1
-            node = ("arith", op, node, self.parse_product())
-        self.depth -= levels
-        return node
+        return self.parse_arith(("+", "-"), self.parse_product)
 
     def parse_product(self) -> Node:
-        node = self.parse_unary()
-        levels = 0
-        while self.tok.kind == "op" and self.tok.text in ("*", "/"):
+        return self.parse_arith(("*", "/"), self.parse_unary)
+
+    def parse_arith(self, ops: tuple[str, str], operand: Callable[[], Node]) -> Node:
+        """A chain of `operand` joined by `ops` (one precedence level), nested to the left."""
+        node = operand()
+        levels = 0  # a chain a + b + c nests to the left: each operator is a level of the tree
+        while self.tok.kind == "op" and self.tok.text in ops:
             op = self.tok.text
             self.pos += 1
             self.deeper()
             levels += 1
-            node = ("arith", op, node, self.parse_unary())
+            node = ("arith", op, node, operand())
         self.depth -= levels
         return node
 

@@ -154,6 +154,19 @@ class FirmwareLibrary:
             fn.argtypes = argtypes
 
 
+class _StructView:
+    """A read-only attribute: a numpy view of one block of the ctypes struct ``self.c``."""
+
+    def __init__(self, block: str) -> None:
+        self.block = block
+
+    def __get__(self, obj: Any, owner: type | None = None) -> np.ndarray:
+        return np.ctypeslib.as_array(getattr(obj.c, self.block))
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        raise AttributeError(f"{self.block} is a view of the C struct: assign into it ([:] = ...)")
+
+
 class NativeCascade:
     """The C cascade controller with the PC controller's parameters (the gains download).
 
@@ -179,29 +192,8 @@ class NativeCascade:
         self._q = (lib.real * 4)()
 
     # numpy views of the struct's blocks (the firmware's own number type)
-    @property
-    def cp(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cp)
-
-    @property
-    def cg(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cg)
-
-    @property
-    def cs(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cs)
-
-    @property
-    def cgs(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cgs)
-
-    @property
-    def act(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.act)
-
-    @property
-    def modes(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cm)
+    cp, cg, cs = _StructView("cp"), _StructView("cg"), _StructView("cs")
+    cgs, act, modes = _StructView("cgs"), _StructView("act"), _StructView("cm")
 
     def step(self, counts: Sequence[int] | np.ndarray) -> None:
         """One control step: encoder `counts` (3 integers) in, :attr:`act` out."""

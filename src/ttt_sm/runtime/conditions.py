@@ -216,12 +216,7 @@ class _Parser:
         return items[0] if len(items) == 1 else ("and", tuple(items))
 
     def parse_not(self) -> Node:
-        if self.take("not"):
-            self.deeper()
-            node = ("not", self.parse_not())
-            self.depth -= 1
-            return node
-        return self.parse_compare()
+        return self.parse_prefix("not", "not", self.parse_compare)
 
     def parse_compare(self) -> Node:
         refs0, units0 = len(self.refs), len(self.units)
@@ -258,12 +253,16 @@ class _Parser:
         return node
 
     def parse_unary(self) -> Node:
-        if self.take("-"):
-            self.deeper()
-            node = ("neg", self.parse_unary())
-            self.depth -= 1
-            return node
-        return self.parse_atom()
+        return self.parse_prefix("-", "neg", self.parse_atom)
+
+    def parse_prefix(self, token: str, node_kind: str, operand: Callable[[], Node]) -> Node:
+        """`operand` after any number of prefix `token` (``not not a``), each a ``node_kind`` node."""
+        if not self.take(token):
+            return operand()
+        self.deeper()
+        node = (node_kind, self.parse_prefix(token, node_kind, operand))
+        self.depth -= 1
+        return node
 
     def parse_atom(self) -> Node:
         tok = self.tok

@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from ..files import RecordBusyError, refuse_if_busy
+from ..files import RecordBusyError, refuse_if_busy, save_figure
 from ..runtime.jsonable import dumps
 
 Command = Callable[[argparse.Namespace], int]
@@ -142,8 +142,6 @@ def add_group(sub: Any, name: str, help_: str) -> tuple[argparse.ArgumentParser,
 def save_png(fig: Any, path: str) -> None:
     """A matplotlib figure laid out, saved whole or not at all as a PNG (docs/reliability.md), then closed."""
     import matplotlib.pyplot as plt
-
-    from ..files import save_figure
 
     fig.tight_layout()
     try:

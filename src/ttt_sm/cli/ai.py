@@ -13,7 +13,7 @@ import argparse
 import time
 from typing import Any
 
-from .common import CliError, print_json
+from .common import CliError, add_group, print_json
 
 ENGINES = ("strong", "thesis")
 
@@ -21,8 +21,7 @@ ENGINES = ("strong", "thesis")
 def register(sub: Any) -> argparse.ArgumentParser:
     """Add ``ai`` (with its ``move`` action) to the subcommands of ``ttt-sm``."""
     help_ = "the tic-tac-toe engines: ask one for its move (thesis 3.6.2)"
-    sp: argparse.ArgumentParser = sub.add_parser("ai", help=help_, description=help_)
-    actions = sp.add_subparsers(dest="ai_command", required=True)
+    sp, actions = add_group(sub, "ai", help_)
     mv = actions.add_parser("move", help="the engine's next cell on a board",
                             description="Print the engine's next cell on BOARD, or that the game is over.")
     mv.add_argument("--board", required=True, metavar="BOARD",

@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from .common import print_json, seed
+from .common import add_group, print_json, seed
 
 DEFAULT_LINK = str(Path(tempfile.gettempdir()) / "ttt-sm-arm")
 """Where ``serve`` puts its stable link by default."""
@@ -26,8 +26,7 @@ DEFAULT_LINK = str(Path(tempfile.gettempdir()) / "ttt-sm-arm")
 def register(sub: Any) -> argparse.ArgumentParser:
     """Add the ``arm`` command to the subcommands of ``ttt-sm``."""
     help_ = "the real arm's side: emulate its firmware (the C that is flashed) on a pseudo-terminal"
-    sp: argparse.ArgumentParser = sub.add_parser("arm", help=help_, description=help_)
-    actions = sp.add_subparsers(dest="arm_command", required=True)
+    sp, actions = add_group(sub, "arm", help_)
     serve = actions.add_parser(
         "serve", help="run the firmware on the twin's plant behind a pseudo-terminal until Ctrl-C",
         description="Emulate the arm: the C firmware coupled to the twin's plant, on a pseudo-terminal reachable"

@@ -26,7 +26,7 @@ from ..smartcam.emulator import CameraEmulator, Fault
 from ..smartcam.errors import SerialLinkError
 from ..smartcam.reader import ReconnectPolicy, SerialCameraReader
 from ..smartcam.sources import board_source
-from .common import print_json, seed
+from .common import add_group, print_json, seed
 
 DEFAULT_LINK = str(Path(tempfile.gettempdir()) / "ttt-sm-camera")
 """Where ``serve`` puts its stable link and ``read`` looks by default."""
@@ -39,8 +39,7 @@ _DEMO_FAULTS = (Fault.corrupt_checksum(), Fault.truncate(), Fault.out_of_range(c
 def register(sub: Any) -> argparse.ArgumentParser:
     """Add the ``camera`` command to the subcommands of ``ttt-sm`` (``build_parser``'s ``sub``)."""
     help_ = "the smart camera's serial link: emulate the camera on a pseudo-terminal, or read its frames"
-    sp: argparse.ArgumentParser = sub.add_parser("camera", help=help_, description=help_)
-    actions = sp.add_subparsers(dest="camera_command", required=True)
+    sp, actions = add_group(sub, "camera", help_)
 
     serve = actions.add_parser("serve", help="send frames on a pseudo-terminal until Ctrl-C",
                                description="Emulate the smart camera: frames of a fixed board on a"

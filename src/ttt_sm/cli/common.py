@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from ..files import RecordBusyError, refuse_if_busy
+from ..files import RecordBusyError, refuse_if_busy, save_figure
 from ..runtime.jsonable import dumps
 
 Command = Callable[[argparse.Namespace], int]
@@ -128,6 +128,26 @@ def add_command(sub: Any, name: str, func: Command, help_: str) -> argparse.Argu
     sp.add_argument("--json", action="store_true", help="print one JSON document")
     sp.add_argument("--seed", type=seed, default=0, help="seed of the simulated arm (default 0)")
     return sp
+
+
+def add_group(sub: Any, name: str, help_: str) -> tuple[argparse.ArgumentParser, Any]:
+    """Add command group ``name`` (``ttt-sm NAME ACTION ...``): its parser and the subparsers of its actions.
+
+    The action chosen is in ``args.NAME_command``.
+    """
+    sp: argparse.ArgumentParser = sub.add_parser(name, help=help_, description=help_)
+    return sp, sp.add_subparsers(dest=f"{name}_command", required=True)
+
+
+def save_png(fig: Any, path: str) -> None:
+    """A matplotlib figure laid out, saved whole or not at all as a PNG (docs/reliability.md), then closed."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    try:
+        save_figure(fig, path, dpi=90, format="png")
+    finally:
+        plt.close(fig)
 
 
 #: A value that starts with a minus and a digit: a negative number, or a list of numbers.

@@ -13,14 +13,14 @@ import argparse
 from collections.abc import Callable
 from typing import Any
 
+from .common import add_group, save_png
 from .kinematics_view import view_command
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
     """Add the ``kinematics`` command group to the subcommands of ``ttt-sm``."""
     help_ = "the kinematics lab: reachable workspace, DH table, IK methods raced (the /kinematics page)"
-    sp: argparse.ArgumentParser = sub.add_parser("kinematics", help=help_, description=help_)
-    acts = sp.add_subparsers(dest="kinematics_command", required=True)
+    sp, acts = add_group(sub, "kinematics", help_)
 
     ws = acts.add_parser("workspace", help="where the pen tip reaches within the joint limits, top and side view",
                          description="The pen tip's reachable set within the joint limits, the board and the"
@@ -146,7 +146,6 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch, Polygon, Rectangle
 
-    from ..files import save_figure
 
     if view == "workspace":
         fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 5.5))
@@ -237,8 +236,4 @@ def draw_png(view: str, data: dict[str, Any], path: str) -> None:
         ax2.set_ylabel("y (m)")
         ax2.set_title("pen tip per iteration, top view")
         ax2.legend(fontsize=7)
-    fig.tight_layout()
-    try:
-        save_figure(fig, path, dpi=90, format="png")  # whole or not at all (docs/reliability.md)
-    finally:
-        plt.close(fig)
+    save_png(fig, path)

@@ -11,6 +11,7 @@ import argparse
 from collections.abc import Callable
 from typing import Any
 
+from .common import save_png
 from .kinematics_view import view_command
 
 #: One colour per trajectory method, as the page draws them.
@@ -127,7 +128,6 @@ def draw_png(view: str, d: dict[str, Any], path: str) -> None:
     import numpy as np
     from matplotlib.patches import Ellipse, Rectangle
 
-    from ..files import save_figure
 
     if view == "trajectory":
         fig, axes = plt.subplots(2, 2, figsize=(12, 8))
@@ -204,8 +204,4 @@ def draw_png(view: str, d: dict[str, Any], path: str) -> None:
         ax_f.set_ylim(-1.0, 3.5)
         ax_f.legend(fontsize=7, loc="lower center")
         ax_f.grid(alpha=0.3)
-    fig.tight_layout()
-    try:
-        save_figure(fig, path, dpi=90, format="png")  # whole or not at all (docs/reliability.md)
-    finally:
-        plt.close(fig)
+    save_png(fig, path)

@@ -20,7 +20,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from .common import CliError, print_json, whole_number
+from .common import CliError, add_group, print_json, whole_number
 
 #: The commands that build a robot from the chosen slots.
 HONOURED = ("play", "gui", "draw", "demo", "debug", "scenario")
@@ -56,8 +56,7 @@ def chosen_charts(args: argparse.Namespace) -> Iterator[None]:
 def register(sub: Any) -> None:
     """Add the ``lab`` command to the subcommands of ``ttt-sm``."""
     help_ = "exercises: write one of the thesis' charts, check what it does (docs/lab.md)"
-    sp = sub.add_parser("lab", help=help_, description=help_)
-    actions = sp.add_subparsers(dest="lab_command", required=True)
+    sp, actions = add_group(sub, "lab", help_)
     ls = actions.add_parser("list", help="list the exercises")
     ls.add_argument("--json", action="store_true", help="print one JSON document")
     ls.set_defaults(func=cmd_lab_list)

@@ -34,14 +34,13 @@ from ..scenario.loader import load_scenario, scenario_files
 from ..scenario.model import Scenario, Step
 from ..scenario.runner import ScenarioResult
 from ..scenario.suite import RunReport, run_scenarios
-from .common import CliError, out_dir, print_json, trace_file
+from .common import CliError, add_group, out_dir, print_json, trace_file
 
 
 def register(sub: Any) -> None:
     """Add the ``scenario`` command to the subcommands of ``ttt-sm`` (``build_parser``'s ``sub``)."""
     help_ = "run scenario tests of event sequences (YAML files; see docs/scenarios.md)"
-    sp = sub.add_parser("scenario", help=help_, description=help_)
-    actions = sp.add_subparsers(dest="scenario_command", required=True)
+    sp, actions = add_group(sub, "scenario", help_)
 
     run = actions.add_parser("run", help="run scenario files", description="Run scenario files; exit"
                              " status 0 if all pass, 1 if one fails, 2 if a file cannot be loaded.")

@@ -30,14 +30,13 @@ import cv2
 
 from ..vision.errors import VisionError
 from ..vision.orientation import VIEW_NAMES, board_text, board_values, establish_orientation
-from .common import board_cells, print_json, seed
+from .common import add_group, board_cells, print_json, seed
 
 
 def register(sub: Any) -> argparse.ArgumentParser:
     """Add the ``vision`` command to the subcommands of ``ttt-sm`` (``build_parser``'s ``sub``)."""
     help_ = "read the board from a photo, make simulated camera photos (thesis 3.6.3; see docs/vision.md)"
-    sp: argparse.ArgumentParser = sub.add_parser("vision", help=help_, description=help_)
-    actions = sp.add_subparsers(dest="vision_command", required=True)
+    sp, actions = add_group(sub, "vision", help_)
 
     d = actions.add_parser("detect", help="locate the field in a photo and read its cells",
                            description="Locate the drawn field in a photo and read its 25 cells.")

@@ -14,35 +14,43 @@ from .rules import Board, Symbol, other
 from .solver import Solver
 
 
-class RandomEngine:
+class _SeededEngine:
+    """An engine whose choices come from a generator seeded by ``seed``.
+
+    :meth:`move` says why a finished game is over; a subclass fills in
+    :meth:`choose`, which is asked only while the game goes on.
+    """
+
+    def __init__(self, seed: int = 0) -> None:
+        self.rng = random.Random(seed)
+
+    def move(self, board: Board | str, symbol: Symbol) -> Move | GameOver:
+        """The engine's cell (:meth:`choose`), or why the game is over."""
+        b, me, over = prepare(board, symbol)
+        return over if over is not None else self.choose(b, me)
+
+    def choose(self, b: Board, me: Symbol) -> Move:
+        """The cell to play on a board where the game goes on, `me` to move."""
+        raise NotImplementedError
+
+
+class RandomEngine(_SeededEngine):
     """Plays a uniformly random empty cell."""
 
     name = "random"
 
-    def __init__(self, seed: int = 0) -> None:
-        self.rng = random.Random(seed)
-
-    def move(self, board: Board | str, symbol: Symbol) -> Move | GameOver:
-        """A random empty cell, or why the game is over."""
-        b, _, over = prepare(board, symbol)
-        if over is not None:
-            return over
+    def choose(self, b: Board, me: Symbol) -> Move:
+        """A random empty cell."""
         return Move(*cell_of(self.rng.choice(bits(b.empty_cells))))
 
 
-class GreedyEngine:
+class GreedyEngine(_SeededEngine):
     """Wins when it can, blocks when it must, else plays a random empty cell."""
 
     name = "greedy"
 
-    def __init__(self, seed: int = 0) -> None:
-        self.rng = random.Random(seed)
-
-    def move(self, board: Board | str, symbol: Symbol) -> Move | GameOver:
-        """A winning cell, else a blocking cell, else a random one; or why the game is over."""
-        b, me, over = prepare(board, symbol)
-        if over is not None:
-            return over
+    def choose(self, b: Board, me: Symbol) -> Move:
+        """A winning cell, else a blocking cell, else a random one."""
         mine, theirs = b.marks(me), b.marks(other(me))
         for cells in (win_cells(mine, theirs), win_cells(theirs, mine), b.empty_cells):
             if cells:
@@ -67,7 +75,7 @@ class RandomOpening:
         return self.engine.move(b, me)
 
 
-class PerfectEngine:
+class PerfectEngine(_SeededEngine):
     """Plays a random move among those that do not lose: a perfect but aimless player.
 
     A move loses if it leaves the other side a forced win: the opening book
@@ -77,15 +85,12 @@ class PerfectEngine:
     name = "perfect"
 
     def __init__(self, seed: int = 0, book: Book | None = None) -> None:
-        self.rng = random.Random(seed)
+        super().__init__(seed)
         self.book = load_book() if book is None else book
         self.solver = Solver()
 
-    def move(self, board: Board | str, symbol: Symbol) -> Move | GameOver:
+    def choose(self, b: Board, me: Symbol) -> Move:
         """A random cell after which the opponent cannot force a win (any cell if all lose)."""
-        b, me, over = prepare(board, symbol)
-        if over is not None:
-            return over
         mine, theirs = b.marks(me), b.marks(other(me))
         for cells in (win_cells(mine, theirs), win_cells(theirs, mine)):
             if cells:

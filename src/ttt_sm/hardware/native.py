@@ -154,6 +154,30 @@ class FirmwareLibrary:
             fn.argtypes = argtypes
 
 
+class _ReadOnly:
+    """A read-only attribute that reads `name` of the C side (a subclass says how)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+    def __set__(self, obj: Any, value: Any) -> None:
+        raise AttributeError(f"{self.name} is read from the C side; it cannot be set")
+
+
+class _StructView(_ReadOnly):
+    """A numpy view of block `name` of the ctypes struct ``self.c``: assign into it (``[:] = ...``)."""
+
+    def __get__(self, obj: Any, owner: type | None = None) -> np.ndarray:
+        return np.ctypeslib.as_array(getattr(obj.c, self.name))
+
+
+class _FirmwareCount(_ReadOnly):
+    """What the firmware's getter `name` returns for ``self.ptr``: a count or a state number."""
+
+    def __get__(self, obj: Any, owner: type | None = None) -> int:
+        return int(getattr(obj.lib.lib, self.name)(obj.ptr))
+
+
 class NativeCascade:
     """The C cascade controller with the PC controller's parameters (the gains download).
 
@@ -179,29 +203,8 @@ class NativeCascade:
         self._q = (lib.real * 4)()
 
     # numpy views of the struct's blocks (the firmware's own number type)
-    @property
-    def cp(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cp)
-
-    @property
-    def cg(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cg)
-
-    @property
-    def cs(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cs)
-
-    @property
-    def cgs(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cgs)
-
-    @property
-    def act(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.act)
-
-    @property
-    def modes(self) -> np.ndarray:
-        return np.ctypeslib.as_array(self.c.cm)
+    cp, cg, cs = _StructView("cp"), _StructView("cg"), _StructView("cs")
+    cgs, act, modes = _StructView("cgs"), _StructView("act"), _StructView("cm")
 
     def step(self, counts: Sequence[int] | np.ndarray) -> None:
         """One control step: encoder `counts` (3 integers) in, :attr:`act` out."""
@@ -279,31 +282,14 @@ class NativeFirmware:
     def act(self) -> np.ndarray:
         return np.ctypeslib.as_array(self.cascade.act)
 
-    @property
-    def state(self) -> int:
-        return int(self.lib.lib.ttt_fw_state(self.ptr))
-
-    @property
-    def frames_ok(self) -> int:
-        return int(self.lib.lib.ttt_fw_frames_ok(self.ptr))
-
-    @property
-    def lost(self) -> int:
-        return int(self.lib.lib.ttt_fw_lost(self.ptr))
-
-    @property
-    def steps(self) -> int:
-        return int(self.lib.lib.ttt_fw_step(self.ptr))
-
-    @property
-    def last_setpoint_step(self) -> int:
-        """The control step at which the last setpoints were accepted."""
-        return int(self.lib.lib.ttt_fw_last_setpoint_step(self.ptr))
-
-    @property
-    def setpoints_ok(self) -> int:
-        """SETPOINTS frames the firmware acted on."""
-        return int(self.lib.lib.ttt_fw_setpoints_ok(self.ptr))
+    state = _FirmwareCount("ttt_fw_state")
+    frames_ok = _FirmwareCount("ttt_fw_frames_ok")
+    lost = _FirmwareCount("ttt_fw_lost")
+    steps = _FirmwareCount("ttt_fw_step")
+    #: The control step at which the last setpoints were accepted.
+    last_setpoint_step = _FirmwareCount("ttt_fw_last_setpoint_step")
+    #: SETPOINTS frames the firmware acted on.
+    setpoints_ok = _FirmwareCount("ttt_fw_setpoints_ok")
 
     def rejections(self) -> dict[int, int]:
         """The firmware's rejection counters, by reason number (``TTT_REJ_*``)."""

@@ -216,12 +216,7 @@ class _Parser:
         return items[0] if len(items) == 1 else ("and", tuple(items))
 
     def parse_not(self) -> Node:
-        if self.take("not"):
-            self.deeper()
-            node = ("not", self.parse_not())
-            self.depth -= 1
-            return node
-        return self.parse_compare()
+        return self.parse_prefix("not", "not", self.parse_compare)
 
     def parse_compare(self) -> Node:
         refs0, units0 = len(self.refs), len(self.units)
@@ -239,36 +234,35 @@ class _Parser:
         return operands[0] if not ops else ("compare", tuple(ops), tuple(operands))
 
     def parse_sum(self) -> Node:
-        node = self.parse_product()
-        levels = 0  # a chain a + b + c nests to the left: each operator is a level of the tree
-        while self.tok.kind == "op" and self.tok.text in ("+", "-"):
-            op = self.tok.text
-            self.pos += 1
-            self.deeper()
-            levels += 1
-            node = ("arith", op, node, self.parse_product())
-        self.depth -= levels
-        return node
+        return self.parse_arith(("+", "-"), self.parse_product)
 
     def parse_product(self) -> Node:
-        node = self.parse_unary()
-        levels = 0
-        while self.tok.kind == "op" and self.tok.text in ("*", "/"):
+        return self.parse_arith(("*", "/"), self.parse_unary)
+
+    def parse_arith(self, ops: tuple[str, str], operand: Callable[[], Node]) -> Node:
+        """A chain of `operand` joined by `ops` (one precedence level), nested to the left."""
+        node = operand()
+        levels = 0  # a chain a + b + c nests to the left: each operator is a level of the tree
+        while self.tok.kind == "op" and self.tok.text in ops:
             op = self.tok.text
             self.pos += 1
             self.deeper()
             levels += 1
-            node = ("arith", op, node, self.parse_unary())
+            node = ("arith", op, node, operand())
         self.depth -= levels
         return node
 
     def parse_unary(self) -> Node:
-        if self.take("-"):
-            self.deeper()
-            node = ("neg", self.parse_unary())
-            self.depth -= 1
-            return node
-        return self.parse_atom()
+        return self.parse_prefix("-", "neg", self.parse_atom)
+
+    def parse_prefix(self, token: str, node_kind: str, operand: Callable[[], Node]) -> Node:
+        """`operand` after any number of prefix `token` (``not not a``), each a ``node_kind`` node."""
+        if not self.take(token):
+            return operand()
+        self.deeper()
+        node = (node_kind, self.parse_prefix(token, node_kind, operand))
+        self.depth -= 1
+        return node
 
     def parse_atom(self) -> Node:
         tok = self.tok

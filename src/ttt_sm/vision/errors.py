@@ -7,6 +7,7 @@ All are ``ValueError`` subclasses through :class:`VisionError`, so a caller
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import ClassVar
 
 Cell = tuple[int, int]
 
@@ -53,48 +54,47 @@ class MoveError(VisionError):
         self.message_for_person = message_for_person
 
 
-class TooManyMovesError(MoveError):
+class _CellsMoveError(MoveError):
+    """A :class:`MoveError` about the cells it is given: a subclass declares its two sentences.
+
+    ``what`` (the message) and ``advice`` (:attr:`MoveError.message_for_person`)
+    are format strings of ``{n}``, how many cells, and ``{cells}``, them.
+    """
+
+    what: ClassVar[str]
+    advice: ClassVar[str]
+
+    def __init__(self, cells: Iterable[Cell]) -> None:
+        cells = tuple(cells)
+        named = {"n": len(cells), "cells": _cells_text(cells)}
+        super().__init__(self.what.format(**named), cells, self.advice.format(**named))
+
+
+class TooManyMovesError(_CellsMoveError):
     """Two or more new symbols appeared at once: only one move per turn."""
 
-    def __init__(self, cells: Iterable[Cell]) -> None:
-        cells = tuple(cells)
-        super().__init__(
-            f"{len(cells)} new symbols at once in cells {_cells_text(cells)}; one move per turn",
-            cells,
-            f"I see {len(cells)} new symbols ({_cells_text(cells)}). Please draw only one per turn"
-            " and wipe the others.")
+    what = "{n} new symbols at once in cells {cells}; one move per turn"
+    advice = "I see {n} new symbols ({cells}). Please draw only one per turn and wipe the others."
 
 
-class RobotCellMarkedError(MoveError):
+class RobotCellMarkedError(_CellsMoveError):
     """The person drew into a cell the robot already occupies."""
 
-    def __init__(self, cells: Iterable[Cell]) -> None:
-        cells = tuple(cells)
-        super().__init__(
-            f"new ink in the robot's cell(s) {_cells_text(cells)}",
-            cells,
-            f"Cell {_cells_text(cells)} is already mine. Please wipe your mark there and draw in an empty cell.")
+    what = "new ink in the robot's cell(s) {cells}"
+    advice = "Cell {cells} is already mine. Please wipe your mark there and draw in an empty cell."
 
 
-class SymbolVanishedError(MoveError):
+class SymbolVanishedError(_CellsMoveError):
     """A symbol that was on the board (the robot's or the person's) is gone."""
 
-    def __init__(self, cells: Iterable[Cell]) -> None:
-        cells = tuple(cells)
-        super().__init__(
-            f"symbol(s) disappeared from cell(s) {_cells_text(cells)}",
-            cells,
-            f"The symbol in {_cells_text(cells)} has disappeared. Please redraw it (or restart the game).")
+    what = "symbol(s) disappeared from cell(s) {cells}"
+    advice = "The symbol in {cells} has disappeared. Please redraw it (or restart the game)."
 
 
-class PictureTurnedError(MoveError, OrientationError):
+class PictureTurnedError(_CellsMoveError, OrientationError):
     """The symbols on the board are where a turned or mirrored camera picture would put them."""
 
-    def __init__(self, cells: Iterable[Cell]) -> None:
-        cells = tuple(cells)
-        super().__init__(
-            f"the marks of cells {_cells_text(cells)} are seen where a turned or mirrored camera picture would"
-            " put them; the camera's picture is turned or mirrored",
-            cells,
-            "My marks appear where a turned or mirrored camera picture would put them. Please fix the camera"
-            " (its mounting or its mirror setting), then play on.")
+    what = ("the marks of cells {cells} are seen where a turned or mirrored camera picture would put them;"
+            " the camera's picture is turned or mirrored")
+    advice = ("My marks appear where a turned or mirrored camera picture would put them. Please fix the camera"
+              " (its mounting or its mirror setting), then play on.")

@@ -20,8 +20,10 @@ with the ``interrupted`` event; every game is bounded in simulated time
 Beside the session: who plays against the robot (:mod:`.person`), the engine
 chosen by name (:mod:`.engines`), how a game ends (:mod:`.game_outcome`), and
 the game inside the chart steps, its stages and driver (:mod:`.game_stages`).
-Mixed into the session: the GUI person's clicks (:mod:`.game_gui`) and the
-record's events, the board pictures and the report (:mod:`.game_report`).
+Mixed into the session: the GUI person's clicks (:mod:`.game_gui`), the
+camera's photos and how far the game trusts them while the picture may be
+mirrored or turned (:mod:`.game_orientation`), and the record's events, the
+board pictures and the report (:mod:`.game_report`).
 """
 from __future__ import annotations
 

@@ -231,7 +231,8 @@ def test_a_mirrored_camera_is_refused_right_after_the_robot_draws_off_the_mirror
 
     The game photographs the board after each robot move: a mark off column 3 (the mirror's axis) seen in the
     mirrored cell ends the game naming the mirror.  The person's moves read before it cannot be checked by any
-    photo (docs/vision.md, "What a single photo can tell")."""
+    photo (docs/vision.md, "What a single photo can tell"): none is taken as a fact (each is recorded unconfirmed,
+    the mirror still open) and every robot move is a cell empty read either way."""
     from ttt_sm.vision.simulated import SimulatedCamera
 
     frame = SimulatedCamera.frame
@@ -248,3 +249,10 @@ def test_a_mirrored_camera_is_refused_right_after_the_robot_draws_off_the_mirror
     last_robot = len(kinds) - 1 - kinds[::-1].index("robot_move")
     assert "person_drew" not in kinds[last_robot:]
     assert robot_cells[-1][1] != 3 and all(c == 3 for _, c in robot_cells[:-1])
+    detected = [e for e in events if e["event"] == "detected"]
+    assert detected and all(e["confirmed"] is False and e["open"] == ["mirrored left-right"] for e in detected)
+    drawn = {(e["row"], e["column"]) for e in events if e["event"] == "person_drew"}
+    read = {(e["row"], e["column"]) for e in detected}
+    assert drawn != read  # the person's moves were read mirrored ...
+    assert not set(robot_cells) & (drawn | read)  # ... and the robot played only cells empty under both readings
+    assert "moves_confirmed" not in kinds

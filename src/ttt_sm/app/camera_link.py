@@ -123,7 +123,7 @@ class CameraLink:
             d: Detection = detect(self.last_photo)
             # a camera turned on its stand would put every symbol in the wrong cell: its perspective says so
             # (OrientationError, never read); a mirror keeps the perspective, the robot's marks tell it
-            # (percent_process, in the game)
+            # (app.game_orientation, in the game)
             check_orientation(d.grid, self.view, "the camera's photo")
             return tuple(board_values(list(d.percentages), self.view)), board_text(d.cells, self.view)
         # Frames photographed before now may still wait in the port: only a

@@ -20,13 +20,14 @@ with the ``interrupted`` event; every game is bounded in simulated time
 Beside the session: who plays against the robot (:mod:`.person`), the engine
 chosen by name (:mod:`.engines`), how a game ends (:mod:`.game_outcome`), and
 the game inside the chart steps, its stages and driver (:mod:`.game_stages`).
-Mixed into the session: the GUI person's clicks (:mod:`.game_gui`) and the
-record's events, the board pictures and the report (:mod:`.game_report`).
+Mixed into the session: the GUI person's clicks (:mod:`.game_gui`), the
+camera's photos and how far the game trusts them while the picture may be
+mirrored or turned (:mod:`.game_orientation`), and the record's events, the
+board pictures and the report (:mod:`.game_report`).
 """
 from __future__ import annotations
 
 import gc
-import math
 import time
 from collections.abc import Callable, Generator, Sequence
 from pathlib import Path
@@ -39,12 +40,13 @@ from ..params import ArmParams
 from ..runtime.listeners import Trace
 from ..runtime.recordfile import interruption
 from ..twin.truth import GroundTruth
-from ..vision import MoveError, OrientationError, percent_process
+from ..vision import MoveError, percent_process
 from ..vision.percent import check_own_marks
-from .camera_link import CameraLink, CameraLost
+from .camera_link import CameraLink
 from .engines import engine_for
 from .game_gui import GuiInputs
-from .game_outcome import GameError, GameInterrupted, outcome_in_words, result_of, winning_cells
+from .game_orientation import GameCamera, OpenWays
+from .game_outcome import GameError, GameInterrupted, outcome_in_words, winning_cells
 from .game_record import GameRecord
 from .game_report import GameReporting
 from .game_stages import Flow, GameDriver, GameStage, PenPathStage, Wait
@@ -55,12 +57,9 @@ from .wires import GAME_WIRES
 #: Longest a game may run, in simulated seconds, unless told otherwise: a whole game of 25 moves
 #: takes about 450 s (a usual one about 190 s), so only a game that is stuck reaches it.
 DEFAULT_TIME_LIMIT_S = 1200.0
-#: Longest the game waits, once the camera is lost, for the Safety chart to lift the pen and hold, s of simulated
-#: time (its lift gives up after 2 s).
-CAMERA_LIFT_S = 3.0
 
 
-class GameSession(GuiInputs, GameReporting):
+class GameSession(GuiInputs, GameReporting, GameCamera):
     """One game on the simulated robot.
 
     ``q_start`` and ``settle_s`` are the :class:`Robot`'s: the pose before the
@@ -102,6 +101,10 @@ class GameSession(GuiInputs, GameReporting):
         self.engine_name = engine
         self.engine = engine_for(engine)
         self.camera = CameraLink(params, self.robot.board, seed=seed, mode=camera)
+        #: The ways the camera's picture may have been turned or mirrored that the photos so far allow.
+        self.ways = OpenWays(camera, self.camera.view)
+        #: The person's moves detected while other ways than the photo as it is remained: not yet facts.
+        self.unconfirmed: list[Cell] = []
         self.board = "." * 25  # what the robot believes: its moves and the person's detected moves
         self.truth = "." * 25  # what is really drawn (the simulated person's hand is known)
         self.robot_cells: list[Cell] = []
@@ -167,10 +170,10 @@ class GameSession(GuiInputs, GameReporting):
 
     def robot_turn_now(self) -> None:
         """Ask the engine for a move and tell the Control chart to draw it."""
-        if result_of(self.board) is not None:
+        if self._result() is not None:
             return
         t0 = time.perf_counter()
-        row, column = self.engine(self.board, self.robot_symbol)
+        row, column = self.ways.robot_move(self._readings(), self.engine, self.robot_symbol)
         ms = (time.perf_counter() - t0) * 1e3
         c = self.robot.control
         c.row, c.column, c.symbol = row, column, 1 if self.robot_symbol == "X" else 0
@@ -272,46 +275,6 @@ class GameSession(GuiInputs, GameReporting):
         i = cell_index(*cell)
         self.board = self.board[:i] + symbol + self.board[i + 1:]
 
-    def _look(self) -> tuple[tuple[float, ...], str | None]:
-        try:
-            view = self.camera.read()
-        except CameraLost as exc:
-            raise self._camera_lost(exc) from None
-        except OrientationError as exc:  # a turned camera: the photo is refused, never read as a board
-            self.detections_wrong += 1
-            self.person.tell(str(exc))
-            self._event("detection_rejected", message=str(exc))
-            raise GameError(f"the camera's view was refused: {exc}") from None
-        self.robot.camera_status.ok = True  # the Camera block: it answers
-        self.last_view = view
-        self.photos += 1
-        return view
-
-    def _refused(self, exc: MoveError) -> GameError:
-        """The camera's view cannot be taken: the person is told why, the record says so, the game ends."""
-        self.detections_wrong += 1
-        message = getattr(exc, "message_for_person", str(exc))
-        self.person.tell(message)
-        self._event("detection_rejected", message=message)
-        return GameError(f"the camera's view was refused: {message}")
-
-    def _camera_lost(self, exc: CameraLost) -> GameError:
-        """The camera stopped answering while the game waited for a photo: the Safety chart's Camera block.
-
-        The Safety chart lifts the pen off the board and holds (docs/safety.md).
-        Played by :meth:`play`, the chart steps are this thread's: they run
-        until the chart holds (at most :data:`CAMERA_LIFT_S`), and the game
-        ends with the chart's reason; driven from the chart steps (the GUI), the
-        game ends now and the chart lifts in the steps that follow.
-        """
-        robot = self.robot
-        robot.camera_status.ok = False
-        self._event("camera_lost", message=str(exc))
-        if self.driver is None:
-            # held or stopped: tripped, and no lift under way (the chart's outputs, not its state names)
-            robot.run_until(lambda: robot.tripped and math.isnan(robot.safety.lift_z), CAMERA_LIFT_S)
-        return GameError(f"safety stop: {robot.safety.reason}" if robot.tripped else f"camera lost: {exc}")
-
     def play(self, max_moves: int = 25) -> dict[str, Any]:
         """Play one game to its end (or until the person gives up); return the report."""
         if self.driver is not None:
@@ -368,15 +331,16 @@ class GameSession(GuiInputs, GameReporting):
         self._event("field_drawn")
         # Each turn adds one move; a GUI's person's turn may end without one (the symbols
         # changed before the first move, or Stop): X moves when the number of moves is even.
-        while result_of(self.board) is None and len(self.moves) < max_moves and not self._stopped():
+        while self._result() is None and len(self.moves) < max_moves and not self._stopped():
             to_move = "X" if len(self.moves) % 2 == 0 else "O"
             if to_move == self.person_symbol:
                 if not (yield from self._person_turn()):
                     break
             else:
                 yield from self._robot_turn()
-        stopped = self._stopped() and result_of(self.board) is None
-        outcome = result_of(self.board) or ("given_up" if self._given_up else "halted" if stopped else "abandoned")
+        result = self._result()
+        stopped = self._stopped() and result is None
+        outcome = result or ("given_up" if self._given_up else "halted" if stopped else "abandoned")
         self.outcome = outcome
         self.result_code = {self.robot_symbol: 1, self.person_symbol: 2, "draw": 3, "given_up": 4}.get(outcome, 3)
         self._event("result", outcome=outcome)
@@ -436,16 +400,20 @@ class GameSession(GuiInputs, GameReporting):
         ok = seen.new == cell
         self.detections_correct += ok
         self.detections_wrong += not ok
+        # while the photo may be mirrored or turned, the move read is not a fact (docs/vision.md)
+        pending = {"confirmed": False, "open": self.ways.open} if self.ways.open and seen.new else {}
         self._event("detected", row=seen.new[0] if seen.new else None,
-                        column=seen.new[1] if seen.new else None, correct=ok,
-                        percentages=[round(p, 1) for p in percentages])
+                    column=seen.new[1] if seen.new else None, correct=ok,
+                    percentages=[round(p, 1) for p in percentages], **pending)
         if seen.new is not None:
+            if pending:
+                self.unconfirmed.append(seen.new)
             self.person_cells.append(seen.new)
             self._set_board(seen.new, self.person_symbol)
             self.o_pos |= 1 << cell_index(*seen.new)
         self.moves.append({"by": "person", "symbol": self.person_symbol, "row": cell[0], "column": cell[1],
                            "t": round(robot.t, 3), "detected": list(seen.new) if seen.new else None})
-        if result_of(self.board) is None:
+        if self._result() is None:
             self._click_play()  # the person's Play click: the robot's turn
         return True
 
@@ -482,6 +450,7 @@ class GameSession(GuiInputs, GameReporting):
             check_own_marks(percentages, self.robot_cells)
         except MoveError as exc:
             raise self._refused(exc) from exc
+        self._narrow(percentages, cell)
         self.robot_ink[cell] = percentages[cell_index(*cell)]
         self.moves.append({"by": "robot", "symbol": self.robot_symbol, "row": cell[0], "column": cell[1],
                            "t": round(robot.t, 3)})

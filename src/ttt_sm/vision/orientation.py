@@ -259,6 +259,23 @@ def check_robot_marks(cells: str, view: str, robot_marks: str, what: str = "phot
 
 
 AS_IS = "as it is"
+#: The eight ways a photo of the square field may have been changed: as it is and :data:`CHANGES`.
+WAYS: dict[str, Callable[[int, int], tuple[int, int]]] = {AS_IS: lambda r, c: (r, c), **CHANGES}
+
+
+def ways_perspective_allows(view: str) -> list[str]:
+    """The ways (:data:`WAYS`) a photo in `view` may have been changed that its perspective cannot tell
+    from the photo as it is: two (as it is and the mirror along the camera's axis) in a view with
+    perspective, all eight in one without."""
+    _check(view)
+    near = NEAR_SIDE[view]
+    return [n for n, ch in WAYS.items() if near is None or _side_after(ch, near) == near]
+
+
+def undo_way(board: str, way: str, view: str) -> str:
+    """25 board-order characters as read from a photo `way` changed: the board the photo shows once the
+    change is undone (``way`` a name of :data:`WAYS`)."""
+    return board_text(_undo(image_text(board, view), WAYS[way]), view)
 
 
 def _side_after(change: Callable[[int, int], tuple[int, int]], side: str) -> str:
@@ -322,7 +339,7 @@ def establish_orientation(grid: object, cells: str, view: str, robot_marks: str 
         raise VisionError(f"{what}: expected 25 detected cells, got {len(cells)}")
     if robot_marks is not None and (len(robot_marks) != N * N or set(robot_marks) - {"X", "O", EMPTY}):
         raise VisionError(f"{what}: expected 25 robot marks ('X', 'O' or '.')")
-    ways: dict[str, Callable[[int, int], tuple[int, int]]] = {AS_IS: lambda r, c: (r, c), **CHANGES}
+    ways = dict(WAYS)
     near = NEAR_SIDE[view]
     evidence = []
     if near is not None:

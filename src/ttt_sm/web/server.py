@@ -49,7 +49,7 @@ from urllib.parse import urlsplit
 
 from starlette.applications import Starlette
 from starlette.requests import HTTPConnection, Request
-from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response, StreamingResponse
+from starlette.responses import JSONResponse, PlainTextResponse, Response, StreamingResponse
 from starlette.routing import Mount, Route, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.types import ASGIApp, Receive, Scope, Send
@@ -65,6 +65,7 @@ from .game import photo_png
 from .kinematics import routes as kinematics_routes
 from .kinematics_motion import routes as kinematics_motion_routes
 from .lab_watch import LabWatch
+from .page_heads import page
 from .protocol import MAX_MESSAGE_BYTES, ProtocolError, parse_command
 from .session import Session
 
@@ -164,12 +165,6 @@ def create_app(session: Session, *, token: str | None = None, hosts: Iterable[st
     diagrams = Diagrams(session.chart_classes)
     if lab is not None:
         lab.attach(session, diagrams)
-    files = resources.files("ttt_sm.web") / "static"
-
-    def page(name: str) -> Response:
-        return HTMLResponse((files / name).read_text(encoding="utf-8"),
-                            headers={"Cache-Control": "no-store", "X-Content-Type-Options": "nosniff",
-                                     "Referrer-Policy": "no-referrer"})
 
     async def index(request: Request) -> Response:
         return page("index.html")

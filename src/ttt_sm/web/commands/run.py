@@ -10,7 +10,7 @@ from ..fields import MAX_COUNT, integer, number, optional, speed
 from .spec import Cockpit, Reply, command
 
 #: The wall time one command may hold the simulation thread (the session pauses it after that;
-#: ``ttt_sm.web.session.COMMAND_BUDGET_S`` is the same number).
+#: ``ttt_sm.web.session_thread.COMMAND_BUDGET_S`` is the same number).
 COMMAND_BUDGET_S = 1.0
 
 

@@ -27,12 +27,9 @@ export class ArmViews {
     this.host = host;
     this.scene = scene;
     this.views = {};
-    this.inkKey = null;
-    this.inkBusy = false;
-    this.inkUrl = null;
-    this.inkAgain = false;
     host.innerHTML = "";
     for (const name of ["side", "top"]) this.views[name] = this.build(name);
+    this.ink = new InkPicture(this.views.top.ink);
     this.note = document.createElement("p");
     this.note.className = "arm-note";
     this.note.dataset.role = "arm-note";
@@ -122,35 +119,52 @@ export class ArmViews {
         part.dataset.touching = arm.touching === tool ? "true" : "false";
       }
     }
-    const key = arm.ink.join(":");
-    if (key !== this.inkKey) {
-      this.inkKey = key;
-      this.refreshInk();
-    }
+    this.ink.show(arm.ink);
   }
 
   // A full frame (a page that joins, a replay): the ink is fetched again whatever its key.
-  resync() { this.inkKey = null; }
+  resync() { this.ink.resync(); }
+}
 
-  // Fetch the ink picture; one request at a time, the latest key wins.
-  async refreshInk() {
-    if (this.inkBusy) { this.inkAgain = true; return; }
-    this.inkBusy = true;
-    const key = this.inkKey;
+// The whiteboard's ink seen from above (/api/arm/ink.png) in an SVG <image>: fetched again when a frame's
+// ink key changes; one request at a time, the latest key wins.
+export class InkPicture {
+  constructor(image) {
+    this.image = image;
+    this.key = null;
+    this.busy = false;
+    this.again = false;
+    this.url = null;
+  }
+
+  // A frame's arm.ink: the picture is fetched when it is not the one shown.
+  show(ink) {
+    const key = ink.join(":");
+    if (key === this.key) return;
+    this.key = key;
+    this.load();
+  }
+
+  resync() { this.key = null; }
+
+  async load() {
+    if (this.busy) { this.again = true; return; }
+    this.busy = true;
+    const key = this.key;
     try {
       const response = await fetch(`/api/arm/ink.png?k=${encodeURIComponent(key)}`, { cache: "no-store" });
       if (response.ok) {
         const url = URL.createObjectURL(await response.blob());
-        this.views.top.ink.setAttribute("href", url);
-        this.views.top.ink.dataset.key = key;
-        if (this.inkUrl) URL.revokeObjectURL(this.inkUrl);
-        this.inkUrl = url;
+        this.image.setAttribute("href", url);
+        this.image.dataset.key = key;
+        if (this.url) URL.revokeObjectURL(this.url);
+        this.url = url;
       }
     } catch (e) {
       // the server went away: the next frame (if any) asks again
     } finally {
-      this.inkBusy = false;
-      if (this.inkAgain) { this.inkAgain = false; setTimeout(() => this.refreshInk(), 150); }
+      this.busy = false;
+      if (this.again) { this.again = false; setTimeout(() => this.load(), 150); }
     }
   }
 }

@@ -40,6 +40,25 @@ export function showsOther(el, value) {
   return true;
 }
 
+// Handle the submit of the form whose data-role is `name` here, as handle(form): the page stays.
+export function onSubmit(name, handle) {
+  role(name).addEventListener("submit", (e) => { e.preventDefault(); handle(e.target); });
+}
+
+// Draw list `name` again, an <li> from item(x) for each of `items` (when there are none: one <li class="none">
+// saying `none`, if given), unless it already shows them (showsOther).
+export function drawList(name, items, item, none) {
+  const list = role(name);
+  if (!showsOther(list, items)) return;
+  list.replaceChildren(...items.map(item));
+  if (!items.length && none) {
+    const li = document.createElement("li");
+    li.className = "none";
+    li.textContent = none;
+    list.append(li);
+  }
+}
+
 // Replace the options of a <select> by `options`, [value, text] pairs.
 export function fillSelect(select, options) {
   select.replaceChildren(...options.map(([value, text]) => new Option(text, value)));

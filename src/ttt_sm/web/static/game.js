@@ -13,44 +13,43 @@ import { SessionLink } from "./session.js";
 
 const state = { game: null, photos: -1, arm: null };
 
-function cellButtons() {
-  const board = role("board");
+// Fill `host` with the field's 5 rows (role="row", laid out by the host's grid), each of 5 cells made by
+// cell(row, column), both counted from 1.
+function fieldRows(host, cell) {
   for (let r = 1; r <= 5; r++) {
     const row = document.createElement("div");
     row.setAttribute("role", "row");
     row.style.display = "contents";
-    for (let c = 1; c <= 5; c++) {
-      const b = document.createElement("button");
-      b.type = "button";
-      b.setAttribute("role", "gridcell");
-      b.setAttribute("aria-label", `row ${r}, column ${c}`);
-      b.dataset.row = r;
-      b.dataset.column = c;
-      b.addEventListener("click", () => link.send({ type: "game_cell", row: r, column: c }));
-      row.appendChild(b);
-    }
-    board.appendChild(row);
+    for (let c = 1; c <= 5; c++) row.appendChild(cell(r, c));
+    host.appendChild(row);
   }
+}
+
+function cellButtons() {
+  fieldRows(role("board"), (r, c) => {
+    const b = document.createElement("button");
+    b.type = "button";
+    b.setAttribute("role", "gridcell");
+    b.setAttribute("aria-label", `row ${r}, column ${c}`);
+    b.dataset.row = r;
+    b.dataset.column = c;
+    b.addEventListener("click", () => link.send({ type: "game_cell", row: r, column: c }));
+    return b;
+  });
   makeReading(role("reading"));
   makeReading(role("feed-reading"));
 }
 
 // A 5x5 table of what a detector read: each cell's ink percentage and symbol.
 function makeReading(reading) {
-  for (let r = 1; r <= 5; r++) {
-    const row = document.createElement("div");
-    row.setAttribute("role", "row");
-    row.style.display = "contents";
-    for (let c = 1; c <= 5; c++) {
-      const cell = document.createElement("div");
-      cell.setAttribute("role", "cell");
-      cell.dataset.row = r;
-      cell.dataset.column = c;
-      cell.textContent = "–";
-      row.appendChild(cell);
-    }
-    reading.appendChild(row);
-  }
+  fieldRows(reading, (r, c) => {
+    const cell = document.createElement("div");
+    cell.setAttribute("role", "cell");
+    cell.dataset.row = r;
+    cell.dataset.column = c;
+    cell.textContent = "–";
+    return cell;
+  });
 }
 
 function drawReading(reading, percentages, read) {

@@ -7,6 +7,7 @@
 // graphs' samples, taken in simulated time by the session) are drawn.  The graphs
 // are plain canvases drawn here; their data live in a ring buffer of fixed size.
 
+import { InkPicture } from "./arm.js";
 import { $, role } from "./dom.js";
 import { addDrive1Stop, addSpeed, drawCommon, drawSpeed, pageHeader, sayReply as say } from "./page.js";
 import { SessionLink } from "./session.js";
@@ -252,7 +253,7 @@ function download(g) {
 // was drawn: it does not scroll away with the graphs' 20 s.
 
 const SVG = "http://www.w3.org/2000/svg";
-const xy = { svg: null, ink: null, tip: null, key: null, busy: false, again: false, url: null };
+const xy = { svg: null, ink: null, tip: null };
 
 function svgEl(name, attrs, parent) {
   const e = document.createElementNS(SVG, name);
@@ -282,8 +283,8 @@ function buildXY(scene) {
                              "aria-label": "what was drawn: the whiteboard's ink from above, X right, Y up, mm" },
                      fig);
   svgEl("rect", { x: bx0, y: -by1, width: bx1 - bx0, height: by1 - by0, class: "board" }, svg);
-  xy.ink = svgEl("image", { x: bx0, y: -by1, width: bx1 - bx0, height: by1 - by0, preserveAspectRatio: "none",
-                            "data-role": "xy-ink" }, svg);
+  xy.ink = new InkPicture(svgEl("image", { x: bx0, y: -by1, width: bx1 - bx0, height: by1 - by0,
+                                           preserveAspectRatio: "none", "data-role": "xy-ink" }, svg));
   const [fx0, fx1, fy0, fy1] = scene.field;
   const grid = svgEl("g", { class: "field" }, svg);
   for (let i = 0; i <= scene.cells; i++) {
@@ -308,11 +309,7 @@ function buildXY(scene) {
 
 function drawXY(arm) {
   if (!xy.svg || !arm) return;
-  const key = arm.ink.join(":");
-  if (key !== xy.key) {
-    xy.key = key;
-    refreshInk();
-  }
+  xy.ink.show(arm.ink);
 }
 
 function drawTip() {
@@ -322,28 +319,6 @@ function drawTip() {
   xy.tip.setAttribute("cx", x);
   xy.tip.setAttribute("cy", -y);
   xy.tip.setAttribute("visibility", "visible");
-}
-
-// One request at a time; the latest key wins.
-async function refreshInk() {
-  if (xy.busy) { xy.again = true; return; }
-  xy.busy = true;
-  const key = xy.key;
-  try {
-    const response = await fetch(`/api/arm/ink.png?k=${encodeURIComponent(key)}`, { cache: "no-store" });
-    if (response.ok) {
-      const url = URL.createObjectURL(await response.blob());
-      xy.ink.setAttribute("href", url);
-      xy.ink.dataset.key = key;
-      if (xy.url) URL.revokeObjectURL(xy.url);
-      xy.url = url;
-    }
-  } catch (e) {
-    // the server went away: the next frame (if any) asks again
-  } finally {
-    xy.busy = false;
-    if (xy.again) { xy.again = false; setTimeout(refreshInk, 150); }
-  }
 }
 
 // -- the controls ---------------------------------------------------------------------------
@@ -441,7 +416,7 @@ function drawFrame(f) {
   if (f.speed !== undefined) drawSpeed(role("sim-speed"), f.speed);
   if (f.operate) drawOperate(f.operate);
   if (f.plot) takePlot(f.plot);
-  if (f.full) xy.key = null;  // a page that joins, a replay: the ink is fetched again whatever its key
+  if (f.full && xy.ink) xy.ink.resync();  // a page that joins, a replay: the ink is fetched again whatever its key
   if ("arm" in f) drawXY(f.arm);
   if (f.error) say(f.error, true);
 }

@@ -77,9 +77,14 @@ export function addDrive1Stop(after, link) {
   after.after(button);
 }
 
-// A speed list (x0.1 .. x10, or "max": as fast as it goes) sets the session's speed; drawSpeed follows the
+// The speeds a page offers, times real time (the session takes 0.1 .. 10, or "max": as fast as it goes).
+const SPEEDS = [["0.1", "x0.1"], ["0.25", "x0.25"], ["0.5", "x0.5"], ["1", "x1 (real time)"], ["2", "x2"],
+  ["5", "x5"], ["10", "x10"], ["max", "as fast as it goes"]];
+
+// A speed list (its options: SPEEDS, x1 chosen) sets the session's speed; drawSpeed follows the
 // session's, which another page may change (not while the list is being used).
 export function addSpeed(select, link) {
+  for (const [value, text] of SPEEDS) select.add(new Option(text, value, value === "1", value === "1"));
   select.addEventListener("change", () => {
     const v = select.value;
     link.send({ type: "speed", value: v === "max" ? "max" : Number(v) });

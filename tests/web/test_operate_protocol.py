@@ -185,10 +185,21 @@ def test_the_sine_waves_magnitude_is_its_peak_to_peak_on_the_whiteboard(
     assert result["speed_mm_s"] == 30.0 and result["closure_gap_mm"] is None and result["rms_error_mm"] < 0.5
 
 
+@pytest.fixture
+def fresh() -> Iterator[tuple[Session, Any, Page, dict[str, Any]]]:
+    """A session of its own, from power-on: what the arm drew before decides which side of the gears' clearance
+    it rests on, and the module's session has drawn whatever the tests that ran on it asked."""
+    with _operating() as it:
+        yield it
+
+
 def test_the_staircase_plays_from_the_waiting_pose_and_back_and_is_measured_as_the_cli_measures_it(
-        operating: tuple[Session, Any, Page, dict[str, Any]]) -> None:
-    """Section 3.5's experiment on the Operational page: Trigger with "staircase" (issue: a Staircase choice)."""
-    session, _, page, _ = operating
+        fresh: tuple[Session, Any, Page, dict[str, Any]]) -> None:
+    """Section 3.5's experiment on the Operational page: Trigger with "staircase" (issue: a Staircase choice).
+
+    From power-on, as ``ttt-sm precision staircase`` runs it: the two are compared at rest, where the gears'
+    clearance shows."""
+    session, _, page, _ = fresh
     session.call(lambda d: d.robot.run_until(lambda: d.robot.control.ready, 200.0), timeout_s=300)
     wait_pose = session.call(lambda d: (d.robot.control.X_out, d.robot.control.Y_out, d.robot.control.Z_out))
     ok = page.answer(page.send(type="operate_trigger", symbol="staircase", magnitude_cm=0, speed=0, axis="x",

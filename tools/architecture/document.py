@@ -25,7 +25,7 @@ from pathlib import Path
 
 from ttt_sm.runtime.export import dot_sha256, svg_dot_sha256, svg_from_dot
 
-from .layers import CONTRACT, TIERS, ImportGraph, allowed, component_edges, cycles, scan
+from .layers import CONTRACT, TIERS, ImportGraph, allowed, component_edges, component_of, cycles, scan
 
 PAGE = Path("docs") / "architecture.md"
 """Where the page lives in the repository."""
@@ -401,8 +401,56 @@ so that a stale copy fails rather than drifts:
 """
 
 
+#: Above this many lines a module is flagged in the module map: a file that grows past a few hundred lines
+#: usually holds two ideas.
+LONG_MODULE = 500
+
+
+def _module_summary(path: Path) -> tuple[int, str]:
+    """A module's length in lines and the first sentence of its docstring (read with ``ast``, not imported)."""
+    text = path.read_text(encoding="utf-8")
+    doc = ast.get_docstring(ast.parse(text)) or ""
+    first = " ".join(doc.strip().split("\n\n")[0].split())
+    cut = first.find(". ")
+    return len(text.splitlines()), (first[:cut + 1] if cut >= 0 else first).replace("|", "\\|")
+
+
+def modules_section(pictures: Pictures) -> str:
+    """Every module of the package by component, with its length and what it holds (its docstring's first
+    sentence): the layout of the code, a module per idea."""
+    del pictures
+    graph = scan()
+    by_component: dict[str, list[str]] = {}
+    for module in sorted(graph.modules):
+        comp = component_of(module)
+        by_component.setdefault(comp.name if comp else "(outside the contract)", []).append(module)
+    blocks = []
+    for comp in sorted(CONTRACT, key=lambda c: (-c.tier, CONTRACT.index(c))):
+        modules = by_component.get(comp.name, [])
+        if not modules:
+            continue
+        rows = ["| module | lines | what it holds |", "|---|---|---|"]
+        for module in modules:
+            lines, what = _module_summary(graph.modules[module])
+            flag = f"**{lines}**" if lines > LONG_MODULE else str(lines)
+            rows.append(f"| `{module}` | {flag} | {what or '—'} |")
+        count = f"{len(modules)} module{'s' * (len(modules) > 1)}"
+        blocks.append(f"<details><summary><b>{comp.name}</b>: {count}</summary>\n\n" + "\n".join(rows)
+                      + "\n\n</details>")
+    longest = max(_module_summary(path)[0] for path in graph.modules.values())
+    return f"""## The modules
+
+Each component's modules, with their length and the first sentence of their
+docstring, read from the source (a module per idea: a length over
+{LONG_MODULE} lines is in bold; the longest now has {longest}).
+
+{(chr(10) * 2).join(blocks)}
+"""
+
+
 #: The sections of docs/architecture.md, in order.  Add yours here.
-SECTIONS: list[Section] = [layers_section, control_step_section, wiring_section, thesis_section, conventions_section]
+SECTIONS: list[Section] = [layers_section, control_step_section, wiring_section, thesis_section, modules_section,
+                           conventions_section]
 
 
 def render() -> tuple[str, dict[str, str]]:

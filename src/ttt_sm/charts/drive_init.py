@@ -53,7 +53,7 @@ def _step_towards(value: float, target: float, inc: float) -> float:
     return value + max(-inc, min(inc, target - value))
 
 
-class _HomeAndPass(TickChart):
+class HomeAndPass(TickChart):
     """What every DriveInit chart does alike: take the index as home, then pass pos_in.
 
     An abstract chart (no states, no data): each DriveInit chart declares its own
@@ -98,7 +98,7 @@ class _HomeAndPass(TickChart):
         self.gave_up = True
 
 
-class _IndexSearch(_HomeAndPass):
+class _IndexSearch(HomeAndPass):
     """A DriveInit chart that waits for an edge of its index switch (drives 1 and 2).
 
     Drive 3's switch is also its limit switch: its guards read the level itself.
@@ -306,7 +306,7 @@ class DriveInit2(_IndexSearch):
         self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc)
 
 
-class DriveInit3(_HomeAndPass):
+class DriveInit3(HomeAndPass):
     """Drive 3: turn towards the index-and-limit switch with a shrinking increment."""
 
     timed = True
@@ -353,7 +353,7 @@ class DriveInit3(_HomeAndPass):
     back_off.to(wait_ini2, cond="pos_out == park")
     wait_ini2.to(pass_pos, cond="ini2")
 
-    # (set_home and during_pass_pos: see _HomeAndPass)
+    # (set_home and during_pass_pos: see HomeAndPass)
 
     def start_search(self) -> None:
         self.inc = self.speed_max * self.tick_period_s

@@ -41,6 +41,9 @@ _INDEX_POS = Data("index_pos", "rad", 0.0, "encoder angle latched at the index s
 _POS_OUT = Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller")
 _OFFSET = Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle")
 _INDEX_ANGLE = Data("index_angle", "rad", 0.0, "true angle of the index switch")
+#: Local data drives 1 and 2 declare alike: the search's step and where it began.
+_SEARCH_INC = Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period")
+_INDEX_START = Data("index_start", "bool", False, "index level when the current search began")
 #: Outputs every DriveInit chart declares: what the application reads of its state.
 _STATUS = (
     Data("passing", "bool", False, "initialised: passes pos_in through (pass_pos)"),
@@ -134,7 +137,7 @@ class DriveInit1(_IndexSearch):
     )
     local = (
         Data("search_speed", "rad/s", 1.0, "how fast the setpoint turns while searching and parking"),
-        Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period"),
+        _SEARCH_INC,
         _INDEX_ANGLE,
         Data("park", "rad", 0.0, "angle to wait at while drives 2 and 3 initialise"),
         Data("still_speed", "rad/s", 0.25, "encoder slower than this (a quarter of search_speed): stalled"),
@@ -143,7 +146,7 @@ class DriveInit1(_IndexSearch):
         Data("moving", "bool", False, "the encoder has moved since the current turn began"),
         Data("park_tol", "rad", 0.002, "how close the encoder must be to the parking angle"),
         Data("enc_prev", "rad", 0.0, "encoder angle one chart tick earlier"),
-        Data("index_start", "bool", False, "index level when the current search began"),
+        _INDEX_START,
     )
 
     class run(State.Compound):
@@ -259,12 +262,12 @@ class DriveInit2(_IndexSearch):
     )
     local = (
         Data("search_speed", "rad/s", 0.75, "how fast the setpoint turns while searching and parking"),
-        Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period"),
+        _SEARCH_INC,
         _INDEX_ANGLE,
         Data("turn_angle", "rad", 0.6, "how far to turn one way before turning back"),
         Data("max_back", "rad", 2.0, "how far to turn back before giving up"),
         Data("travel", "rad", 0.0, "turned so far in the current direction"),
-        Data("index_start", "bool", False, "index level when the current search began"),
+        _INDEX_START,
         Data("park", "rad", 0.0, "angle to hold once initialised, until the Control chart takes over"),
     )
 

@@ -41,6 +41,9 @@ _INDEX_POS = Data("index_pos", "rad", 0.0, "encoder angle latched at the index s
 _POS_OUT = Data("pos_out", "rad", 0.0, "position setpoint sent to the drive's controller")
 _OFFSET = Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle")
 _INDEX_ANGLE = Data("index_angle", "rad", 0.0, "true angle of the index switch")
+#: Local data drives 1 and 2 declare alike: the search's step and where it began.
+_SEARCH_INC = Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period")
+_INDEX_START = Data("index_start", "bool", False, "index level when the current search began")
 #: Outputs every DriveInit chart declares: what the application reads of its state.
 _STATUS = (
     Data("passing", "bool", False, "initialised: passes pos_in through (pass_pos)"),
@@ -53,7 +56,7 @@ def _step_towards(value: float, target: float, inc: float) -> float:
     return value + max(-inc, min(inc, target - value))
 
 
-class _HomeAndPass(TickChart):
+class HomeAndPass(TickChart):
     """What every DriveInit chart does alike: take the index as home, then pass pos_in.
 
     An abstract chart (no states, no data): each DriveInit chart declares its own
@@ -98,7 +101,7 @@ class _HomeAndPass(TickChart):
         self.gave_up = True
 
 
-class _IndexSearch(_HomeAndPass):
+class _IndexSearch(HomeAndPass):
     """A DriveInit chart that waits for an edge of its index switch (drives 1 and 2).
 
     Drive 3's switch is also its limit switch: its guards read the level itself.
@@ -134,7 +137,7 @@ class DriveInit1(_IndexSearch):
     )
     local = (
         Data("search_speed", "rad/s", 1.0, "how fast the setpoint turns while searching and parking"),
-        Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period"),
+        _SEARCH_INC,
         _INDEX_ANGLE,
         Data("park", "rad", 0.0, "angle to wait at while drives 2 and 3 initialise"),
         Data("still_speed", "rad/s", 0.25, "encoder slower than this (a quarter of search_speed): stalled"),
@@ -143,7 +146,7 @@ class DriveInit1(_IndexSearch):
         Data("moving", "bool", False, "the encoder has moved since the current turn began"),
         Data("park_tol", "rad", 0.002, "how close the encoder must be to the parking angle"),
         Data("enc_prev", "rad", 0.0, "encoder angle one chart tick earlier"),
-        Data("index_start", "bool", False, "index level when the current search began"),
+        _INDEX_START,
     )
 
     class run(State.Compound):
@@ -259,12 +262,12 @@ class DriveInit2(_IndexSearch):
     )
     local = (
         Data("search_speed", "rad/s", 0.75, "how fast the setpoint turns while searching and parking"),
-        Data("inc", "rad", 0.0, "search step per chart tick: search_speed times the tick period"),
+        _SEARCH_INC,
         _INDEX_ANGLE,
         Data("turn_angle", "rad", 0.6, "how far to turn one way before turning back"),
         Data("max_back", "rad", 2.0, "how far to turn back before giving up"),
         Data("travel", "rad", 0.0, "turned so far in the current direction"),
-        Data("index_start", "bool", False, "index level when the current search began"),
+        _INDEX_START,
         Data("park", "rad", 0.0, "angle to hold once initialised, until the Control chart takes over"),
     )
 
@@ -306,7 +309,7 @@ class DriveInit2(_IndexSearch):
         self.pos_out = _step_towards(self.pos_out_p, self.park, self.inc)
 
 
-class DriveInit3(_HomeAndPass):
+class DriveInit3(HomeAndPass):
     """Drive 3: turn towards the index-and-limit switch with a shrinking increment."""
 
     timed = True
@@ -353,7 +356,7 @@ class DriveInit3(_HomeAndPass):
     back_off.to(wait_ini2, cond="pos_out == park")
     wait_ini2.to(pass_pos, cond="ini2")
 
-    # (set_home and during_pass_pos: see _HomeAndPass)
+    # (set_home and during_pass_pos: see HomeAndPass)
 
     def start_search(self) -> None:
         self.inc = self.speed_max * self.tick_period_s

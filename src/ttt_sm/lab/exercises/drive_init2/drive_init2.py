@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from statemachine import State
 
+from ttt_sm.charts.drive_init import DriveInit2
 from ttt_sm.runtime import Data, TickChart
 
 
@@ -15,20 +16,9 @@ class MyDriveInit2(TickChart):
 
     timed = True
 
-    inputs = (
-        Data("pos_in", "rad", 0.0, "joint coordinate to pass through once initialised"),
-        Data("index", "bool", False, "index switch level"),
-        Data("index_pos", "rad", 0.0, "encoder angle latched at the index switch's last edge"),
-        Data("ini1", "bool", False, "drive 1 is initialised and parked"),
-        Data("ini3", "bool", False, "drive 3 is initialised"),
-    )
-    outputs = (
-        Data("pos_out", "rad", 0.0, "position setpoint"),
-        Data("offset", "rad", 0.0, "correction the Encoder block adds to the encoder angle"),
-        Data("ini2", "bool", False, "drive 2 is initialised"),
-        Data("passing", "bool", False, "initialised: passes pos_in through"),
-        Data("gave_up", "bool", False, "the search gave up"),
-    )
+    # the slot's contract, as the thesis chart declares it: what the robot feeds and reads
+    inputs = DriveInit2.inputs
+    outputs = DriveInit2.outputs
     local = (
         Data("index_angle", "rad", 0.0, "true angle of the index switch (parameter file)"),
         Data("park", "rad", 0.0, "angle to hold once initialised (parameter file)"),

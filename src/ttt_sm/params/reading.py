@@ -21,21 +21,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from .values import (
-    TUNING_PRESETS,
-    ArmParams,
-    Board,
-    ControlParams,
-    DriveParams,
-    Geometry,
-    IKParams,
-    Masses,
-    Pen,
-    SafetyParams,
-    Servo,
-    Sponge,
-    Tuning,
-)
+from .values import SECTIONS, TUNING_PRESETS, ArmParams, DriveParams, Geometry, Tuning
 
 DEFAULT_PARAMS_NAME = "arm.toml"
 
@@ -279,14 +265,11 @@ def parse_params(data: dict[str, Any], where: str, text: str | None = None) -> A
     With the document's `text`, messages also name the line of the key.
     """
     at = _Where(where, text)
-    sections = {"geometry": Geometry, "board": Board, "pen": Pen, "sponge": Sponge,
-                "servo": Servo, "masses": Masses, "control": ControlParams, "ik": IKParams,
-                "safety": SafetyParams}
-    unknown = sorted(set(data) - set(sections) - {"drive", "tuning", "as_built"})
+    unknown = sorted(set(data) - set(SECTIONS) - {"drive", "tuning", "as_built"})
     if unknown:
         raise ParameterError(f"{where}: unknown section(s) {', '.join(str(u)[:30] for u in unknown[:5])}")
     built: dict[str, Any] = {}
-    for name, cls in sections.items():
+    for name, cls in SECTIONS.items():
         if name not in data:
             raise ParameterError(f"{where}: missing section [{name}]")
         built[name] = _section(data[name], cls, name, at)

@@ -302,3 +302,8 @@ class ArmParams:
         """Upper joint limits q1..q4 (rad)."""
         d = self.drives
         return (d[0].limit_max_rad, d[1].limit_max_rad, d[2].limit_max_rad, self.servo.max_rad)
+
+
+#: The file's tables of one dataclass each, by name (``[drive.N]``, ``[tuning]`` and ``[as_built]`` aside).
+SECTIONS: dict[str, type] = {"geometry": Geometry, "board": Board, "pen": Pen, "sponge": Sponge, "servo": Servo,
+                             "masses": Masses, "control": ControlParams, "ik": IKParams, "safety": SafetyParams}

@@ -59,11 +59,17 @@ class PoseRecorder:
 
 
 @dataclass
-class DrawRecord:
-    """Per chart step: desired pose, forward kinematics of the encoders, the true tip."""
+class PoseRecord:
+    """Per chart step: its time, s, and the desired tool position, m (what both records begin with)."""
 
     t: list[float] = field(default_factory=list)
     desired: list[Point] = field(default_factory=list)
+
+
+@dataclass
+class DrawRecord(PoseRecord):
+    """Per chart step: desired pose, forward kinematics of the encoders, the true tip."""
+
     fk_encoder: list[Point] = field(default_factory=list)
     #: Forward kinematics of the same encoder angles with the arm's true lengths (``[as_built]``).
     fk_as_built: list[Point] = field(default_factory=list)
@@ -91,11 +97,9 @@ class RecordStage(PoseRecorder):
 
 
 @dataclass
-class StairRecord:
+class StairRecord(PoseRecord):
     """Per chart tick: time, desired pose, FK of the encoders, the true tool and the sensor's coordinate."""
 
-    t: list[float] = field(default_factory=list)
-    desired: list[Point] = field(default_factory=list)
     fk: list[Point] = field(default_factory=list)
     q_encoder: list[Angles] = field(default_factory=list)
     true: list[Point] = field(default_factory=list)

@@ -6,7 +6,8 @@ from pathlib import Path
 
 from ttt_sm.charts import ALL_CHARTS, Control
 from ttt_sm.cli.commands import REPO_CHART_FORMATS, repo_chart_extras
-from ttt_sm.runtime.dot import subcharts, to_dot, views
+from ttt_sm.runtime.dot import to_dot
+from ttt_sm.runtime.dot_views import subcharts, views
 from ttt_sm.runtime.export import stale_files
 
 REPO = Path(__file__).resolve().parents[2]

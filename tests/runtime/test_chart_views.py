@@ -10,7 +10,9 @@ import pytest
 from statemachine import State
 
 from ttt_sm.runtime import Data, TickChart
-from ttt_sm.runtime.dot import WHOLE, View, legend_dot, legend_features, legend_markdown, to_dot, views
+from ttt_sm.runtime.dot import legend_features, to_dot
+from ttt_sm.runtime.dot_text import legend_dot, legend_markdown
+from ttt_sm.runtime.dot_views import WHOLE, View, views
 from ttt_sm.runtime.export import export_all, pictures, render_active, svg_from_dot
 
 needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz dot not installed")

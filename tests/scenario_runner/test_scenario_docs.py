@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from ttt_sm.scenario import load_scenario_text
-from ttt_sm.scenario.loader import STEP_OPTIONS
+from ttt_sm.scenario.steps import STEP_OPTIONS
 
 ROOT = Path(__file__).resolve().parents[2]
 DOC = (ROOT / "docs" / "scenarios.md").read_text(encoding="utf-8")

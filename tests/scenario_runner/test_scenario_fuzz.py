@@ -15,7 +15,8 @@ from hypothesis import strategies as st
 
 from fuzzing import fuzz, one_line
 from ttt_sm.scenario import ScenarioError, load_scenario, load_scenario_text
-from ttt_sm.scenario.loader import STEP_OPTIONS, TOP_KEYS
+from ttt_sm.scenario.loader import TOP_KEYS
+from ttt_sm.scenario.steps import STEP_OPTIONS
 
 FOLDER = Path(__file__).resolve().parents[1] / "scenarios"
 FILES = {f.name: f.read_text() for f in sorted(FOLDER.glob("*.yaml"))}

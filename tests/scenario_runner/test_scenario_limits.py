@@ -15,7 +15,7 @@ import pytest
 
 from ttt_sm.runtime.conditions import MAX_CONDITION_CHARS, MAX_DEPTH, ExprError, parse
 from ttt_sm.scenario import ScenarioError, load_scenario, load_scenario_text
-from ttt_sm.scenario.loader import DEFAULT_MAX_STEP_S
+from ttt_sm.scenario.model import DEFAULT_MAX_STEP_S
 from ttt_sm.scenario.source import MAX_FILE_BYTES, MAX_NESTING
 
 MEMORY_LIMIT_MB = 500

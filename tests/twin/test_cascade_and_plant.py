@@ -147,14 +147,14 @@ def test_the_controller_and_the_plant_keep_their_own_memory(params, gains):
 
 def test_the_fused_loop_is_compiled_for_the_steps_sources_it_runs():
     # numba's disk cache checks only the fused loop's own file; the loop closes over a
-    # fingerprint of both steps' files, their layout and the servo's formula (params.py),
+    # fingerprint of both steps' files, their layout and the servo's formula (params/values.py),
     # so an edit of any of them compiles the loop afresh
     import hashlib
     from pathlib import Path
 
-    from ttt_sm import params
+    from ttt_sm.params import values
     from ttt_sm.twin import _kernel as K
 
-    expected = hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in (C, P, layout, params))).hexdigest()
+    expected = hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in (C, P, layout, values))).hexdigest()
     cells = [c.cell_contents for c in K.run_steps.py_func.__closure__]
     assert cells == [expected]

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -29,12 +29,12 @@ import numpy as np
 
 from ..arm import Arm
 from ..params import ArmParams
-from ..sched.scheduler import PathStage, Signals
+from ..sched.scheduler import PathStage
 from ..sched.trajectory import Waypoint, distance_to_path, sample_polyline, simplify_polyline
 from ..twin.board_picture import save_board_picture
-from ..twin.kinematics import fk
 from ..twin.truth import GroundTruth
 from .path_plot import PathData, save_path_plot
+from .recorders import ActiveStateLog, DrawRecord, RecordStage
 from .robot import Robot
 
 KINDS = ("field", "X", "O", "sine", "lines")
@@ -47,87 +47,6 @@ LINES_LENGTH_M = 0.10
 
 class DrawError(ValueError):
     """A drawing request that cannot be carried out (bad cell, size, speed, or a stuck chart)."""
-
-
-@dataclass
-class DrawRecord:
-    """Per chart step: desired pose, forward kinematics of the encoders, the true tip."""
-
-    t: list[float] = field(default_factory=list)
-    desired: list[tuple[float, float, float]] = field(default_factory=list)
-    fk_encoder: list[tuple[float, float, float]] = field(default_factory=list)
-    #: Forward kinematics of the same encoder angles with the arm's true lengths (``[as_built]``).
-    fk_as_built: list[tuple[float, float, float]] = field(default_factory=list)
-    fk_true: list[tuple[float, float, float]] = field(default_factory=list)
-    tip: list[tuple[float, float]] = field(default_factory=list)  # NaN while the pen is lifted
-
-
-class ActiveStateLog:
-    """python-statemachine listener: when each leaf state of a chart became active, by a clock.
-
-    For labelling plots only (which sub-chart drew what): it reads state names,
-    so nothing may decide anything by it.
-    """
-
-    def __init__(self, clock: Callable[[], float]) -> None:
-        self.clock = clock
-        #: (time, ``"parent.leaf"``) at each change of the active leaf, oldest first.
-        self.changes: list[tuple[float, str]] = []
-
-    def observe(self, chart: Any) -> ActiveStateLog:
-        """Attach to a chart and note the leaf active now."""
-        chart.add_listener(self)
-        self._note(chart)
-        return self
-
-    def after_transition(self, machine: Any) -> None:
-        self._note(machine)
-
-    def _note(self, machine: Any) -> None:
-        leaves = [s for s in machine.configuration if not s.states]
-        label = ", ".join(f"{s.parent.id}.{s.id}" if s.parent is not None else s.id for s in leaves)
-        if not self.changes or self.changes[-1][1] != label:
-            self.changes.append((self.clock(), label))
-
-    def between(self, t0: float, t1: float) -> list[tuple[float, str]]:
-        """The changes in [t0, t1], led by the state already active at t0 (stamped t0)."""
-        before = [c for c in self.changes if c[0] <= t0]
-        inside = [c for c in self.changes if t0 < c[0] <= t1]
-        return ([(t0, before[-1][1])] if before else []) + inside
-
-
-class RecordStage:
-    """Joint stage run last: records the three paths of section 3.5 while `on`.
-
-    Simulation only: the true path is the twin's ground truth.
-    """
-
-    def __init__(self, robot: Robot) -> None:
-        if robot.truth is None:
-            raise DrawError("measuring a drawing's precision needs ground truth: the simulated arm's, or an"
-                            " emulator's (ttt-sm arm serve sends it; a board does not)")
-        self.robot = robot
-        self.truth = robot.truth
-        self.on = False
-        self.record = DrawRecord()
-
-    def tick(self, signals: Signals) -> None:
-        """Append this chart step's desired, encoder and true positions."""
-        if not self.on:
-            return
-        r = self.robot
-        g = r.params.geometry
-        q_enc = r.arm.encoder_angles()
-        servo = float(signals.q_set[3])
-        rec = self.record
-        rec.t.append(r.t)
-        task = signals.task  # the Control chart's pose, or the pose of a path stage after it (``draw lines``)
-        rec.desired.append((float(task[0]), float(task[1]), float(task[2])))
-        rec.fk_encoder.append(tuple(fk((q_enc[0], q_enc[1], q_enc[2], servo), g)[:3]))
-        rec.fk_as_built.append(tuple(fk((q_enc[0], q_enc[1], q_enc[2], servo), r.params.true_geometry)[:3]))
-        rec.fk_true.append(tuple(self.truth.tool_pose()[:3]))
-        contact = r.board.contact
-        rec.tip.append(contact.tip_m if contact.pen_touching and contact.tip_m else (math.nan, math.nan))
 
 
 @dataclass(frozen=True)
@@ -352,7 +271,10 @@ class DrawSession:
                  arm: Arm | None = None, truth: GroundTruth | None = None) -> None:
         self.params = params
         self.robot = Robot(params, seed=seed, arm=arm, truth=truth)
-        self.recorder = RecordStage(self.robot)
+        if self.robot.truth is None:
+            raise DrawError("measuring a drawing's precision needs ground truth: the simulated arm's, or an"
+                            " emulator's (ttt-sm arm serve sends it; a board does not)")
+        self.recorder = RecordStage(self.robot, self.robot.truth)
         self.robot.sched.joint_stages.append(self.recorder)
         #: The Control chart's active sub-state over time, for the path plot's bands.
         self.control_states = ActiveStateLog(lambda: self.robot.t).observe(self.robot.control)

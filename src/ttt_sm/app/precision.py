@@ -17,7 +17,7 @@ controllers, the arm), and three values are compared over time:
 initialises with its init charts and waits in ``wait_1``; then a task stage
 (:class:`~ttt_sm.sched.scheduler.PathStage`, after the Control chart's, whose
 pose it replaces) moves the tool to the staircase's start and plays the
-stairs, one pose per chart tick.  A joint stage run last (:class:`StairRecorder`)
+stairs, one pose per chart tick.  A joint stage run last (:class:`~.recorders.StairRecorder`)
 records, per chart tick, the desired pose, forward kinematics of the encoders
 (with the servo's commanded angle: it has no encoder) and one reading of the
 sensor (:mod:`ttt_sm.twin.sensor`, on the true tool: simulation only).
@@ -40,10 +40,10 @@ import numpy as np
 
 from ..params import ArmParams, Tuning
 from ..sched.scheduler import PathStage, Signals
-from ..twin.kinematics import arm_chain_py, fk, jacobian
+from ..twin.kinematics import fk, jacobian
 from ..twin.plant import gear_play, gravity_torques
 from ..twin.sensor import SensorMount, SensorSpec, TriangulationSensor
-from ..twin.truth import GroundTruth
+from .recorders import StairRecorder
 from .robot import Robot
 
 AXES = ("x", "y", "z")
@@ -156,49 +156,6 @@ def staircase_poses(spec: StaircaseSpec, frm: tuple[float, float, float, float],
         ticks.append(tick)
         tick += hold
     return np.vstack(rows), n_app, ticks
-
-
-@dataclass
-class StairRecord:
-    """Per chart tick: time, desired pose, FK of the encoders, the true tool and the sensor's coordinate."""
-
-    t: list[float] = field(default_factory=list)
-    desired: list[tuple[float, float, float]] = field(default_factory=list)
-    fk: list[tuple[float, float, float]] = field(default_factory=list)
-    q_encoder: list[tuple[float, float, float, float]] = field(default_factory=list)
-    true: list[tuple[float, float, float]] = field(default_factory=list)
-    sensor: list[float | None] = field(default_factory=list)  # the coordinate along the axis, m; None out of range
-
-
-class StairRecorder:
-    """Joint stage run last: records the three values of section 3.5 while `on` (simulation only)."""
-
-    def __init__(self, robot: Robot, truth: GroundTruth, sensor: TriangulationSensor, axis: np.ndarray) -> None:
-        self.robot = robot
-        self.truth = truth
-        self.sensor = sensor
-        self.axis = axis
-        g = robot.params.geometry  # the nominal lengths: what forward kinematics on a real arm knows
-        self._geometry = (g.L1, g.L2, g.L3, g.L4, g.l_f)
-        self.on = False
-        self.record = StairRecord()
-
-    def tick(self, signals: Signals) -> None:
-        """Append this chart step's desired pose, FK of the encoders, the true tool and a sensor reading."""
-        if not self.on:
-            return
-        rec = self.record
-        q1, q2, q3 = self.robot.arm.encoder_angles()
-        servo = float(signals.q_set[3])
-        x, y, z, *_ = arm_chain_py(q1, q2, q3, servo, *self._geometry)
-        task = signals.task
-        tip = self.truth.tool_pose()
-        rec.t.append(signals.t)
-        rec.desired.append((float(task[0]), float(task[1]), float(task[2])))
-        rec.fk.append((x, y, z))
-        rec.q_encoder.append((q1, q2, q3, servo))
-        rec.true.append((float(tip[0]), float(tip[1]), float(tip[2])))
-        rec.sensor.append(self.sensor.position(self.sensor.distance(tip), self.axis))
 
 
 @dataclass(frozen=True)
@@ -524,7 +481,7 @@ def _with_reading(r: StaircaseResult) -> StaircaseResult:
 
 
 __all__ = ["AXES", "STEP_KINDS", "STEP_M", "STAIRS", "HOLD_S", "STATIC_WINDOW_S", "DYNAMIC_WINDOW_S",
-           "COMPARISONS", "PARTS", "THESIS_FIGURE", "PrecisionError", "StaircaseSpec", "StairRecord", "StairRecorder",
+           "COMPARISONS", "PARTS", "THESIS_FIGURE", "PrecisionError", "StaircaseSpec",
            "StepErrors", "StaircaseResult", "StaircaseStage", "Staircase", "staircase_playing",
            "staircase_poses", "step_errors",
            "clearance_bound_m", "run_staircase"]

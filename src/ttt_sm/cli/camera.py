@@ -24,7 +24,8 @@ from typing import Any
 
 from ..smartcam.emulator import CameraEmulator, Fault
 from ..smartcam.errors import SerialLinkError
-from ..smartcam.reader import ReconnectPolicy, SerialCameraReader
+from ..smartcam.link import ReconnectPolicy
+from ..smartcam.reader import SerialCameraReader
 from ..smartcam.sources import board_source
 from .common import add_group, print_json, seed
 

@@ -26,8 +26,9 @@ from typing import Any
 import numpy as np
 
 from ..app.chart_file import load_chart
-from ..app.drawing import DrawRecord, DrawSession
+from ..app.drawing import DrawSession
 from ..app.init_wiring import InitMonitor
+from ..app.recorders import DrawRecord
 from ..app.robot import Robot
 from ..app.slots import ChartSlots, using_slots
 from ..charts import DriveInit1

@@ -6,7 +6,8 @@ listeners (:class:`Trace`, :class:`Coverage`).  :mod:`.diagram` draws them.
 """
 
 from .action_text import does
-from .chart import ChartActions, TickChart, TickChartMeta
+from .chart import ChartActions, TickChart
+from .chart_class import TickChartMeta
 from .data import Data
 from .errors import (
     ChartDefinitionError,

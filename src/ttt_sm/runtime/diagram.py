@@ -274,7 +274,7 @@ def to_markdown(chart: StateChart | type[StateChart], pictures: Sequence[tuple[s
     ``pictures`` are the chart's Graphviz pictures as (what it shows, file name),
     the first the one to see first: with more than one, it is embedded in the page
     and all are linked.  ``legend``: the pictures' legend, Markdown table rows
-    (:func:`~.dot.legend_markdown`), written once under them.
+    (:func:`~.dot_text.legend_markdown`), written once under them.
     """
     structure = structure_of(chart)
     cls = chart_class(chart)

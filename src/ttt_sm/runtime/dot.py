@@ -1,7 +1,7 @@
 """Graphviz DOT of a chart: the whole chart, an overview and one picture per sub-chart.
 
 A chart whose top level holds compound states (Control: ``start_stop``,
-``Drawing_X``, ...) is drawn in several :class:`View`\\ s, the way Stateflow shows
+``Drawing_X``, ...) is drawn in several :class:`~.dot_views.View`\\ s (:mod:`.dot_views`), the way Stateflow shows
 a chart with subcharts:
 
 * the **overview**: those compound states *closed*, each a grey box with its name,
@@ -17,8 +17,8 @@ a chart with subcharts:
 Every picture carries its title; the legend of what a chart's pictures use
 (transitions with and without events, execution order, condition and transition
 actions, ``en:``/``du:``/``ex:``, history, connective junctions, ...) is drawn
-once per page: :func:`legend_dot` (the cockpit), :func:`legend_markdown` (the
-chart's Markdown page).  Labels read as in Stateflow:
+once per page: :func:`~.dot_text.legend_dot` (the cockpit), :func:`~.dot_text.legend_markdown` (the
+chart's Markdown page); :mod:`.dot_text` holds the pieces of the text.  Labels read as in Stateflow:
 ``2: event [guard] {condition action} / transition action``; an action reads as
 what it does (:mod:`.action_text`), a long one summarised with ``…`` and whole in
 the element's tooltip.  A
@@ -35,8 +35,6 @@ edge of transition ``n`` (its index in :class:`~.structure.ChartStructure`).
 
 from __future__ import annotations
 
-import re
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 from statemachine import StateChart
@@ -54,174 +52,19 @@ from .diagram import (
     state_actions_full,
     structure_of,
 )
-from .structure import ChartStructure, StateInfo, TransitionInfo
-
-EVENT_COLOR = "#1f4e9c"
-CLOSED_FILL = "#ececec"
-STUB_COLOR = "#707070"
-
-
-@dataclass(frozen=True)
-class View:
-    """Which part of a chart a picture shows.
-
-    ``key`` names the picture: ``""`` the whole chart, ``"overview"``, or the id of
-    the sub-chart (a top-level compound state) it shows alone (``root``).
-    ``closed`` are the compound states drawn as closed boxes.
-    """
-
-    key: str = ""
-    root: str | None = None
-    closed: frozenset[str] = frozenset()
-    #: sub-charts drawn open in an overview (:func:`overview_with`), for the title
-    opened: tuple[str, ...] = ()
-
-    def file_stem(self, chart_name: str) -> str:
-        """``Control``, ``Control.overview``, ``Control.Drawing_X``."""
-        return f"{chart_name}.{self.key}" if self.key else chart_name
-
-    def title(self, chart_name: str) -> str:
-        if self.root is not None:
-            return f"{chart_name} — sub-chart {self.root}"
-        if self.opened:
-            return f"{chart_name} — overview, {', '.join(self.opened)} open"
-        if self.closed:
-            return f"{chart_name} — overview, sub-charts closed"
-        return chart_name
-
-
-WHOLE = View()
-OVERVIEW = "overview"
-
-
-def subcharts(chart: StateChart | type[StateChart]) -> tuple[str, ...]:
-    """Ids of the chart's top-level compound states: its sub-charts."""
-    return tuple(s.id for s in structure_of(chart).states if s.parent is None and s.is_compound)
-
-
-def views(chart: StateChart | type[StateChart]) -> tuple[View, ...]:
-    """The pictures of a chart: overview, one per sub-chart, the whole chart.
-
-    A chart without sub-charts has one picture, the whole chart.
-    """
-    subs = subcharts(chart)
-    if not subs:
-        return (WHOLE,)
-    if OVERVIEW in subs:
-        raise ValueError(f"{structure_of(chart).name}: a sub-chart named {OVERVIEW!r} would share"
-                         " its picture's name with the overview; rename the state")
-    return (View(OVERVIEW, closed=frozenset(subs)), *(View(s, root=s) for s in subs), WHOLE)
-
-
-def overview_with(chart: StateChart | type[StateChart], opened: Iterable[str] = ()) -> View:
-    """The overview with the sub-charts ``opened`` drawn open in place, the others closed.
-
-    Stateflow opens a subchart where it stands; a live view (the browser
-    cockpit) offers the same, one picture per set of open sub-charts.
-    """
-    subs = subcharts(chart)
-    wanted = tuple(s for s in subs if s in set(opened))
-    unknown = sorted(set(opened) - set(subs))
-    if unknown:
-        raise ValueError(f"{structure_of(chart).name} has no sub-chart {unknown[0]!r};"
-                         f" sub-charts: {', '.join(subs) or 'none'}")
-    if not wanted:
-        return View(OVERVIEW, closed=frozenset(subs))
-    return View("+".join((OVERVIEW, *wanted)), closed=frozenset(subs) - set(wanted), opened=wanted)
-
-
-# -- text --------------------------------------------------------------------
-
-
-def _q(text: str) -> str:
-    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
-    return '"' + escaped + '"'
-
-
-def _left(text: str) -> str:
-    """A quoted DOT label whose lines are left-aligned (``\\l`` after each), as a block of action text reads."""
-    lines = text.split("\n")
-    return '"' + "".join(_q(line)[1:-1] + "\\l" for line in lines) + '"'
-
-
-def _html(text: str) -> str:
-    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;").replace('"', "&quot;")
-
-
-def _html_label(title: str, lines: list[str]) -> str:
-    if not lines:
-        return f"<<b>{_html(title)}</b>>"
-    body = "<br/>".join(_html(line) for line in lines)
-    return (
-        '<<table border="0" cellborder="0" cellspacing="0" cellpadding="2">'
-        f"<tr><td><b>{_html(title)}</b></td></tr><hr/>"
-        f'<tr><td align="left" balign="left">{body}</td></tr></table>>'
-    )
-
-
-def _closed_label(title: str, lines: list[str], ports: list[tuple[str, str, bool, bool]]) -> str:
-    """A closed sub-chart: name, its own lines, then one row per port (inner state)."""
-    rows = [f"<tr><td><b>{_html(title)}</b></td></tr>"]
-    if lines:
-        body = "<br/>".join(_html(line) for line in lines)
-        rows.append(f'<hr/><tr><td align="left" balign="left">{body}</td></tr>')
-    if ports:
-        rows.append("<hr/>")
-        for port, name, into, out_of in ports:
-            text = ("▸ " if into else "") + _html(name) + (" ▸" if out_of else "")
-            align = "left" if into else "right"
-            rows.append(f'<tr><td port="{port}" align="{align}">{text}</td></tr>')
-    return '<<table border="0" cellborder="0" cellspacing="0" cellpadding="2">' + "".join(rows) + "</table>>"
-
-
-# -- legend ------------------------------------------------------------------
-
-_ARROW = "───▶"
-#: (feature, symbol as an HTML-like label cell, meaning), in the order listed.
-_LEGEND: tuple[tuple[str, str, str], ...] = (
-    ("tick", f"<td>{_ARROW}</td>",
-     "transition without an event: tried at every wake-up of the chart, valid when its [guard] holds"),
-    ("event", f'<td><font color="{EVENT_COLOR}">{_ARROW}</font></td>',
-     "transition with an event: tried only when that event wakes the chart"),
-    ("priority", "<td>2: [guard]</td>",
-     "execution order: a source's outer (or inner) transitions are tried in this order, 1 first"),
-    ("condition", "<td>{f}</td>", "condition action: f runs as soon as the guard holds, before anything is left"),
-    ("action", "<td>/ f</td>", "transition action: f runs once the path reaches a state, between exit and entry"),
-    ("entry", "<td>en: f</td>", "entry action: f runs when the state is entered"),
-    ("during", "<td>du: f</td>", "during action: f runs at every wake-up in which the state stays active"),
-    ("exit", "<td>ex: f</td>", "exit action: f runs when the state is left"),
-    ("previous", "<td>X_p</td>", "output X's value at the previous tick"),
-    ("summary", "<td>f …</td>", "a long action, summarised: hover for its whole text"),
-    ("handler", "<td>on event / f</td>", "the state's on action: f runs after its during action, when the"
-                                          " event wakes the chart; the state stays"),
-    ("inner", "<td>↻ [guard] / f</td>", "inner transition of the state to itself: f runs, nothing is left"),
-    ("initial", "<td>●───▶</td>", "default transition: where the chart or a compound state starts"),
-    ("final", '<td><table border="1" cellborder="1" cellspacing="2" cellpadding="1" style="rounded">'
-              '<tr><td style="rounded">final</td></tr></table></td>', "final state: the chart rests there"),
-    ("history", "<td>(H)  (H*)</td>",
-     "history junction: the compound is entered in the sub-state that was active when it was left"
-     " (H*: at every depth)"),
-    ("connective", "<td>──○──▶</td>", "connective junction: a path's segments meet; those leaving it are"
-                                      " tried in their order"),
-    ("junction", "<td>──•──▶</td>", "the same transition from several states, drawn once from the dot"),
-    ("closed", f'<td border="1" bgcolor="{CLOSED_FILL}">sub-chart</td>',
-     "sub-chart, closed (its own picture shows it open; click); ▸ s: its state s entered from outside,"
-     " s ▸: left to the outside"),
-    ("stub", f'<td border="1" style="dashed"><font color="{STUB_COLOR}">state</font></td>',
-     "a state outside this sub-chart (click for its picture)"),
-    ("active", f'<td bgcolor="{ACTIVE_FILL}">state</td>', "active now"),
+from .dot_text import (
+    CLOSED_FILL,
+    EVENT_COLOR,
+    STUB_COLOR,
+    closed_label,
+    html,
+    html_label,
+    left_quote,
+    quote,
+    title_label,
 )
-
-
-def _title(title: str) -> str:
-    return f'<<font point-size="16"><b>{_html(title)}</b></font>>'
-
-
-def _legend_table(features: set[str] | None) -> str:
-    items = [(symbol, meaning) for feature, symbol, meaning in _LEGEND if features is None or feature in features]
-    rows = "".join(f'<tr>{symbol}<td align="left">{_html(meaning)}</td></tr>' for symbol, meaning in items)
-    return ('<<table border="0" cellborder="0" cellspacing="0" cellpadding="3">'
-            f'<tr><td align="left" colspan="2"><b>Legend</b></td></tr>{rows}</table>>')
+from .dot_views import OVERVIEW, WHOLE, View, views
+from .structure import ChartStructure, StateInfo, TransitionInfo
 
 
 def legend_features(chart: StateChart | type[StateChart]) -> set[str]:
@@ -233,34 +76,6 @@ def legend_features(chart: StateChart | type[StateChart]) -> set[str]:
         picture.dot()
         found |= picture.features
     return found
-
-
-def legend_dot(features: set[str] | None = None) -> str:
-    """A picture of the legend alone (``features``: the rows to show, all by default).
-
-    The charts' pictures carry no legend: a page shows it once (the cockpit, collapsible)
-    and a chart's Markdown page lists it once (:func:`legend_markdown`).
-    """
-    return (f'digraph "legend" {{\n  graph [label={_legend_table(features)}, labelloc="t", labeljust="l",'
-            f' fontname={_q(FONT)}, fontsize="10", margin="0"];\n}}\n')
-
-
-def legend_markdown(features: set[str] | None = None) -> list[str]:
-    """The legend as a Markdown table (symbol, meaning)."""
-    out = ["| on the picture | meaning |", "|---|---|"]
-    for feature, symbol, meaning in _LEGEND:
-        if features is None or feature in features:
-            text = re.sub(r"<[^>]+>", " ", symbol).replace("&lt;", "<").replace("&gt;", ">")
-            out.append(f"| {_LEGEND_WORDS.get(feature, ' '.join(text.split()))} | {meaning} |")
-    return out
-
-
-#: How the Markdown legend names a symbol it cannot draw as text.
-_LEGEND_WORDS = {
-    "tick": "black arrow", "event": "blue arrow", "final": "double border", "closed": "grey box",
-    "stub": "dashed box, grey name", "active": "turquoise box", "initial": "● arrow",
-    "connective": "small circle", "junction": "small dot several arrows meet at",
-}
 
 
 # -- the drawing ---------------------------------------------------------------
@@ -276,9 +91,9 @@ class _End:
     cluster: str = ""
 
     def ref(self) -> str:
-        ref = _q(self.node)
+        ref = quote(self.node)
         if self.port:
-            ref += f":{_q(self.port)}"
+            ref += f":{quote(self.port)}"
         if self.compass:
             ref += f":{self.compass}"
         return ref
@@ -419,8 +234,8 @@ class _Picture:
             colour = [] if kind == "tick" else [f'color="{EVENT_COLOR}"', f'fontcolor="{EVENT_COLOR}"']
             if len(group) == 1 or not label:
                 for e in group:
-                    attrs = [f"label={_left(label)}"] if label else []
-                    attrs.append(f"tooltip={_q(e.full)}")
+                    attrs = [f"label={left_quote(label)}"] if label else []
+                    attrs.append(f"tooltip={quote(e.full)}")
                     attrs += self.clip_attrs(e.tail, e.head)
                     attrs += ['style="solid"'] if kind == "tick" else colour
                     attrs.append(f'id="{_edge_id(e.transitions)}"')
@@ -433,15 +248,15 @@ class _Picture:
             ink = EVENT_COLOR if colour else "black"
             scope = self.scope_of([e.source for e in group] + [group[0].target])
             self.junctions.setdefault(scope, []).append(
-                f'{_q(join)} [shape="point", width="0.09", label="", color="{ink}", fillcolor="{ink}"];')
+                f'{quote(join)} [shape="point", width="0.09", label="", color="{ink}", fillcolor="{ink}"];')
             for e in group:
                 attrs = self.clip_attrs(e.tail, _End(join)) + ['arrowhead="none"'] + colour
                 attrs.append(f'id="{_edge_id(e.transitions)}"')
-                out.append(f"  {e.tail.ref()} -> {_q(join)} [{', '.join(attrs)}];")
-            attrs = [f"label={_left(label)}", f"tooltip={_q(chr(10).join(e.full for e in group))}"]
+                out.append(f"  {e.tail.ref()} -> {quote(join)} [{', '.join(attrs)}];")
+            attrs = [f"label={left_quote(label)}", f"tooltip={quote(chr(10).join(e.full for e in group))}"]
             attrs += self.clip_attrs(_End(join), head) + colour
             attrs.append(f'id="{_edge_id(all_ids)}-join"')
-            out.append(f"  {_q(join)} -> {head.ref()} [{', '.join(attrs)}];")
+            out.append(f"  {quote(join)} -> {head.ref()} [{', '.join(attrs)}];")
         return out
 
     def scope_of(self, states: list[str]) -> str | None:
@@ -464,9 +279,9 @@ class _Picture:
     def clip_attrs(tail: _End, head: _End) -> list[str]:
         attrs = []
         if tail.cluster:
-            attrs.append(f"ltail={_q(tail.cluster)}")
+            attrs.append(f"ltail={quote(tail.cluster)}")
         if head.cluster:
-            attrs.append(f"lhead={_q(head.cluster)}")
+            attrs.append(f"lhead={quote(head.cluster)}")
         return attrs
 
     # -- states
@@ -509,13 +324,13 @@ class _Picture:
             if initial is not None:
                 self.features.add("initial")
                 start = f"{parent.id}__start" if parent else "__start__"
-                out.append(f'{indent}{_q(start)} [shape="point", width="0.12", fillcolor="black", label=""];')
+                out.append(f'{indent}{quote(start)} [shape="point", width="0.12", fillcolor="black", label=""];')
                 target = initial.id
                 lhead = ""
                 if initial.id not in self.view.closed and initial.is_compound:
                     target = f"{initial.id}__start" if not initial.parallel else initial.id
-                    lhead = f', lhead={_q("cluster_" + initial.id)}'
-                out.append(f"{indent}{_q(start)} -> {_q(target)} [weight=\"10\"{lhead}];")
+                    lhead = f', lhead={quote("cluster_" + initial.id)}'
+                out.append(f"{indent}{quote(start)} -> {quote(target)} [weight=\"10\"{lhead}];")
         for state in states:
             is_active = state.id in self.active
             if is_active:
@@ -526,46 +341,46 @@ class _Picture:
                 ports = self.port_rows(state.id)
                 # closed, as Stateflow draws a subchart: its name and ports; its own actions in its
                 # tooltip and in its own picture
-                attrs = [f"label={_closed_label(state.label, [], ports)}",
+                attrs = [f"label={closed_label(state.label, [], ports)}",
                          f'fillcolor="{ACTIVE_FILL if is_active else CLOSED_FILL}"', 'penwidth="2"',
                          f'URL="{self.structure.name}.{state.id}.svg"',
-                         f"tooltip={_q('sub-chart ' + self.tooltip(state))}",
+                         f"tooltip={quote('sub-chart ' + self.tooltip(state))}",
                          state_id]
-                out.append(f"{indent}{_q(state.id)} [{', '.join(attrs)}];")
+                out.append(f"{indent}{quote(state.id)} [{', '.join(attrs)}];")
             elif state.is_compound:
                 style = "rounded,dashed" if parent is not None and parent.parallel else "rounded"
-                attrs = [f"label={_html_label(state.label, self.lines_of(state))}",
-                         f"tooltip={_q(self.tooltip(state))}",
-                         f"style={_q(style + (',filled' if is_active else ''))}", 'labeljust="c"', state_id]
+                attrs = [f"label={html_label(state.label, self.lines_of(state))}",
+                         f"tooltip={quote(self.tooltip(state))}",
+                         f"style={quote(style + (',filled' if is_active else ''))}", 'labeljust="c"', state_id]
                 if is_active:
                     attrs += [f'fillcolor="{ACTIVE_CLUSTER_FILL}"', 'penwidth="2.5"']
-                out.append(f"{indent}subgraph {_q('cluster_' + state.id)} {{")
+                out.append(f"{indent}subgraph {quote('cluster_' + state.id)} {{")
                 out.extend(f"{indent}  {a};" for a in attrs)
                 # Invisible anchor: edges to and from the compound start or end here.
-                out.append(f'{indent}  {_q(state.id)} [shape="point", style="invis", width="0",'
+                out.append(f'{indent}  {quote(state.id)} [shape="point", style="invis", width="0",'
                            ' height="0", label=""];')
                 out.extend(self.state_lines([self.by_id[c] for c in state.children], indent + "  ", state))
                 out.extend(f"{indent}  {line}" for line in self.junctions.get(state.id, []))
                 out.append(f"{indent}}}")
             elif state.junction:
                 self.features.add("connective")
-                out.append(f'{indent}{_q(state.id)} [label="", shape="circle", width="0.16", height="0.16",'
+                out.append(f'{indent}{quote(state.id)} [label="", shape="circle", width="0.16", height="0.16",'
                            f' fixedsize="true", style="filled", fillcolor="white", penwidth="1.5",'
                            f' tooltip="junction {state.id}", {state_id}];')
             elif state.history:
                 self.features.add("history")
-                out.append(f'{indent}{_q(state.id)} [label={_q(state.label)}, shape="circle",'
+                out.append(f'{indent}{quote(state.id)} [label={quote(state.label)}, shape="circle",'
                            f' width="0.3", fixedsize="true", {state_id}];')
             else:
-                attrs = [f"label={_html_label(state.label, self.lines_of(state))}",
-                         f"tooltip={_q(self.tooltip(state))}"]
+                attrs = [f"label={html_label(state.label, self.lines_of(state))}",
+                         f"tooltip={quote(self.tooltip(state))}"]
                 if state.final:
                     self.features.add("final")
                     attrs.append('peripheries="2"')
                 if is_active:
                     attrs += [f'fillcolor="{ACTIVE_FILL}"', 'penwidth="2.5"']
                 attrs.append(state_id)
-                out.append(f"{indent}{_q(state.id)} [{', '.join(attrs)}];")
+                out.append(f"{indent}{quote(state.id)} [{', '.join(attrs)}];")
         return out
 
     def _order(self, state_id: str) -> int:
@@ -576,9 +391,9 @@ class _Picture:
         for state_id in sorted(self.stubs, key=self._order):
             self.features.add("stub")
             state = self.by_id[state_id]
-            where = f'<br/><font point-size="9">in {_html(state.parent)}</font>' if state.parent else ""
+            where = f'<br/><font point-size="9">in {html(state.parent)}</font>' if state.parent else ""
             out.append(
-                f'  {_q("stub__" + state_id)} [label=<<i>{_html(state.label)}</i>{where}>, style="rounded,dashed",'
+                f'  {quote("stub__" + state_id)} [label=<<i>{html(state.label)}</i>{where}>, style="rounded,dashed",'
                 f' color="{STUB_COLOR}", fontcolor="{STUB_COLOR}", URL="{self.picture_of(state_id)}",'
                 f' tooltip="{state_id}: open its picture", id="stub-{state_id}"];'
             )
@@ -597,15 +412,15 @@ class _Picture:
         has_subcharts = any(x.parent is None and x.is_compound for x in s.states)
         rankdir = "TB" if has_subcharts else "LR"
         head = [
-            f"digraph {_q(self.view.file_stem(s.name))} {{",
-            f"  graph [label={_title(self.view.title(s.name))}, labelloc=\"t\","
-            f' labeljust="l", fontname={_q(FONT)}, fontsize="10", rankdir="{rankdir}", compound="true",'
+            f"digraph {quote(self.view.file_stem(s.name))} {{",
+            f"  graph [label={title_label(self.view.title(s.name))}, labelloc=\"t\","
+            f' labeljust="l", fontname={quote(FONT)}, fontsize="10", rankdir="{rankdir}", compound="true",'
             ' nodesep="0.35", ranksep="0.45"];',
-            f'  node [fontname={_q(FONT)}, fontsize="10", shape="box", style="rounded,filled",'
+            f'  node [fontname={quote(FONT)}, fontsize="10", shape="box", style="rounded,filled",'
             ' fillcolor="white", penwidth="1.5"];',
             # decorate: a label is underlined and tied to its edge by a line, so a guard placed
             # away from a crowded edge still says which edge it belongs to
-            f'  edge [fontname={_q(FONT)}, fontsize="9", decorate="true"];',
+            f'  edge [fontname={quote(FONT)}, fontsize="9", decorate="true"];',
         ]
         return "\n".join(head + body + ["}"]) + "\n"
 

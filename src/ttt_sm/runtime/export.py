@@ -1,6 +1,6 @@
 """Write chart diagrams to files and tell when a diagrams folder is stale.
 
-For each chart ``<Name>`` and each of its pictures (:func:`~.dot.views`: the whole
+For each chart ``<Name>`` and each of its pictures (:func:`~.dot_views.views`: the whole
 chart ``<Name>``; with sub-charts also ``<Name>.overview`` and one
 ``<Name>.<sub-chart>`` each): ``.dot`` (Graphviz source), ``.svg`` and ``.png``
 (rendered by Graphviz ``dot``); and ``<Name>.md`` (the pictures, the Mermaid
@@ -32,7 +32,9 @@ from statemachine import StateChart
 
 from ..files import write_atomic
 from .diagram import active_ids, chart_class, to_markdown, to_mermaid
-from .dot import WHOLE, View, legend_features, legend_markdown, to_dot, views
+from .dot import legend_features, to_dot
+from .dot_text import legend_markdown
+from .dot_views import WHOLE, View, views
 from .errors import GraphvizMissingError
 
 Chart = StateChart | type[StateChart]
@@ -116,7 +118,7 @@ def render_active(chart: StateChart, fmt: str = "svg", view: View = WHOLE) -> st
     """The chart's diagram with its active states highlighted, now.
 
     ``fmt`` is ``"dot"``, ``"mermaid"`` or ``"svg"`` (text) or ``"png"`` (bytes);
-    ``view`` one of :func:`~.dot.views` (Graphviz formats; a closed sub-chart is
+    ``view`` one of :func:`~.dot_views.views` (Graphviz formats; a closed sub-chart is
     highlighted while a state inside it is active).
     """
     active = active_ids(chart)

@@ -1,7 +1,7 @@
 """Breadth-first search over a chart's behaviour, by running it: which input steps take which transitions.
 
-A **path** is a list of :class:`Step`: set some inputs, maybe post an event,
-then tick the chart until it takes a transition (at most
+A **path** is a list of :class:`~.paths.Step` (:mod:`.paths` runs one): set
+some inputs, maybe post an event, then tick the chart until it takes a transition (at most
 :attr:`Bounds.max_ticks` chart steps).  The search runs the chart alone, as
 bare-chart mode does (docs/scenarios.md, "Bare-chart mode"): built with the
 arm's chart period, nothing feeding its inputs.  A chart cannot be copied, so
@@ -33,22 +33,19 @@ import itertools
 import math
 import time
 from collections import deque
-from collections.abc import Container, Iterable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Container, Iterable
+from dataclasses import dataclass
 from typing import Any
 
 from ..runtime import TickChart
 from ..runtime.structure import TransitionInfo
 from ..runtime.temporal import duration_of, temporal_of
 from .guard_reader import GuardReader, Node, Setting, atoms, has_clock, kleene, refs, settings_for
-from .model import chart_states
-from .runner import StateLog
+from .paths import Sim, Step, same_value
 
 #: How many comparisons of one decision the truth table enumerates (2**n combinations); above it,
 #: only each comparison alone.
 MAX_TABLE_ATOMS = 6
-#: A step that takes no transition ends once what the guards read stood still this many chart steps.
-STILL_TICKS = 512
 
 
 @dataclass(frozen=True)
@@ -61,128 +58,10 @@ class Bounds:
     time_s: float = 120.0  #: wall-clock limit of one search: a safety net (the nodes bound the search)
 
 
-@dataclass(frozen=True)
-class Step:
-    """One step of a path: inputs set, an event posted, then ``ticks`` chart steps.
-
-    ``why`` says where each input value came from; ``taken`` (the labels of the
-    transitions the step took), ``active`` (the leaf states after it) and
-    ``outputs`` (the outputs it changed, and the local data other than measured
-    quantities, with their new values) are what running it did.
-    """
-
-    sets: tuple[tuple[str, Any], ...] = ()
-    events: tuple[str, ...] = ()
-    ticks: int = 0
-    why: tuple[str, ...] = ()
-    taken: tuple[str, ...] = ()
-    active: tuple[str, ...] = ()
-    outputs: tuple[tuple[str, Any], ...] = ()
-    entered: tuple[str, ...] = ()  #: the leaf states it entered, in order
-
-
-@dataclass
-class Sim:
-    """One bare chart, run from power-on through steps."""
-
-    cls: type[TickChart]
-    dt: float
-    chart: TickChart = field(init=False)
-    log: StateLog = field(init=False)
-    taken: list[str] = field(init=False, default_factory=list)
-    _log_start: int = field(init=False, default=0)
-
-    def __post_init__(self) -> None:
-        self.log = StateLog()
-        labels = self.cls.structure().by_transition
-
-        class Taken:
-            @staticmethod
-            def after_transition(machine: TickChart, transition: Any) -> None:
-                info = labels.get(id(transition))
-                if info is not None:
-                    self.taken.append(info.label)
-
-        self.chart = self.cls(tick_period_s=self.dt, chart_name=self.cls.__name__, listeners=[self.log, Taken()])
-        self.log.record_initial([self.chart])
-
-    def replay(self, path: Iterable[Step]) -> Sim:
-        for step in path:
-            self._start(step)
-            for _ in range(step.ticks):
-                self.chart.tick()
-        return self
-
-    def _start(self, step: Step) -> None:
-        if step.sets:
-            self.chart.set_inputs(**dict(step.sets))
-        for event in step.events:
-            self.chart.post(event)
-
-    def run(self, step: Step, max_ticks: int, clock: float, watch: Sequence[str] = ()) -> Step | None:
-        """Run a new step: tick until a transition is taken; None if none is within ``max_ticks``.
-
-        Past ``clock`` ticks (when the temporal operators of the active states change no more) a step
-        also ends without a transition once the data its guards read (``watch``; all data if empty)
-        stood still for :data:`STILL_TICKS` chart steps: waiting longer would change nothing they see.
-        """
-        before = self.chart.snapshot(("output", "local"))
-        self._start(step)
-        start = len(self.taken)
-        self._log_start = len(self.log.entries[self.cls.__name__])
-        data = self.chart.data_mapping()
-        names = tuple(watch) or tuple(data)
-        previous: tuple[Any, ...] | None = None
-        still_since = 0
-        for n in range(1, max_ticks + 1):
-            self.chart.tick()
-            if len(self.taken) > start:
-                return self._done(step, n, start, before)
-            if n > clock and n % 64 == 0:
-                now = tuple("nan" if isinstance(v, float) and math.isnan(v) else v
-                            for v in map(data.__getitem__, names))
-                if now != previous:
-                    previous, still_since = now, n
-                elif n - still_since >= STILL_TICKS:
-                    return None
-        return None
-
-    def hold(self, step: Step) -> Step:
-        """A step that only sets inputs: no chart step runs (what a later step needs may be more)."""
-        before = self.chart.snapshot(("output", "local"))
-        self._log_start = len(self.log.entries[self.cls.__name__])
-        self._start(step)
-        return self._done(step, 0, len(self.taken), before)
-
-    def _done(self, step: Step, ticks: int, start: int, before: dict[str, Any]) -> Step:
-        kinds = chart_states(self.cls)
-        outputs = {d.name for d in self.cls.declarations() if d.kind == "output"}
-        after = self.chart.snapshot(("output", "local"))
-        # what a step is checked by: the outputs it changed, and the counters and flags of its own data
-        changed = tuple((k, v) for k, v in after.items() if not _same(v, before.get(k))
-                        and (k in outputs or not isinstance(v, float)))
-        leaves = tuple(s for s in self.chart.configuration_values if kinds.get(s) == "leaf")
-        entered = tuple(e.state for e in self.log.entries[self.cls.__name__][self._log_start:]
-                        if kinds.get(e.state) == "leaf")
-        return Step(step.sets, step.events, ticks, step.why, tuple(dict.fromkeys(self.taken[start:])),
-                    leaves, changed, entered)
-
-    def leaf_sequence(self) -> list[str]:
-        """The leaf states entered since power-on, as ``expect_states`` with ``match: exact`` sees them."""
-        kinds = chart_states(self.cls)
-        return [e.state for e in self.log.entries[self.cls.__name__] if kinds.get(e.state) == "leaf"]
-
-
 def has_clock_spec(spec: Any) -> bool:
     """Whether a guard spec is a temporal operator or a ``duration``."""
     func = getattr(spec, "func", None)
     return temporal_of(func) is not None or duration_of(func) is not None
-
-
-def _same(a: Any, b: Any) -> bool:
-    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
-        return True
-    return bool(a == b) and type(a) is type(b)
 
 
 @dataclass(frozen=True)
@@ -279,7 +158,7 @@ class Explorer:
         waiting = self._predict(groups, None, data)
 
         def add(values: dict[str, Any], events: tuple[str, ...], why: Iterable[str], action: bool = False) -> None:
-            sets = tuple(sorted((k, v) for k, v in values.items() if not _same(v, data.get(k))))
+            sets = tuple(sorted((k, v) for k, v in values.items() if not same_value(v, data.get(k))))
             # settings that change no decision the same way are one candidate (the first: the fewest changes);
             # one that changes what an action does is its own
             trial = {**data, **dict(sets)}
@@ -379,13 +258,13 @@ class Explorer:
                 if setting is None:
                     continue
                 for k, v in setting.values:
-                    conflict |= k in values and not _same(values[k], v)
+                    conflict |= k in values and not same_value(values[k], v)
                     values[k] = v
                 why.append(setting.why)
             if conflict:
                 continue
             trial = {**data, **values}
-            changes = sum(not _same(v, data.get(k)) for k, v in values.items())
+            changes = sum(not same_value(v, data.get(k)) for k, v in values.items())
             blocked = False  # a transition before it may hold
             for t in ts:
                 truth = kleene(self.guards[t.label], trial, self.free)

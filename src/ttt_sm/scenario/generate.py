@@ -36,8 +36,9 @@ from ..files import write_atomic
 from ..runtime import TickChart
 from ..runtime.jsonable import dumps
 from ..runtime.structure import TransitionInfo
-from .explore import Bounds, Explorer, Sim, Step
+from .explore import Bounds, Explorer
 from .guard_reader import atoms, kleene, refs, show, show_value
+from .paths import Sim, Step
 
 STRATEGIES = ("shortest", "tour")
 #: How many nodes the greedy tours may search in all, and each extension of a tour (nodes, not seconds:

@@ -27,8 +27,9 @@ from .errors import (
     SerialLinkError,
 )
 from .framing import LineFramer, Rejection
+from .link import LinkStats, ReconnectPolicy
 from .protocol import CELLS, MAX_SENTENCE_BYTES, Frame, Level, Status, crc16, decode_line, encode_frame, encode_status
-from .reader import LinkStats, ReconnectPolicy, SerialCameraReader
+from .reader import SerialCameraReader
 from .sources import board_source, detection_source, parse_board
 
 __all__ = [

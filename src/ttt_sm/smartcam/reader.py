@@ -31,7 +31,6 @@ import os
 import time
 from collections import deque
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
 from typing import TypeAlias
 
 import serial
@@ -39,6 +38,7 @@ import serial
 from .burst_log import BurstLog
 from .errors import CameraSilent, FrameError, LinkLost, PortUnavailable, Reason, SerialLinkError, snippet
 from .framing import LineFramer, Rejection
+from .link import LinkCounters, LinkStats, ReconnectPolicy
 from .protocol import SEQ_MODULUS, Frame, Level, Status, decode_line
 
 PortSpec: TypeAlias = "str | serial.SerialBase | Callable[[], serial.SerialBase]"
@@ -49,76 +49,6 @@ symlink, ``socket://host:port``, ``spy:///dev/pts/3``), a ``serial.Serial``
 _CHUNK = 4096
 _LOG = logging.getLogger(__name__)
 
-
-@dataclass(frozen=True)
-class ReconnectPolicy:
-    """How hard the reader tries to (re)open the port: exponential backoff, bounded in count and time.
-
-    Attempt ``k`` (0-based) waits ``min(max_delay_s, first_delay_s * factor**k)``
-    after the previous one; the reader gives up after ``max_attempts`` failed
-    opens or ``max_duration_s`` since the link went down, whichever comes first.
-    """
-
-    first_delay_s: float = 0.05
-    max_delay_s: float = 1.0
-    factor: float = 2.0
-    max_attempts: int = 100
-    max_duration_s: float = 60.0
-
-    def __post_init__(self) -> None:
-        if not (0 <= self.first_delay_s <= self.max_delay_s) or self.factor < 1:
-            raise ValueError(f"reconnect policy needs 0 <= first_delay_s <= max_delay_s and factor >= 1, got {self}")
-        if self.max_attempts < 1 or not self.max_duration_s >= 0:
-            raise ValueError(f"reconnect policy needs max_attempts >= 1 and max_duration_s >= 0, got {self}")
-
-    def delay_s(self, attempt: int) -> float:
-        """Wait before attempt ``attempt + 1``, seconds."""
-        return float(min(self.max_delay_s, self.first_delay_s * self.factor ** min(attempt, 64)))
-
-
-@dataclass(frozen=True)
-class LinkStats:
-    """A snapshot of what the reader has seen (counts since it was made)."""
-
-    frames_ok: int
-    rejected: dict[str, int]
-    """Rejected lines (and garbage runs) by :class:`~.errors.Reason` value."""
-    gaps: int
-    """Times the sequence number jumped forward by more than one."""
-    frames_missed: int
-    """Frames the gaps skipped, in total."""
-    duplicates: int
-    seq_restarts: int
-    """Times the sequence number went back (the camera restarted)."""
-    disconnects: int
-    reconnects: int
-    silences: int
-    """Times the port stayed open but no valid frame came for ``silence_s``."""
-    statuses: int
-    garbage_bytes: int
-    skipped_bytes: int
-    """Bytes dropped after an open up to the first '$' (the end of a line sent before the port opened)."""
-    bytes_read: int
-
-    @property
-    def rejected_total(self) -> int:
-        return sum(self.rejected.values())
-
-
-@dataclass
-class _Counters:
-    frames_ok: int = 0
-    rejected: dict[str, int] = field(default_factory=dict)
-    gaps: int = 0
-    frames_missed: int = 0
-    duplicates: int = 0
-    seq_restarts: int = 0
-    disconnects: int = 0
-    reconnects: int = 0
-    silences: int = 0
-    statuses: int = 0
-    garbage_bytes: int = 0
-    bytes_read: int = 0
 
 
 class SerialCameraReader:
@@ -184,7 +114,7 @@ class SerialCameraReader:
         self._expected_since = 0.0
         self._silent = False
         self._last_seq: int | None = None
-        self._n = _Counters()
+        self._n = LinkCounters()
         self._burst = BurstLog(self._log, self.port_name, self._summary)
         self.last_status: Status | None = None
         """The latest status line from the camera, if any."""
@@ -302,10 +232,7 @@ class SerialCameraReader:
     @property
     def stats(self) -> LinkStats:
         """Counts so far (a snapshot)."""
-        n = self._n
-        return LinkStats(n.frames_ok, dict(n.rejected), n.gaps, n.frames_missed, n.duplicates, n.seq_restarts,
-                         n.disconnects, n.reconnects, n.silences, n.statuses, n.garbage_bytes,
-                         self._framer.skipped, n.bytes_read)
+        return self._n.snapshot(self._framer.skipped)
 
     # -- one step: read a chunk, or try to (re)open --------------------------
 

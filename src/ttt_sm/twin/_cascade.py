@@ -84,7 +84,7 @@ from .layout import (
     MODE_OPEN,
 )
 
-# the offsets above, and the servo's formula from params.py, are frozen into the cached machine code:
+# the offsets above, and the servo's formula from params/values.py, are frozen into the cached machine code:
 # recompile when either changes
 layout.forget_stale_compilations(__file__, servo_duty.__code__.co_filename)
 
@@ -94,7 +94,7 @@ def _clip(x: float, lo: float, hi: float) -> float:
     return lo if x < lo else (hi if x > hi else x)
 
 
-#: ``params.servo_duty`` compiled: the servo's calibration, one definition for params.py and this step.
+#: ``params.servo_duty`` compiled: the servo's calibration, one definition for params/values.py and this step.
 servo_duty_compiled = njit(cache=True, inline="always")(servo_duty)
 
 

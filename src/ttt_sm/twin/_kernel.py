@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from .. import params
+from ..params import values as servo_formula
 from . import _cascade, _plant, layout
 from ._cascade import cascade_step
 from ._plant import plant_step
@@ -80,11 +80,11 @@ def _sources_fingerprint() -> str:
 
     numba's disk cache checks only the file of the function it caches: after
     an edit of ``_cascade.py``, ``_plant.py``, ``layout.py`` or the servo's
-    calibration in ``params.py`` alone it would load the fused loop compiled
+    calibration in ``params/values.py`` alone it would load the fused loop compiled
     from the old code.  Its cache key includes the contents of the
     function's closure, so the loop closes over this fingerprint.
     """
-    return layout.fingerprint(*(str(m.__file__) for m in (_cascade, _plant, layout, params)))
+    return layout.fingerprint(*(str(m.__file__) for m in (_cascade, _plant, layout, servo_formula)))
 
 
 def _compile_run_steps(fingerprint: str) -> Any:

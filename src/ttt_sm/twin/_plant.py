@@ -101,7 +101,7 @@ from .layout import (
     PS_WQ,
 )
 
-# the offsets above, and the servo's formula from params.py, are frozen into the cached machine code:
+# the offsets above, and the servo's formula from params/values.py, are frozen into the cached machine code:
 # recompile when either changes
 layout.forget_stale_compilations(__file__, servo_angle.__code__.co_filename)
 
@@ -223,7 +223,7 @@ def _integrate_drive(d: int, n_sub: int, h: float, tau0: float, dtau_dq: float, 
     pi[d, PI_AT_LIMIT] = lim
 
 
-#: ``params.servo_angle`` compiled: the servo's calibration, one definition for params.py and this step.
+#: ``params.servo_angle`` compiled: the servo's calibration, one definition for params/values.py and this step.
 servo_angle_compiled = njit(cache=True, inline="always")(servo_angle)
 
 

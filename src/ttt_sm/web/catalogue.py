@@ -16,7 +16,7 @@ from typing import Any
 from ..debug.debugger import Debugger
 from ..debug.views import SIGNAL_DOCS, SIGNAL_UNITS
 from ..runtime import Data, TickChart
-from ..runtime.dot import subcharts, views
+from ..runtime.dot_views import subcharts, views
 from ..runtime.structure import ChartStructure
 
 #: Signals that only a simulation has (the twin's ground truth): labelled so in the pages.
@@ -91,7 +91,7 @@ def describe_datum(d: Data) -> dict[str, Any]:
 
 
 def view_list(chart: TickChart | type[TickChart]) -> list[dict[str, str]]:
-    """The pictures of a chart (:func:`~ttt_sm.runtime.dot.views`) as the pages offer them."""
+    """The pictures of a chart (:func:`~ttt_sm.runtime.dot_views.views`) as the pages offer them."""
     out = []
     cls = chart if isinstance(chart, type) else type(chart)
     for v in views(cls):

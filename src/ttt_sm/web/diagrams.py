@@ -31,7 +31,9 @@ from collections import OrderedDict
 from xml.dom import minidom
 
 from ..runtime import TickChart
-from ..runtime.dot import WHOLE, View, legend_dot, legend_features, overview_with, subcharts, to_dot
+from ..runtime.dot import legend_features, to_dot
+from ..runtime.dot_text import legend_dot
+from ..runtime.dot_views import WHOLE, View, overview_with, subcharts
 from ..runtime.export import svg_from_dot
 from ..runtime.structure import ChartStructure
 from .catalogue import qualified_names, transition_name

@@ -48,8 +48,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from ..app.drawing import DrawError, DrawRecord, RecordStage, measure
+from ..app.drawing import DrawError, measure
 from ..app.precision import AXES, STEP_KINDS, PrecisionError, Staircase, staircase_playing
+from ..app.recorders import DrawRecord, RecordStage
 from ..app.robot import Robot
 from ..debug.debugger import Debugger
 from ..sched.scheduler import Signals
@@ -128,7 +129,7 @@ class OperateStage:
         self.robot = robot
         self.control = robot.control
         self.arm = robot.arm
-        self.recorder = RecordStage(robot) if robot.truth is not None else None
+        self.recorder = RecordStage(robot, robot.truth) if robot.truth is not None else None
         self.every = max(1, round(SAMPLE_PERIOD_S / robot.params.control.chart_dt))
         self.ticks = 0
         #: The Control chart has waited at its waiting pose once: the arm is initialised and placed.

@@ -339,7 +339,10 @@ def wiring_section(pictures: Pictures) -> str:
 #: every figure and equation).  Each module named here is checked to exist when the page is drawn.
 THESIS_MODULES: tuple[tuple[str, str, str], ...] = (
     ("§3.1.2, figs. 3.2-3.4", "the drive-initialisation charts", "ttt_sm.charts.drive_init"),
-    ("§3.6.1, figs. 3.23-3.27", "the Control chart: field, X, four-arc O, erase, finish", "ttt_sm.charts.control"),
+    ("§3.6.1, figs. 3.23-3.25", "the Control chart: its sub-charts, start_stop, wait_1", "ttt_sm.charts.control"),
+    ("§3.6.1, figs. 3.26-3.27", "its drawing sub-charts: the field, the X, the four-arc O (and the sine)",
+     "ttt_sm.charts.control_drawing"),
+    ("§3.6.1 (Erase)", "its erasing and finishing sub-charts", "ttt_sm.charts.control_erase"),
     ("eqs. 3.36-3.51", "the geometry of the field, the X and the O", "ttt_sm.charts.geometry"),
     ("§3.6.2, fig. 3.30", "the algorithm activator and the game flow", "ttt_sm.charts.game"),
     ("(Stateflow)", "how every chart runs: one wake-up, junctions, local events, temporal logic",
@@ -351,7 +354,7 @@ THESIS_MODULES: tuple[tuple[str, str, str], ...] = (
     ("§3.2 (gains)", "the gains, designed with python-control, and their margins", "ttt_sm.twin.tuning"),
     ("figs. 3.7-3.9", "step responses of drives 1-3", "ttt_sm.twin.step_response"),
     ("fig. 3.25 (fr_sw)", "the setpoint filters and their cut-off switch", "ttt_sm.twin.gains"),
-    ("§3.3", "the pen servo's duty and angle", "ttt_sm.params"),
+    ("§3.3", "the pen servo's duty and angle", "ttt_sm.params.values"),
     ("(the loop's memory)", "the layouts of the controller's and the plant's flat arrays", "ttt_sm.twin.layout"),
     ("§3.1.2 note (1 kHz, charts at half rate)", "controller and plant fused in one compiled loop",
      "ttt_sm.twin._kernel"),
@@ -382,7 +385,7 @@ def thesis_section(pictures: Pictures) -> str:
 Where the thesis' parts live (docs/thesis_map.md maps every figure and
 equation). The cascade loop spans several modules on purpose: one
 definition of each formula (`ttt_sm.twin._cascade` for the controller step and
-the setpoint filter, `ttt_sm.twin._plant` for gravity, `ttt_sm.params` for the
+the setpoint filter, `ttt_sm.twin._plant` for gravity, `ttt_sm.params.values` for the
 servo), one table of each memory layout (`ttt_sm.twin.layout`), the design of
 the gains apart from the step that uses them (`ttt_sm.twin.tuning`,
 `ttt_sm.twin.gains`), and the loop that fuses controller and plant

@@ -18,6 +18,7 @@ from __future__ import annotations
 import ast
 import functools
 import inspect
+import re
 import textwrap
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -407,6 +408,8 @@ so that a stale copy fails rather than drifts:
 #: Above this many lines a module is flagged in the module map: a file that grows past a few hundred lines
 #: usually holds two ideas.
 LONG_MODULE = 500
+#: A full stop that ends a sentence: not the one of "figs.", "eq.", "e.g." or "i.e.".
+_SENTENCE_END = re.compile(r"(?<!\bfigs)(?<!\bfig)(?<!\beqs)(?<!\beq)(?<!\be\.g)(?<!\bi\.e)\.\s")
 
 
 def _module_summary(path: Path) -> tuple[int, str]:
@@ -414,8 +417,8 @@ def _module_summary(path: Path) -> tuple[int, str]:
     text = path.read_text(encoding="utf-8")
     doc = ast.get_docstring(ast.parse(text)) or ""
     first = " ".join(doc.strip().split("\n\n")[0].split())
-    cut = first.find(". ")
-    return len(text.splitlines()), (first[:cut + 1] if cut >= 0 else first).replace("|", "\\|")
+    end = _SENTENCE_END.search(first)
+    return len(text.splitlines()), (first[:end.start() + 1] if end else first).replace("|", "\\|")
 
 
 def modules_section(pictures: Pictures) -> str:

@@ -18,7 +18,8 @@ import time
 import pytest
 
 from ttt_sm.hardware.emulator import ArmEmulator
-from ttt_sm.hardware.serial_arm import HEARTBEAT_PERIOD_S, KEEPER_TICK_S, LINK_TIMEOUT_S, SerialArm
+from ttt_sm.hardware.firmware_link import HEARTBEAT_PERIOD_S, KEEPER_TICK_S, LINK_TIMEOUT_S
+from ttt_sm.hardware.serial_arm import SerialArm
 from ttt_sm.twin.plant import REST_POSE
 from ttt_sm.twin.workspace import load_arm
 

@@ -19,7 +19,7 @@ import pytest
 from ttt_sm.app.robot import Robot
 from ttt_sm.cli import main
 from ttt_sm.faults.link import LinkTap
-from ttt_sm.hardware import serial_arm as SA
+from ttt_sm.hardware import firmware_link as FL
 from ttt_sm.hardware.emulator import ArmEmulator
 from ttt_sm.hardware.serial_arm import SerialArm
 from ttt_sm.twin.plant import REST_POSE
@@ -87,7 +87,7 @@ def test_a_cut_link_stops_the_robot_with_its_reason_and_reset_rearms_the_firmwar
 
 def test_a_game_whose_link_is_cut_ends_with_one_error_line_and_the_reason_in_its_record(tapped, tmp_path, capsys,
                                                                                           monkeypatch):
-    monkeypatch.setattr(SA, "GATED_TIMEOUT_S", GATED_S)
+    monkeypatch.setattr(FL, "GATED_TIMEOUT_S", GATED_S)
     arms: list[SerialArm] = []  # the PC's side of the link, as `play` builds it
     init = SerialArm.__init__
 

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from ttt_sm.arm import Arm
+from ttt_sm.faults.link import PaceProbe
 from ttt_sm.hardware import link as L
 from ttt_sm.hardware.emulator import ArmEmulator
 from ttt_sm.hardware.native import WATCHDOG_S
@@ -116,31 +117,6 @@ def test_the_pc_declares_the_link_lost_when_the_firmware_falls_silent(emulator, 
         arm.close()
 
 
-class SleepProbe:
-    """A thread that sleeps 1 ms at a time while it runs and keeps how late it woke up at the worst, s: how far
-    this machine held a process of this test up (a loaded machine), which a real-time case cannot tell from a
-    fault of the link."""
-
-    def __init__(self) -> None:
-        self.max_late_s = 0.0
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
-
-    def _run(self) -> None:
-        while not self._stop.is_set():
-            t0 = time.monotonic()
-            time.sleep(0.001)
-            self.max_late_s = max(self.max_late_s, time.monotonic() - t0 - 0.001)
-
-    def __enter__(self) -> SleepProbe:
-        self._thread.start()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self._stop.set()
-        self._thread.join()
-
-
 def test_in_realtime_the_firmware_stops_the_arm_when_the_pc_falls_silent(tmp_path, firmware_libs, gains):
     with ArmEmulator(P, pace="realtime", link=tmp_path / "arm", cache=firmware_libs["float"].path.parent) as emu:
         arm = SerialArm(emu.port, P, gains, servo_angle=REST_POSE[3], link_timeout_s=PATIENT_S)
@@ -151,7 +127,7 @@ def test_in_realtime_the_firmware_stops_the_arm_when_the_pc_falls_silent(tmp_pat
             fw = emu.firmware
             assert fw.state == 2 and fw.steps > 50 and fw.setpoints_ok <= 1
             late = fw.rejections()[L.Reason.LATE]
-            with SleepProbe() as probe:
+            with PaceProbe() as probe:
                 rearmed = arm.rearm()  # START again, then 0.2 s of setpoints in real time while the drives settle
             if not rearmed and (fw.rejections()[L.Reason.LATE] > late or probe.max_late_s > WATCHDOG_S / 2):
                 # the watchdog did its job again: the PC's setpoints came late, or the machine held this process

@@ -47,7 +47,13 @@ def shown_tick(page: Any) -> int:
 
 
 def go_to_tick(page: Any, tick: int) -> None:
-    """Replay to a chart tick with the time slider."""
+    """Replay to a chart tick with the time slider.
+
+    The slider's range is the run so far as the page last heard it: a tick the session has passed
+    but the page not yet shown would be clamped to the old end (seen once in CI), so this waits for
+    the range to reach the tick first, as a person would see the knob's track grow.
+    """
+    page.wait_for_function(f"Number(document.querySelector('[data-role=slider]').max) >= {tick}")
     page.locator('[data-role="slider"]').fill(str(tick))
     page.wait_for_function(f"document.querySelector('[data-role=tick]').textContent === '{tick}'"
                            " && document.querySelector('[data-role=mode]').textContent === 'paused'")

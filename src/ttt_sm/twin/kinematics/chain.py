@@ -125,12 +125,7 @@ def fk(q: Any, geometry: Geometry) -> np.ndarray:
 def arm_points(q: Any, geometry: Geometry) -> np.ndarray:
     """The points along the arm: the column's foot, the shoulder, the elbow, the wrist, the pen tip.
 
-    Parameters
-    ----------
-    q : array_like, shape (4,)
-        Joint angles q1..q4, rad.
-    geometry : Geometry
-        Link lengths, m.
+    Takes the arguments of :func:`fk`.
 
     Returns
     -------
@@ -160,19 +155,9 @@ def arm_points(q: Any, geometry: Geometry) -> np.ndarray:
 def link_points(q: Any, geometry: Geometry) -> np.ndarray:
     """Positions of the elbow (joint 3), the wrist (servo axis) and the pen tip.
 
-    Parameters
-    ----------
-    q : array_like, shape (4,)
-        Joint angles q1..q4, rad.
-    geometry : Geometry
-        Link lengths, m.
-
-    Returns
-    -------
-    np.ndarray, shape (3, 3)
-        Rows elbow, wrist, tip; columns x, y, z (m): the moving points of
-        :func:`arm_points`.  The tip row equals ``fk(q)[:3]``.  Used to keep
-        the whole arm, not only the pen, out of a zone.
+    The moving rows of :func:`arm_points` (same arguments), shape (3, 3): rows
+    elbow, wrist, tip; columns x, y, z (m).  The tip row equals ``fk(q)[:3]``.
+    Used to keep the whole arm, not only the pen, out of a zone.
     """
     return arm_points(q, geometry)[2:]
 

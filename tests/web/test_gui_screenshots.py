@@ -19,6 +19,17 @@ from .test_cockpit_browser import go_to_tick, open_cockpit, show
 SHOTS = ("gui_running.png", "gui_subchart_in_place.png", "gui_click_breakpoint.png", "gui_coverage.png")
 
 
+# For each element `sel` picks in the diagram box: is it whole between the box's left and right edges?
+HORIZONTALLY_WHOLE = """(sel) => {
+  const d = document.querySelector('[data-role=diagram]');
+  const left = d.getBoundingClientRect().left + d.clientLeft;
+  return [...d.querySelectorAll(sel)].map((e) => {
+    const r = e.getBoundingClientRect();
+    return r.left >= left - 0.5 && r.right <= left + d.clientWidth + 0.5;
+  });
+}"""
+
+
 @pytest.fixture
 def folder(tmp_path: Path) -> Path:
     wanted = os.environ.get("TTT_SM_SCREENSHOTS")
@@ -50,6 +61,16 @@ def test_the_screenshots_of_the_guide(browser: Any, cockpit: Cockpit, folder: Pa
         page.locator('[data-role="chart-tabs"]').get_by_role("button", name="Control", exact=True).click()
         page.locator('[data-role="view-bar"]').get_by_role("button", name="Overview").click()
         wait_ready(page)
+        # wider than the box: opened scrolled just enough to show the active state, its title pinned in view
+        assert page.evaluate("(() => { const d = document.querySelector('[data-role=diagram]');"
+                             " return d.scrollWidth > d.clientWidth && d.scrollLeft > 0; })()")
+        assert page.evaluate(HORIZONTALLY_WHOLE, "[data-role=diagram-title]") == [True]
+        assert page.evaluate(HORIZONTALLY_WHOLE, '[data-state-id="Drawing_playing_field"]') == [True]
+        gap = page.evaluate("(() => { const d = document.querySelector('[data-role=diagram]');"
+                            " const s = d.querySelector('[data-state-id=\"Drawing_playing_field\"]');"
+                            " return d.getBoundingClientRect().left + d.clientLeft + d.clientWidth"
+                            " - s.getBoundingClientRect().right; })()")
+        assert 20 <= gap <= 30, gap  # the state at the right with its 24 px margin: no further than it takes
         page.screenshot(path=str(folder / SHOTS[0]))
         # 2. Its sub-chart opened in place
         page.get_by_role("button", name="open sub-chart Drawing_playing_field in place").click()

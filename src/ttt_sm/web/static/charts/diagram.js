@@ -9,6 +9,8 @@
 import { $$, button, role } from "../dom.js";
 import { openMenu } from "./menu.js";
 
+// Room left around an active state scrolled into view, CSS pixels.
+const REVEAL_MARGIN_PX = 24;
 // The smallest a label may be drawn, in CSS pixels: "fit to width" shrinks a picture no further
 // (a quarter pixel to spare: the page's layout rounds the picture's width).
 const MIN_LABEL_PX = 11.25;
@@ -179,7 +181,9 @@ export class DiagramView {
     fitReadable(this.box);
   }
 
-  // A picture larger than its box opens scrolled to its first active state, not to an empty corner.
+  // A picture larger than its box opens scrolled to its first active state, not to an empty corner:
+  // as little as it takes to show that state whole, so the picture's title (top left) stays in view
+  // whenever the state and the title fit in the box together.
   reveal() {
     const box = this.box;
     const active = box.querySelector('[data-state-id][data-active="true"]:not(.cluster)')
@@ -187,8 +191,8 @@ export class DiagramView {
     if (!active || (box.scrollWidth <= box.clientWidth && box.scrollHeight <= box.clientHeight)) return;
     const a = active.getBoundingClientRect();
     const b = box.getBoundingClientRect();
-    box.scrollLeft += a.left + a.width / 2 - (b.left + b.width / 2);
-    box.scrollTop += a.top + a.height / 2 - (b.top + b.height / 2);
+    box.scrollLeft = nearestScroll(box.scrollLeft, a.left - b.left - box.clientLeft, a.width, box.clientWidth);
+    box.scrollTop = nearestScroll(box.scrollTop, a.top - b.top - box.clientTop, a.height, box.clientHeight);
   }
 
   // The legend of what the chart's pictures use: once on the page (collapsible), not in every picture.
@@ -249,15 +253,39 @@ export class DiagramView {
 const SVG_NS = "http://www.w3.org/2000/svg";
 
 // The picture in `box` fits the page's width only as far as its smallest label stays MIN_LABEL_PX
-// high: a large chart is then wider than the page, and the box scrolls (the cockpit, the lab page).
+// high: a large chart is then wider than the page, and the box scrolls (the cockpit, the lab page),
+// its title pinned at the left.
 export function fitReadable(box) {
   const svg = box.querySelector("svg");
   const view = svg && svg.viewBox.baseVal;
   if (!view || !view.width) return;
+  pinTitle(box, svg);
   const sizes = [...svg.querySelectorAll("text")]
     .map((t) => parseFloat(t.getAttribute("font-size"))).filter((x) => x > 0);
   if (!sizes.length) return;
   svg.style.minWidth = `${Math.ceil((view.width * MIN_LABEL_PX) / Math.min(...sizes))}px`;
+}
+
+// The picture's title (Graphviz's graph label, drawn at its top left) as a caption above it that
+// stays in view while a picture wider than the box is scrolled sideways.
+function pinTitle(box, svg) {
+  const title = svg.querySelector("g.graph > text");
+  if (!title) return;
+  const caption = document.createElement("div");
+  caption.className = "diagram-title";
+  caption.dataset.role = "diagram-title";
+  caption.textContent = title.textContent;
+  title.remove();
+  box.prepend(caption);
+}
+
+// The scroll offset nearest the start (0) that shows a thing `size` long, now at `at` from the view's
+// start (scrolled by `scroll`), whole with REVEAL_MARGIN_PX around it in a view `view` long; a thing
+// longer than the view shows its start.
+function nearestScroll(scroll, at, size, view) {
+  const start = scroll + at - REVEAL_MARGIN_PX;
+  const end = scroll + at + size + REVEAL_MARGIN_PX;
+  return Math.max(0, Math.min(start, end - view));
 }
 
 // How often an edge was taken, drawn beside its label ("×3"; at the middle of an edge without one).

@@ -164,7 +164,7 @@ class DebugShell(StopCommands, InputCommands, Completion, cmd.Cmd):
 
     def _tick_s(self) -> float:
         control = self.dbg.robot.params.control
-        return float(control.chart_divider * control.dt)
+        return float(control.chart_dt)
 
     def stopped(self, lines: Iterable[str]) -> None:
         """What a command that moved the robot says: its lines, then the ``display`` expressions."""

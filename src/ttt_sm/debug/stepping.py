@@ -86,7 +86,7 @@ class Stepper:
         """Run up to and through the next ``n`` chart ticks (fewer if a breakpoint hits)."""
         _check_count(n, "tick")
         control = self._robot().params.control
-        seconds = n * control.chart_divider * control.dt
+        seconds = n * control.chart_dt
         self._check_bound(seconds, "tick", f"{n} chart ticks ({seconds:g} s)")
         return self._advance((n + 1) * control.chart_divider, ticks=n, end="done")
 

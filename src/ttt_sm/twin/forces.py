@@ -259,7 +259,7 @@ def force_run(params: ArmParams, a: Any, b: Any, speed: float = DRAW_SPEED_M_S, 
     if not (math.isfinite(speed) and speed > 0.0):
         raise ValueError(f"speed must be a positive number (m/s), got {speed!r}")
     c = params.control
-    dt = c.dt * c.chart_divider
+    dt = c.chart_dt
     zs = params.board.surface_z
     up, down = zs + lift_m, zs - press_m
     pa, pb = (a[0], a[1], up), (b[0], b[1], up)

@@ -23,7 +23,7 @@ def bench_motion_lab(params: ArmParams, seed: int = 0, quick: bool = False) -> d
     cx, cy = b.field_center_x, b.field_center_y
     z = b.surface_z - PRESS_M
     a, e = (cx - 0.025, cy - 0.025, z), (cx + 0.025, cy + 0.025, z)
-    dt = params.control.dt * params.control.chart_divider
+    dt = params.control.chart_dt
     n = int(move_duration(a, e, 0.02) / dt)
     res: dict[str, Any] = {}
     repeat = 20 if quick else 200

@@ -212,7 +212,7 @@ def run_move(params: ArmParams, method: str, a: Any, b: Any, speed: float = DRAW
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     if not (math.isfinite(speed) and speed > 0.0):
         raise ValueError(f"speed must be a positive number (m/s), got {speed!r}")
-    dt = params.control.dt * params.control.chart_divider
+    dt = params.control.chart_dt
     move_s = move_duration(a, b, speed)
     n = int(math.ceil((move_s + hold_s) / dt))
     targets = task_targets(method, a, b, speed, dt, n)

@@ -111,9 +111,9 @@ def drive_problem(params: ArmParams) -> str | None:
     h = c.dt / SUBSTEPS
     for i, d in enumerate(params.drives, start=1):
         where = f"[drive.{i}]"
-        counts = INIT_STILL_SPEED_RAD_S * c.chart_dt * d.encoder_counts * d.gear_ratio / (2 * math.pi)
+        counts = INIT_STILL_SPEED_RAD_S * c.chart_dt / d.rad_per_count
         if counts < INIT_COUNTS_PER_TICK:
-            need = INIT_COUNTS_PER_TICK * 2 * math.pi / (INIT_STILL_SPEED_RAD_S * c.chart_dt * d.encoder_counts)
+            need = d.gear_ratio * INIT_COUNTS_PER_TICK / counts  # counts grow with the gear ratio
             return (f"{where} gear_ratio = {d.gear_ratio:g}: the encoder shows {counts:.2g} counts per chart tick at"
                     f" {INIT_STILL_SPEED_RAD_S:g} rad/s, the initialisation charts need >= {INIT_COUNTS_PER_TICK:g}"
                     f" to tell a turning drive from a stalled one: gear_ratio >= {need:.3g} with encoder_counts ="

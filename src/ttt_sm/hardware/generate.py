@@ -125,19 +125,10 @@ FILES: tuple[tuple[str, Callable[[], str], str], ...] = (
 )
 
 
-def _root(root: Path | None) -> Path:
-    return (firmware_root() if root is None else root).resolve()  # the checkout's firmware/, not a link to it
-
-
 def generated(root: Path | None = None) -> dict[Path, Callable[[], str]]:
     """Every generated source of the firmware: its path, and the function that makes its text."""
-    return {_root(root) / rel: make for rel, make, _ in FILES}
-
-
-def tables(root: Path | None = None) -> dict[Path, str]:
-    """Every generated source of the firmware: its path, and the module whose tables it is made from."""
-    return {_root(root) / rel: source for rel, _, source in FILES}
-
+    root = (firmware_root() if root is None else root).resolve()  # the checkout's firmware/, not a link to it
+    return {root / rel: make for rel, make, _ in FILES}
 
 def stale(root: Path | None = None) -> list[Path]:
     """The generated files that are missing or differ from what their tables make now."""

@@ -203,3 +203,9 @@ def test_a_struct_doc_that_would_close_the_c_comment_is_refused():
     bad = structs.struct("ttt_x", "a struct", [("a", "float", (), "ends */ early")])
     with pytest.raises(ValueError, match="ttt_x.a"):
         generate.structs_h([bad])
+
+
+def test_a_ttt_real_struct_needs_the_builds_real_type():
+    with pytest.raises(ValueError, match="cp: a ttt_real field"):
+        structs.CASCADE.ctypes_fields()
+    assert dict(structs.CASCADE.ctypes_fields(ctypes.c_float))["act"]._type_ is ctypes.c_float

@@ -180,7 +180,7 @@ class NativeCascade:
         self.cp[:] = pc.cp[:, :layout.N_CP]
         self.cg[:] = pc.cg[:layout.N_CG]
         self.cgs[layout.CGS_SV_SET] = servo_angle
-        self._counts = (ctypes.c_int32 * 3)()
+        self._counts = (ctypes.c_int32 * structs.DRIVES)()  # ttt_cascade_step's counts[TTT_DRIVES]
         self._q = (lib.real * 4)()
 
     # numpy views of the struct's blocks (the firmware's own number type)

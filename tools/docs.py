@@ -2,7 +2,7 @@
 
 ``export`` writes the chart diagrams in ``charts/`` (as ``ttt-sm charts
 export`` does), ``docs/architecture.md`` with its pictures, and the firmware's
-generated ``layout.h``; ``check`` lists the files that are stale and exits
+generated headers (``layout.h``, ``structs.h``); ``check`` lists the files that are stale and exits
 with status 1 if there are any.  Run it from the repository's root with the
 repository's Python (``.venv/bin/python -m tools.docs check``) or pass
 ``--root``.  A development tool: the installed package does not carry it (the
@@ -25,7 +25,7 @@ from .architecture.layers import SOURCE_ROOT
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m tools.docs",
-        description="regenerate every generated file (charts/, docs/architecture.md, the firmware's layout.h),"
+        description="regenerate every generated file (charts/, docs/architecture.md, the firmware's headers),"
                     " or check they are up to date")
     parser.add_argument("action", choices=["export", "check"])
     parser.add_argument("--root", default=".", help="the repository's root folder (default: the current folder)")

@@ -3,19 +3,25 @@
 ``firmware/include/ttt_fw/layout.h`` is generated from ``ttt_sm.twin.layout``
 (``python -m ttt_sm.hardware.generate``): the C port of the controller step
 and the PC's compiled step index the same memory because both take their
-offsets from one table.
+offsets from one table.  ``structs.h`` is generated from
+``ttt_sm.hardware.structs``, the table the ctypes Structures of
+``ttt_sm.hardware.native`` are built from: the C compiler's ``offsetof`` and
+``sizeof`` of every field are compared here with ctypes'.
 """
 
 from __future__ import annotations
 
+import ctypes
 import re
 import shutil
+import subprocess
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
-from ttt_sm.hardware import generate
-from ttt_sm.hardware.firmware import firmware_root
+from ttt_sm.hardware import generate, native, structs
+from ttt_sm.hardware.firmware import CFLAGS, compiler, firmware_root
 from ttt_sm.twin import layout
 
 
@@ -25,7 +31,9 @@ def _defines(text: str) -> dict[str, int]:
 
 def test_every_generated_source_is_current():
     paths = list(generate.generated())
-    assert [p.name for p in paths] == ["layout.h"]
+    assert [p.name for p in paths] == ["layout.h", "structs.h"]
+    for _, make, tables in generate.FILES:  # the module docs/architecture.md names is the one the file names
+        assert f"src/{tables.replace('.', '/')}.py" in make()
     assert generate.stale() == [], "stale; regenerate with python -m ttt_sm.hardware.generate"
 
 
@@ -37,8 +45,8 @@ def test_the_header_defines_the_controllers_layout_and_nothing_else():
     assert expected["CS_OFFSET"] == layout.CS_OFFSET and expected["N_CP"] == layout.N_CP  # the PC's own numbers
     assert "N_MODE" not in expected  # an enumeration has no length
     cascade_h = (firmware_root() / "include" / "ttt_fw" / "cascade.h").read_text()
-    assert '#include "layout.h"' in cascade_h
-    assert _defines(cascade_h) == {"DRIVES": 3}  # no offset is written by hand any more
+    assert '#include "layout.h"' in cascade_h and '#include "structs.h"' in cascade_h
+    assert _defines(cascade_h) == {}  # no offset or length is written by hand any more
 
 
 def test_a_field_added_to_a_table_moves_the_offsets_after_it():
@@ -84,3 +92,120 @@ def test_an_unwritable_generated_file_is_said_in_one_line_and_nothing_half_writt
     assert err.count("\n") == 1 and "Traceback" not in err
     assert err.startswith("python -m ttt_sm.hardware.generate: error: ") and "layout.h" in err
     assert sorted(p.name for p in (root / "include" / "ttt_fw").iterdir()) == ["layout.h"]  # no temporary left
+
+
+# ==== structs.h: the structs the PC reads and writes through ctypes =================================
+
+INCLUDE = firmware_root() / "include"
+
+
+def _typedefs(text: str) -> dict[str, list[tuple[str, str, tuple[str, ...], str]]]:
+    """Each ``typedef struct`` of a header: its members as (C type, name, length names, comment)."""
+    out = {}
+    for name, body, again in re.findall(r"^typedef struct (\w+) \{\n(.*?)^\} (\w+);", text, re.MULTILINE | re.DOTALL):
+        assert again == name
+        out[name] = [(ctype, member, tuple(re.findall(r"\[(\w+)\]", dims)), doc)
+                     for ctype, member, dims, doc in re.findall(r"^ +(\w+) (\w+)((?:\[\w+\])*);(?: +/\* (.*) \*/)?$",
+                                                                body, re.MULTILINE)]
+        assert len(out[name]) == body.count(";"), body  # every member read, none skipped
+    return out
+
+
+def _table(t: structs.CStruct) -> list[tuple[str, str, tuple[str, ...], str]]:
+    return [(f.ctype, f.name, tuple(d.name for d in f.dims), f.doc) for f in t.fields]
+
+
+def test_the_struct_header_declares_the_tables_fields_and_no_other_header_does():
+    header = (INCLUDE / "ttt_fw" / "structs.h").read_text()
+    assert "do not edit" in header and "src/ttt_sm/hardware/structs.py" in header
+    assert _typedefs(header) == {t.name: _table(t) for t in structs.STRUCTS}
+    assert _defines(header) == {"DRIVES": structs.DRIVES}
+    assert [t.name for t in structs.STRUCTS] == ["ttt_cascade", "ttt_board", "ttt_sensors"]
+    for other in (INCLUDE / "ttt_fw").glob("*.h"):  # the hand-written copies are gone
+        if other.name != "structs.h":
+            declared = re.findall(r"^typedef struct (\w+)", other.read_text(), re.MULTILINE)
+            assert not set(declared) & {t.name for t in structs.STRUCTS}, other.name
+    assert '#include "structs.h"' in (INCLUDE / "ttt_fw" / "fw.h").read_text()
+
+
+def _c_layout(include: Path, tables, precision: str, tmp_path: Path) -> dict[str, tuple[int, int]]:
+    """``{"<struct>.<field>": (offsetof, sizeof), "<struct>": (0, sizeof)}`` as the C compiler lays out `tables`.
+
+    The program includes fw.h, as the firmware's sources do, and is built with the firmware's flags.
+    """
+    lines = ['#include <stddef.h>', '#include <stdio.h>', '#include "ttt_fw/fw.h"', "int main(void)", "{"]
+    for t in tables:
+        lines.append(f'    printf("{t.name} 0 %zu\\n", sizeof({t.name}));')
+        for f in t.fields:
+            lines.append(f'    printf("{t.name}.{f.name} %zu %zu\\n", offsetof({t.name}, {f.name}),'
+                         f" sizeof((({t.name} *)0)->{f.name}));")
+    lines += ["    return 0;", "}", ""]
+    src, exe = tmp_path / f"layout_{precision}.c", tmp_path / f"layout_{precision}"
+    src.write_text("\n".join(lines))
+    define = ["-DTTT_FW_DOUBLE"] if precision == "double" else []
+    built = subprocess.run([compiler(), *CFLAGS, *define, f"-I{include}", str(src), "-o", str(exe)],
+                           capture_output=True, text=True)
+    assert built.returncode == 0, built.stderr
+    ran = subprocess.run([str(exe)], capture_output=True, text=True, check=True)
+    return {key: (int(offset), int(size)) for key, offset, size in (row.split() for row in ran.stdout.splitlines())}
+
+
+def _ctypes_layout(classes: dict[str, type[ctypes.Structure]]) -> dict[str, tuple[int, int]]:
+    """The same, as the ctypes Structures lay them out."""
+    out = {}
+    for name, cls in classes.items():
+        out[name] = (0, ctypes.sizeof(cls))
+        for field, _ in cls._fields_:
+            member = getattr(cls, field)
+            out[f"{name}.{field}"] = (member.offset, member.size)
+    return out
+
+
+@pytest.mark.parametrize("precision", ["float", "double"])
+def test_every_field_sits_where_the_ctypes_structures_read_it(firmware_libs, tmp_path, precision):
+    lib = firmware_libs[precision]
+    python = _ctypes_layout({"ttt_cascade": lib.Cascade, "ttt_board": native.Board, "ttt_sensors": native.SensorsIn})
+    c = _c_layout(INCLUDE, structs.STRUCTS, precision, tmp_path)
+    assert c == python
+    assert len(c) == sum(1 + len(t.fields) for t in structs.STRUCTS)
+    assert c["ttt_cascade.cp"] == (0, ctypes.sizeof(lib.real) * 3 * layout.N_CP)  # the build's ttt_real, layout's N_CP
+
+
+@pytest.mark.parametrize("precision", ["float", "double"])
+def test_a_field_added_to_a_table_is_in_the_header_and_the_ctypes_struct_at_one_offset(tmp_path, precision):
+    sensors = structs.SENSORS
+    fields = list(sensors.fields)
+    at = [f.name for f in fields].index("current_a")
+    fields.insert(at, structs.CField("new", "double", (), "a new number"))  # 8-aligned: moves what follows
+    grown = replace(sensors, fields=tuple(fields))
+    tables = (structs.CASCADE, structs.BOARD, grown)
+    include = tmp_path / "include"
+    shutil.copytree(INCLUDE, include)
+    header = generate.structs_h(tables)
+    assert "    double new;" in header and _typedefs(header)["ttt_sensors"] == _table(grown)
+    (include / "ttt_fw" / "structs.h").write_text(header)
+
+    class Grown(ctypes.Structure):
+        _fields_ = grown.ctypes_fields()
+
+    c = _c_layout(include, tables, precision, tmp_path)
+    assert c["ttt_sensors.new"] == (native.SensorsIn.current_a.offset, 8) == (Grown.new.offset, 8)
+    assert c["ttt_sensors.current_a"][0] == Grown.current_a.offset > native.SensorsIn.current_a.offset
+    real = ctypes.c_double if precision == "double" else ctypes.c_float
+
+    class Cascade(ctypes.Structure):
+        _fields_ = structs.CASCADE.ctypes_fields(real)
+
+    assert c == _ctypes_layout({"ttt_cascade": Cascade, "ttt_board": native.Board, "ttt_sensors": Grown})
+
+
+def test_a_struct_doc_that_would_close_the_c_comment_is_refused():
+    bad = structs.struct("ttt_x", "a struct", [("a", "float", (), "ends */ early")])
+    with pytest.raises(ValueError, match="ttt_x.a"):
+        generate.structs_h([bad])
+
+
+def test_a_ttt_real_struct_needs_the_builds_real_type():
+    with pytest.raises(ValueError, match="cp: a ttt_real field"):
+        structs.CASCADE.ctypes_fields()
+    assert dict(structs.CASCADE.ctypes_fields(ctypes.c_float))["act"]._type_ is ctypes.c_float

@@ -377,10 +377,8 @@ def thesis_section(pictures: Pictures) -> str:
         rows.append(f"| {where} | {what} | `{module}` |")
     from ttt_sm.hardware import generate
 
-    files = [Path(*path.parts[len(path.parts) - 1 - path.parts[::-1].index("firmware"):])
-             for path in generate.generated(Path("firmware"))]  # as the repository names them
-    generated = "\n".join(f"- `{path.as_posix()}` from `ttt_sm.twin.layout` (`ttt_sm.hardware.generate`)"
-                          for path in files)
+    generated = "\n".join(f"- `firmware/{path}` from `{tables}` (`ttt_sm.hardware.generate`)"
+                          for path, _, tables in generate.FILES)
     return f"""## From the thesis to the modules
 
 Where the thesis' parts live (docs/thesis_map.md maps every figure and

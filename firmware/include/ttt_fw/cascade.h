@@ -10,8 +10,10 @@
  * the same blocks, the same index names, the same operations in the same
  * order.  The indices (TTT_CP_*, TTT_CG_*, TTT_CS_*, TTT_CGS_*, TTT_ACT_*,
  * TTT_MODE_*, TTT_N_*) are in layout.h, generated from the PC's tables
- * (src/ttt_sm/twin/layout.py).  No heap, no library call; the caller owns
- * the struct.
+ * (src/ttt_sm/twin/layout.py); the struct ttt_cascade is in structs.h,
+ * generated from src/ttt_sm/hardware/structs.py, whose table the PC's
+ * ctypes binding is built from too.  No heap, no library call; the caller
+ * owns the struct.
  *
  * Drives are indexed 0..2 here (drive 1 of the thesis is index 0).
  */
@@ -22,17 +24,7 @@
 
 #include "layout.h"
 #include "real.h"
-
-#define TTT_DRIVES 3
-
-typedef struct ttt_cascade {
-    ttt_real cp[TTT_DRIVES][TTT_N_CP];
-    ttt_real cg[TTT_N_CG];
-    ttt_real cs[TTT_DRIVES][TTT_N_CS];
-    ttt_real cgs[TTT_N_CGS];
-    ttt_real act[TTT_N_ACT];
-    int32_t cm[TTT_DRIVES];
-} ttt_cascade;
+#include "structs.h" /* ttt_cascade and TTT_DRIVES, generated like layout.h */
 
 /* sizeof(ttt_real): 4 on a float build, 8 on a double build (for bindings). */
 int ttt_real_size(void);

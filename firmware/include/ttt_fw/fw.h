@@ -19,6 +19,7 @@
 
 #include "cascade.h"
 #include "link.h"
+#include "structs.h" /* ttt_board, ttt_sensors (and ttt_cascade), generated */
 
 #define TTT_FW_VERSION_MAJOR 0
 #define TTT_FW_VERSION_MINOR 2
@@ -37,7 +38,6 @@
 #define TTT_GAINS_BLOCKS 4 /* blocks 0..2: cp of drive 1..3 (10 values); block 3: cg (18 values) */
 #define TTT_TX_CAP 1024
 
-/* What the board is: told to the PC in the handshake. */
 /* What GAINS may carry (checked in fw.c, rejected as TTT_REJ_VALUE; docs/hardware.md): no gain or
  * coefficient beyond +-TTT_GAIN_MAX, a control step in [TTT_DT_MIN_S, TTT_DT_MAX_S], a servo PWM
  * period up to TTT_SV_PERIOD_MAX_S. */
@@ -46,27 +46,10 @@
 #define TTT_DT_MAX_S 0.1
 #define TTT_SV_PERIOD_MAX_S 0.1
 
-typedef struct ttt_board {
-    double rad_per_count[TTT_DRIVES];
-    float limit_min_rad[TTT_DRIVES];
-    float limit_max_rad[TTT_DRIVES];
-    float servo_min_rad, servo_max_rad, servo_safe_rad;
-    uint32_t control_period_us;
-    uint32_t watchdog_steps;  /* setpoints missing this many steps -> SAFE_STOP (50 at 1 kHz: 50 ms) */
-    uint32_t status_every;    /* a STATUS frame every this many control steps */
-    uint32_t late_steps;      /* setpoints this many steps past their step are late */
-} ttt_board;
-
-/* What the board read this control step. */
-typedef struct ttt_sensors {
-    int32_t counts[TTT_DRIVES];
-    int32_t index_count[TTT_DRIVES];
-    uint16_t index_edges[TTT_DRIVES];
-    uint8_t index;            /* bit d: drive d's index switch level */
-    float current_a[TTT_DRIVES];
-    uint16_t servo_adc;       /* the pen servo's feedback wire (its potentiometer's wiper), ADC counts */
-} ttt_sensors;
-
+/* The firmware's state.  Written here by hand, unlike ttt_board and ttt_sensors
+ * (structs.h, generated with the PC's ctypes Structures from one table): the PC
+ * never sees its layout, it allocates ttt_fw_size() bytes and reads them through
+ * the functions at the end of this file. */
 typedef struct ttt_fw {
     ttt_board board;
     ttt_cascade cascade;

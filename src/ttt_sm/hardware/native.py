@@ -7,6 +7,10 @@ ttt_fw/cascade.h``) and offers the commands of
 ``set_open_duty``.  Its parameters are the PC controller's (the gains
 download of a real arm): the same rows, converted to the firmware's number
 type.  Drives are numbered 1, 2, 3 where a method takes a drive number.
+
+The ctypes Structures of the structs the C shares (:class:`Board`,
+:class:`SensorsIn`, the cascade's) are built from the tables of
+:mod:`.structs`, which the firmware's ``structs.h`` is generated from.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from ..params import ArmParams
 from ..twin import layout
 from ..twin.cascade import CascadeController
 from ..twin.gains import Gains, check_drive
+from . import structs
 from .firmware import FirmwareError, Precision
 
 _REAL = {"float": ctypes.c_float, "double": ctypes.c_double}
@@ -29,46 +34,22 @@ _NUMPY = {"float": np.float32, "double": np.float64}
 
 
 def _struct(real: Any) -> type[ctypes.Structure]:
+    """``ttt_cascade`` (structs.h) of a build whose ``ttt_real`` is `real`."""
     class Cascade(ctypes.Structure):
-        _fields_ = [
-            ("cp", (real * layout.N_CP) * 3),
-            ("cg", real * layout.N_CG),
-            ("cs", (real * layout.N_CS) * 3),
-            ("cgs", real * layout.N_CGS),
-            ("act", real * layout.N_ACT),
-            ("cm", ctypes.c_int32 * 3),
-        ]
+        _fields_ = structs.CASCADE.ctypes_fields(real)
     return Cascade
 
 
 class Board(ctypes.Structure):
-    """``ttt_board`` (fw.h): what the board is, told to the PC in the handshake."""
+    """``ttt_board`` (structs.h): what the board is, told to the PC in the handshake."""
 
-    _fields_ = [
-        ("rad_per_count", ctypes.c_double * 3),
-        ("limit_min_rad", ctypes.c_float * 3),
-        ("limit_max_rad", ctypes.c_float * 3),
-        ("servo_min_rad", ctypes.c_float),
-        ("servo_max_rad", ctypes.c_float),
-        ("servo_safe_rad", ctypes.c_float),
-        ("control_period_us", ctypes.c_uint32),
-        ("watchdog_steps", ctypes.c_uint32),
-        ("status_every", ctypes.c_uint32),
-        ("late_steps", ctypes.c_uint32),
-    ]
+    _fields_ = structs.BOARD.ctypes_fields()
 
 
 class SensorsIn(ctypes.Structure):
-    """``ttt_sensors`` (fw.h): what the board read this control step."""
+    """``ttt_sensors`` (structs.h): what the board read this control step."""
 
-    _fields_ = [
-        ("counts", ctypes.c_int32 * 3),
-        ("index_count", ctypes.c_int32 * 3),
-        ("index_edges", ctypes.c_uint16 * 3),
-        ("index", ctypes.c_uint8),
-        ("current_a", ctypes.c_float * 3),
-        ("servo_adc", ctypes.c_uint16),
-    ]
+    _fields_ = structs.SENSORS.ctypes_fields()
 
 
 #: The watchdog's limit: setpoints missing this long stop the drives (s).
@@ -199,7 +180,7 @@ class NativeCascade:
         self.cp[:] = pc.cp[:, :layout.N_CP]
         self.cg[:] = pc.cg[:layout.N_CG]
         self.cgs[layout.CGS_SV_SET] = servo_angle
-        self._counts = (ctypes.c_int32 * 3)()
+        self._counts = (ctypes.c_int32 * structs.DRIVES)()  # ttt_cascade_step's counts[TTT_DRIVES]
         self._q = (lib.real * 4)()
 
     # numpy views of the struct's blocks (the firmware's own number type)

@@ -22,7 +22,9 @@ import pytest
 
 from ttt_sm.hardware import generate, native, structs
 from ttt_sm.hardware.firmware import CFLAGS, compiler, firmware_root
+from ttt_sm.params import load_params
 from ttt_sm.twin import layout
+from ttt_sm.twin.plant import REST_POSE
 
 
 def _defines(text: str) -> dict[str, int]:
@@ -31,7 +33,7 @@ def _defines(text: str) -> dict[str, int]:
 
 def test_every_generated_source_is_current():
     paths = list(generate.generated())
-    assert [p.name for p in paths] == ["layout.h", "structs.h"]
+    assert [p.name for p in paths] == ["layout.h", "structs.h", "arm_board.h"]
     for _, make, tables in generate.FILES:  # the module docs/architecture.md names is the one the file names
         assert f"src/{tables.replace('.', '/')}.py" in make()
     assert generate.stale() == [], "stale; regenerate with python -m ttt_sm.hardware.generate"
@@ -209,3 +211,52 @@ def test_a_ttt_real_struct_needs_the_builds_real_type():
     with pytest.raises(ValueError, match="cp: a ttt_real field"):
         structs.CASCADE.ctypes_fields()
     assert dict(structs.CASCADE.ctypes_fields(ctypes.c_float))["act"]._type_ is ctypes.c_float
+
+
+def _c_board(header: str, tmp_path: Path) -> dict[str, float]:
+    """``{"<field>" or "<field>[i]": value}`` of the ``ttt_board`` that `header`'s ``ttt_arm_board()`` fills, as
+    compiled C prints it (the reference board's sketch includes the header beside the firmware's)."""
+    board_dir = tmp_path / "board"
+    board_dir.mkdir(exist_ok=True)
+    (board_dir / "arm_board.h").write_text(header)
+    lines = ['#include <stdio.h>', '#include "arm_board.h"', "int main(void)", "{",
+             "    ttt_board b;", "    ttt_arm_board(&b);"]
+    for f in structs.BOARD.fields:
+        names = [f"{f.name}[{i}]" for i in range(f.dims[0].value)] if f.dims else [f.name]
+        lines += [f'    printf("{n} %.17g\\n", (double)b.{n});' for n in names]
+    lines += ["    return 0;", "}", ""]
+    src, exe = tmp_path / "arm_board.c", tmp_path / "arm_board"
+    src.write_text("\n".join(lines))
+    built = subprocess.run([compiler(), *CFLAGS, f"-I{INCLUDE}", f"-I{board_dir}", str(src), "-o", str(exe)],
+                           capture_output=True, text=True)
+    assert built.returncode == 0, built.stderr
+    ran = subprocess.run([str(exe)], capture_output=True, text=True, check=True)
+    return {name: float(value) for name, value in (row.split() for row in ran.stdout.splitlines())}
+
+
+def _python_board(board: native.Board) -> dict[str, float]:
+    out = {}
+    for f in structs.BOARD.fields:
+        value = getattr(board, f.name)
+        out.update({f"{f.name}[{i}]": float(v) for i, v in enumerate(value)} if f.dims else {f.name: float(value)})
+    return out
+
+
+def test_the_reference_boards_arm_is_the_emulators_board_field_for_field(tmp_path):
+    header = (firmware_root() / "board" / "nucleo_f446re" / "arm_board.h").read_text()
+    assert "do not edit" in header and "src/ttt_sm/data/arm.toml" in header
+    params = load_params()
+    want = _python_board(native.board_for(params, servo_safe_rad=REST_POSE[3]))
+    assert _c_board(header, tmp_path) == want  # every field, to the bit of its C type
+    assert want["rad_per_count[1]"] == params.drives[1].rad_per_count and want["watchdog_steps"] == 50
+    sketch = (firmware_root() / "board" / "nucleo_f446re" / "nucleo_f446re.ino").read_text()
+    assert '#include "src/arm_board.h"' in sketch and "ttt_arm_board(&board);" in sketch
+    assert "rad_per_count" not in sketch.replace("control_period_us", "")  # no hand-kept copy of the numbers
+
+
+def test_a_recalibrated_arm_toml_changes_the_boards_numbers(tmp_path):
+    params = load_params()
+    geared = replace(params, drives=(replace(params.drives[0], gear_ratio=100.0), *params.drives[1:]))
+    c = _c_board(generate.arm_board_h(geared), tmp_path)
+    assert c["rad_per_count[0]"] == geared.drives[0].rad_per_count != params.drives[0].rad_per_count
+    assert c["rad_per_count[1]"] == params.drives[1].rad_per_count

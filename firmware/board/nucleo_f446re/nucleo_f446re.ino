@@ -12,8 +12,8 @@
  * tests/hardware/test_board_io.py); the firmware's core (../../src,
  * ../../include) is the C the tests run in the emulator.
  *
- * To build: copy (or link) firmware/src/*.c, firmware/include/ttt_fw/ and
- * board_io.{c,h} into this sketch's src/ folder, so the Arduino IDE compiles
+ * To build: copy (or link) firmware/src/*.c, firmware/include/ttt_fw/,
+ * board_io.{c,h} and arm_board.h into this sketch's src/ folder, so the Arduino IDE compiles
  * them with the sketch; select the board "Nucleo-64 / Nucleo F446RE",
  * "Optimize: Smallest (-Os) with LTO" off, C runtime "Newlib Nano".
  */
@@ -22,16 +22,10 @@
 #include <Servo.h>
 
 extern "C" {
+#include "src/arm_board.h" /* the arm's numbers, generated from arm.toml */
 #include "src/board_io.h"
 #include "src/ttt_fw/fw.h"
 }
-
-/* ---- the arm this board drives (from the parameter file, arm.toml) ------------------------------------ */
-/* rad per encoder count at the joint: 2 pi / (2000 counts per motor turn x gear ratio 150, 160, 120) */
-static const double RAD_PER_COUNT[3] = {2.0943951023931954e-05, 1.9634954084936207e-05, 2.617993877991494e-05};
-static const float LIMIT_MIN[3] = {-2.96706f, -0.785398f, -2.617994f};
-static const float LIMIT_MAX[3] = {2.96706f, 2.356194f, 0.523599f};
-static const float SERVO_MIN = -2.094395f, SERVO_MAX = 2.617994f, SERVO_SAFE = 0.0f; /* SAFE: the pen lifted */
 
 /* ---- pins (Arduino names of the Nucleo-64 headers; STM32 pins in the comments) ------------------------- */
 static const uint32_t PIN_EN[3] = {PA8, PA9, PA10};   /* TIM1 CH1..CH3: DRV8874 EN (PWM, 20 kHz) */
@@ -47,7 +41,6 @@ static const int SERVO_FB_SAMPLES = 16;               /* conversions averaged pe
 /* encoders: TIM2 (PA0, PA1), TIM3 (PA6, PA7), TIM4 (PB6, PB7) in encoder mode, x4 decoding */
 
 static const uint32_t PWM_HZ = 20000;
-static const uint32_t CONTROL_HZ = 1000;
 
 static ttt_fw fw;
 static ttt_sensors sensors;
@@ -82,19 +75,8 @@ static void on_tick(void) { control_due = 1; }
 
 void setup()
 {
-    ttt_board board = {};
-    for (int d = 0; d < 3; d++) {
-        board.rad_per_count[d] = RAD_PER_COUNT[d];
-        board.limit_min_rad[d] = LIMIT_MIN[d];
-        board.limit_max_rad[d] = LIMIT_MAX[d];
-    }
-    board.servo_min_rad = SERVO_MIN;
-    board.servo_max_rad = SERVO_MAX;
-    board.servo_safe_rad = SERVO_SAFE;
-    board.control_period_us = 1000000u / CONTROL_HZ;
-    board.watchdog_steps = 50;  /* 50 ms without setpoints: safe stop */
-    board.status_every = 2;     /* a STATUS every chart step (500 Hz) */
-    board.late_steps = 2;
+    ttt_board board;
+    ttt_arm_board(&board); /* the control period, a STATUS every chart step, the watchdog: arm_board.h */
     ttt_fw_init(&fw, &board);
 
     Serial.begin(921600);  /* the ST-LINK's virtual COM port (USART2, PA2/PA3) */
@@ -123,7 +105,7 @@ void setup()
     servo.attach(PIN_SERVO);  /* no pulse is written until the firmware computes a duty */
 
     tick = new HardwareTimer(TIM6);
-    tick->setOverflow(CONTROL_HZ, HERTZ_FORMAT);
+    tick->setOverflow(board.control_period_us, MICROSEC_FORMAT);  /* 1000 us: 1 kHz */
     tick->attachInterrupt(on_tick);
     tick->resume();
 }

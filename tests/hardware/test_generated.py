@@ -3,29 +3,40 @@
 ``firmware/include/ttt_fw/layout.h`` is generated from ``ttt_sm.twin.layout``
 (``python -m ttt_sm.hardware.generate``): the C port of the controller step
 and the PC's compiled step index the same memory because both take their
-offsets from one table.
+offsets from one table.  ``protocol.h`` is generated from
+``ttt_sm.hardware.link.protocol``: the firmware reads and writes each body's
+fields at the bytes the PC's messages pack them at.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import shutil
+import struct
 from dataclasses import replace
 
 import pytest
 
 from ttt_sm.hardware import generate
+from ttt_sm.hardware import link as L
 from ttt_sm.hardware.firmware import firmware_root
+from ttt_sm.hardware.link import protocol
 from ttt_sm.twin import layout
 
 
 def _defines(text: str) -> dict[str, int]:
-    return {name: int(value) for name, value in re.findall(r"^#define TTT_(\w+) (\d+)", text, re.MULTILINE)}
+    return {name: int(value, 0) for name, value in re.findall(r"^#define TTT_(\w+) (0x[0-9A-F]+|\d+)\b(?![.e])", text,
+                                                              re.MULTILINE)}
+
+
+def _header(name: str) -> str:
+    return (firmware_root() / "include" / "ttt_fw" / name).read_text()
 
 
 def test_every_generated_source_is_current():
     paths = list(generate.generated())
-    assert [p.name for p in paths] == ["layout.h"]
+    assert [p.name for p in paths] == ["layout.h", "protocol.h"]
     assert generate.stale() == [], "stale; regenerate with python -m ttt_sm.hardware.generate"
 
 
@@ -84,3 +95,113 @@ def test_an_unwritable_generated_file_is_said_in_one_line_and_nothing_half_writt
     assert err.count("\n") == 1 and "Traceback" not in err
     assert err.startswith("python -m ttt_sm.hardware.generate: error: ") and "layout.h" in err
     assert sorted(p.name for p in (root / "include" / "ttt_fw").iterdir()) == ["layout.h"]  # no temporary left
+
+
+
+#: The attributes of a message its body's fields are not named after.
+_FIELD_OF = {"fr_sw": "FLAGS"}
+#: The fields a body repeats drive by drive, interleaved (docs/hardware.md: HANDSHAKE, "per drive: ...").
+_PER_DRIVE = {"HANDSHAKE": ("rad_per_count", "limit_min_rad", "limit_max_rad")}
+
+
+def _marker(value: object) -> object:
+    """A value of `value`'s type whose first byte on the wire is not 0 (1/3: 0x55 as f64, 0xAB as f32)."""
+    return True if isinstance(value, bool) else 1 / 3 if isinstance(value, float) else 0x11
+
+
+def _where_the_pc_packs(message: L.Message) -> dict[str, list[int]]:
+    """Each attribute's byte offsets (one per value of a tuple) in the PC's packed body: a marker packed alone."""
+    zero = message.pack()
+    out = {}
+    for f in dataclasses.fields(message):
+        value = getattr(message, f.name)
+        offsets = []
+        for i in range(len(value) if isinstance(value, tuple) else 1):
+            marked = (*value[:i], _marker(value[i]), *value[i + 1:]) if isinstance(value, tuple) else _marker(value)
+            body = replace(message, **{f.name: marked}).pack()
+            offsets.append(next(k for k, (a, b) in enumerate(zip(zero, body, strict=True)) if a != b))
+        out[f.name] = offsets
+    return out
+
+
+def _protocol_as_the_pc_speaks_it() -> dict[str, int]:
+    """What protocol.h must define, found from the PC's messages, their packed bytes and frames."""
+    want = {"PROTOCOL_VERSION": L.PROTOCOL_VERSION, "HEADER": L.HEADER, "CRC": L.CRC_BYTES, "MAX_BODY": L.MAX_BODY,
+            "MAX_FRAME": L.MAX_FRAME, "MAX_ENCODED": L.MAX_ENCODED, "N_REJ": L.N_REASONS,
+            "GAINS_BLOCKS": L.GAINS_BLOCKS}
+    frame = L.cobs_decode(L.encode_frame(0x11, 0x0011, b"")[:-1])
+    want |= {"FRAME_TYPE": frame.index(0x11), "FRAME_SEQ": frame.index(0x11, 1)}
+    want |= {f"MSG_{m.name}": m.value for m in L.Msg if m is not L.Msg.EMU_TRUTH}  # the emulator's own: not the C's
+    want |= {f"REJ_{r.name}": r.value for r in L.Reason}
+    want |= {f"STATE_{name.upper()}": i for i, name in enumerate(L.STATE_NAMES)}
+    want |= {f"OP_{o.name}": o.value for o in L.Op}
+    drive_row, global_row = L.Gains(0, (0.0,) * L.N_CP), L.Gains(L.GAINS_BLOCKS - 1, (0.0,) * L.N_CG)
+    at = _where_the_pc_packs(drive_row)
+    want |= {"GAINS_BLOCK": at["block"][0], "GAINS_VALUES": at["values_"][0], "GAINS_BLOCK_GLOBAL": global_row.block,
+             "BODY_GAINS_DRIVE": len(drive_row.pack()), "BODY_GAINS_GLOBAL": len(global_row.pack())}
+    for cls in L.MESSAGES.values():
+        kind = cls.KIND.name
+        if cls.KIND in (L.Msg.GAINS, L.Msg.GAINS_READBACK, L.Msg.EMU_TRUTH):
+            continue
+        size = L.body_length(cls.KIND, b"")
+        assert size is not None
+        message = cls.unpack(bytes(size))
+        want[f"BODY_{kind}"] = len(message.pack())
+        for name, offsets in _where_the_pc_packs(message).items():
+            want[f"{kind}_{_FIELD_OF.get(name, name.upper())}"] = offsets[0]
+            if name in _PER_DRIVE.get(kind, ()):
+                stride = offsets[1] - offsets[0]
+                assert offsets == [offsets[0] + d * stride for d in range(L.DRIVES)]
+                assert want.setdefault(f"{kind}_DRIVE_STRIDE", stride) == stride  # one stride for the group
+    return want
+
+
+def test_the_protocol_header_defines_what_the_pc_sends_and_nothing_else():
+    header = _header("protocol.h")
+    assert "do not edit" in header and "src/ttt_sm/hardware/link/protocol.py" in header
+    want = _protocol_as_the_pc_speaks_it()
+    assert _defines(header) == want
+    assert want["BODY_HANDSHAKE"] == 70 and want["HANDSHAKE_DRIVE_STRIDE"] == 16 and want["STATUS_SERVO_ADC"] == 43
+    for r in L.Reason:  # the reasons' docs are the C's comments
+        assert re.search(rf"^#define TTT_REJ_{r.name} {r.value} +/\* {re.escape(r.doc)} \*/$", header, re.MULTILINE)
+
+
+def test_link_h_and_fw_h_take_the_protocol_from_the_generated_header():
+    generated = set(_defines(_header("protocol.h")))
+    for name in ("link.h", "fw.h"):
+        text = _header(name)
+        assert '#include "protocol.h"' in text, name
+        assert not set(_defines(text)) & generated, f"{name} defines a number of protocol.h by hand"
+    for name in ("link.c", "fw.c"):  # bodies are read and written at the generated offsets, never at a literal one
+        text = (firmware_root() / "src" / name).read_text()
+        assert not re.search(r"(?<![.\w])(?<!uint8_t )(b|body|frame)( \+ \d|\[\d)", text), name
+
+
+def test_a_field_added_to_a_message_table_moves_the_offsets_after_it_and_the_length():
+    before = _defines(generate.protocol_h())
+    handshake = protocol.BODIES[L.Msg.HANDSHAKE]
+    items = list(handshake.items)
+    at = next(i for i, item in enumerate(items) if getattr(item, "name", "") == "SERVO_MIN_RAD")
+    items.insert(at, protocol.Field("NEW", "H", doc="a new number"))
+    group = next(i for i, item in enumerate(items) if isinstance(item, protocol.Group))
+    old_group = items[group]
+    assert isinstance(old_group, protocol.Group)
+    items[group] = replace(old_group, fields=(*old_group.fields, protocol.Field("SPARE", "f")))  # 4 bytes a drive
+    grown = protocol.Body(tuple(items))
+    after = _defines(generate.protocol_h({**protocol.BODIES, L.Msg.HANDSHAKE: grown}))
+    drives = 4 * L.DRIVES
+    assert after["HANDSHAKE_DRIVE_STRIDE"] == before["HANDSHAKE_DRIVE_STRIDE"] + 4
+    assert after["HANDSHAKE_SPARE"] == before["HANDSHAKE_LIMIT_MAX_RAD"] + 4
+    assert after["HANDSHAKE_NEW"] == before["HANDSHAKE_SERVO_MIN_RAD"] + drives
+    assert after["HANDSHAKE_SERVO_MIN_RAD"] == before["HANDSHAKE_SERVO_MIN_RAD"] + drives + 2
+    assert after["HANDSHAKE_SERVO_SAFE_RAD"] == before["HANDSHAKE_SERVO_SAFE_RAD"] + drives + 2
+    assert after["BODY_HANDSHAKE"] == before["BODY_HANDSHAKE"] + drives + 2 == struct.calcsize(grown.format)
+    unmoved = ("HANDSHAKE_CONTROL_PERIOD_US", "HANDSHAKE_RAD_PER_COUNT", "HANDSHAKE_LIMIT_MAX_RAD", "BODY_STATUS")
+    assert all(after[k] == before[k] for k in unmoved)
+
+
+def test_a_protocol_name_defined_twice_is_refused():
+    clash = protocol.body(protocol.Field("RAD_PER_COUNT", "d"))  # HELLO_RAD_PER_COUNT: fine; as HANDSHAKE's: twice
+    twice = protocol.Body((*protocol.BODIES[L.Msg.HANDSHAKE].items, *clash.items))
+    with pytest.raises(ValueError, match="TTT_HANDSHAKE_RAD_PER_COUNT"):
+        generate.protocol_h({**protocol.BODIES, L.Msg.HANDSHAKE: twice})

@@ -153,7 +153,8 @@ class SerialArm(FirmwareLink):
                 for d in range(3):  # the PC's offsets are the ones: any sent while the link was down were lost
                     self._send(L.Drive(d, L.Op.OFFSET, self._offsets[d]))
                 give_up = sent + timeout_s
-                while not (self._status is not None and self._status.state == 1 and self.status_seen_at >= sent):
+                while not (self._status is not None and self._status.state == L.State.RUNNING
+                           and self.status_seen_at >= sent):
                     if time.monotonic() > give_up:
                         return False
                     self._poll(0.005)

@@ -2,8 +2,8 @@
 
 ``export`` writes the chart diagrams in ``charts/`` (as ``ttt-sm charts
 export`` does), ``docs/architecture.md`` with its pictures, and the firmware's
-generated ``layout.h``; ``check`` lists the files that are stale and exits
-with status 1 if there are any.  Run it from the repository's root with the
+generated headers (``layout.h``, ``protocol.h``); ``check`` lists the files
+that are stale and exits with status 1 if there are any.  Run it from the repository's root with the
 repository's Python (``.venv/bin/python -m tools.docs check``) or pass
 ``--root``.  A development tool: the installed package does not carry it (the
 wheel has no repository to write into).
@@ -25,8 +25,8 @@ from .architecture.layers import SOURCE_ROOT
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="python -m tools.docs",
-        description="regenerate every generated file (charts/, docs/architecture.md, the firmware's layout.h),"
-                    " or check they are up to date")
+        description="regenerate every generated file (charts/, docs/architecture.md, the firmware's generated"
+                    " headers), or check they are up to date")
     parser.add_argument("action", choices=["export", "check"])
     parser.add_argument("--root", default=".", help="the repository's root folder (default: the current folder)")
     parser.add_argument("--json", action="store_true", help="print one JSON document")

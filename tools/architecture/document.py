@@ -379,7 +379,7 @@ def thesis_section(pictures: Pictures) -> str:
 
     files = [Path(*path.parts[len(path.parts) - 1 - path.parts[::-1].index("firmware"):])
              for path in generate.generated(Path("firmware"))]  # as the repository names them
-    generated = "\n".join(f"- `{path.as_posix()}` from `ttt_sm.twin.layout` (`ttt_sm.hardware.generate`)"
+    generated = "\n".join(f"- `{path.as_posix()}` from `{generate.TABLES[path.name]}` (`ttt_sm.hardware.generate`)"
                           for path in files)
     return f"""## From the thesis to the modules
 
@@ -387,7 +387,8 @@ Where the thesis' parts live (docs/thesis_map.md maps every figure and
 equation). The cascade loop spans several modules on purpose: one
 definition of each formula (`ttt_sm.twin._cascade` for the controller step and
 the setpoint filter, `ttt_sm.twin._plant` for gravity, `ttt_sm.params.values` for the
-servo), one table of each memory layout (`ttt_sm.twin.layout`), the design of
+servo), one table of each memory layout (`ttt_sm.twin.layout`) and of the
+serial link's protocol (`ttt_sm.hardware.link.protocol`), the design of
 the gains apart from the step that uses them (`ttt_sm.twin.tuning`,
 `ttt_sm.twin.gains`), and the loop that fuses controller and plant
 (`ttt_sm.twin._kernel`).

@@ -146,6 +146,10 @@ def protocol_h(bodies: Mapping[protocol.Msg, protocol.Body] = protocol.BODIES) -
     return "\n".join(lines)
 
 
+#: The module whose tables each generated file is made from, by file name (docs/architecture.md lists them).
+TABLES = {"layout.h": "ttt_sm.twin.layout", "protocol.h": "ttt_sm.hardware.link.protocol"}
+
+
 def generated(root: Path | None = None) -> dict[Path, Callable[[], str]]:
     """Every generated source of the firmware: its path, and the function that makes its text."""
     root = (firmware_root() if root is None else root).resolve()  # the checkout's firmware/, not a link to it

@@ -37,7 +37,7 @@ class Numbered(IntEnum):
 
     doc: str
 
-    def __new__(cls, value: int, doc: str = "") -> Self:  # the default: `Msg(kind)` looks a member up by number
+    def __new__(cls, value: int, doc: str = "") -> Self:  # doc's default: a type checker takes `Msg(kind)`, a lookup
         member = int.__new__(cls, value)
         member._value_ = value
         member.doc = doc
@@ -134,6 +134,10 @@ class Group:
     fields: tuple[Field, ...]
     count: int
 
+    def __post_init__(self) -> None:
+        if any(f.count != 1 for f in self.fields):
+            raise ValueError(f"group {self.name}: a repeated field holds one value a repeat")
+
     @property
     def format(self) -> str:
         return "".join(f.format for f in self.fields) * self.count
@@ -175,13 +179,9 @@ class Body:
                 at += item.size
         return rows
 
-    def names(self) -> tuple[str, ...]:
-        """The message's attributes, in order: one per field (a group's: one per field, a tuple each)."""
-        return tuple(f.name.lower() for item in self.items
-                     for f in (item.fields if isinstance(item, Group) else (item,)))
-
 
 def body(*items: Field | Group) -> Body:
+    """A :class:`Body` of these fields, in wire order."""
     return Body(items)
 
 

@@ -270,7 +270,7 @@ void ttt_fw_rx(ttt_fw *fw, const uint8_t *data, size_t n)
             continue;
         }
         if (got != TTT_RX_FRAME) continue;
-        if (fw->rx.type >= 0x80) { /* a firmware -> PC type: not for us, its number not taken */
+        if (fw->rx.type >= TTT_FIRST_TO_PC) { /* a firmware -> PC type: not for us, its number not taken */
             reject(fw, TTT_REJ_UNKNOWN_TYPE);
             continue;
         }

@@ -132,6 +132,8 @@ def _protocol_as_the_pc_speaks_it() -> dict[str, int]:
     frame = L.cobs_decode(L.encode_frame(0x11, 0x0011, b"")[:-1])
     want |= {"FRAME_TYPE": frame.index(0x11), "FRAME_SEQ": frame.index(0x11, 1)}
     want |= {f"MSG_{m.name}": m.value for m in L.Msg if m is not L.Msg.EMU_TRUTH}  # the emulator's own: not the C's
+    want["FIRST_TO_PC"] = 0x80  # docs/hardware.md: PC -> firmware below 0x80, firmware -> PC from 0x80
+    assert max(L.TO_FIRMWARE) < want["FIRST_TO_PC"] <= min(L.TO_PC)
     want |= {f"REJ_{r.name}": r.value for r in L.Reason}
     want |= {f"STATE_{name.upper()}": i for i, name in enumerate(L.STATE_NAMES)}
     want |= {f"OP_{o.name}": o.value for o in L.Op}

@@ -27,7 +27,7 @@
 #define TTT_MAX_FRAME 165    /* header, body, CRC */
 #define TTT_MAX_ENCODED 166  /* COBS-encoded, without the 0x00: one byte added per 254 */
 
-/* Message types: PC -> firmware below 0x80, firmware -> PC from 0x80. */
+/* Message types: PC -> firmware below 0x80, firmware -> PC from 0x80 (FIRST_TO_PC). */
 #define TTT_MSG_HELLO 0x01            /* start a session: the firmware answers HANDSHAKE */
 #define TTT_MSG_GAINS 0x02            /* one block of the controller's parameters (idle or safe_stop only) */
 #define TTT_MSG_GAINS_READ 0x03       /* ask for one block of gains back */
@@ -39,6 +39,7 @@
 #define TTT_MSG_GAINS_READBACK 0x82   /* a gains block as the firmware holds it */
 #define TTT_MSG_STATUS 0x85           /* the sensors and the state after a control step */
 #define TTT_MSG_HEARTBEAT_REPLY 0x86  /* the heartbeat's token, the step and the link's counters */
+#define TTT_FIRST_TO_PC 0x80          /* types from here on: firmware -> PC */
 
 /* Why bytes or a frame were rejected (the same numbers on both sides of the link). */
 #define TTT_REJ_COBS 0          /* not valid COBS */

@@ -16,7 +16,7 @@ from dataclasses import Field, dataclass
 from typing import Any, ClassVar, Self
 
 from ...twin.layout import DRIVES, N_CG, N_CP
-from .protocol import BODIES, GAINS_BLOCKS, PROTOCOL_VERSION, Group, Msg, Op, State, body_of, gains_body
+from .protocol import BODIES, FIRST_TO_PC, GAINS_BLOCKS, PROTOCOL_VERSION, Group, Msg, Op, State, body_of, gains_body
 
 STATE_NAMES = tuple(s.name.lower() for s in State)
 
@@ -265,8 +265,8 @@ class EmuTruth(Message):
 MESSAGES: dict[int, type[Message]] = {m.KIND: m for m in (
     Hello, Gains, GainsRead, Setpoints, Heartbeat, Drive, Start, Handshake, GainsReadback, Status, HeartbeatReply,
     EmuTruth)}
-TO_FIRMWARE = frozenset(k for k in MESSAGES if k < 0x80)
-TO_PC = frozenset(k for k in MESSAGES if k >= 0x80)
+TO_FIRMWARE = frozenset(k for k in MESSAGES if k < FIRST_TO_PC)
+TO_PC = frozenset(k for k in MESSAGES if k >= FIRST_TO_PC)
 
 
 def body_length(kind: int, body: bytes) -> int | None:

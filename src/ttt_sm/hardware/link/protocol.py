@@ -44,8 +44,12 @@ class Numbered(IntEnum):
         return member
 
 
+#: The first message type that goes firmware -> PC: the types below it go PC -> firmware.
+FIRST_TO_PC = 0x80
+
+
 class Msg(Numbered):
-    """Message types: PC -> firmware below 0x80, firmware -> PC from 0x80."""
+    """Message types: PC -> firmware below 0x80, firmware -> PC from 0x80 (FIRST_TO_PC)."""
 
     HELLO = 0x01, "start a session: the firmware answers HANDSHAKE"
     GAINS = 0x02, "one block of the controller's parameters (idle or safe_stop only)"
@@ -266,7 +270,7 @@ def body_of(kind: Msg, block: int = 0) -> Body:
     return BODIES[kind]
 
 
-__all__ = ["BODIES", "CRC_BYTES", "EMULATOR_ONLY", "GAINS_BLOCKS", "GAINS_DRIVE", "GAINS_GLOBAL",
+__all__ = ["BODIES", "CRC_BYTES", "EMULATOR_ONLY", "FIRST_TO_PC", "GAINS_BLOCKS", "GAINS_DRIVE", "GAINS_GLOBAL",
            "GAINS_GLOBAL_BLOCK", "HEAD", "HEADER", "HEAD_FORMAT", "MAX_BODY", "MAX_ENCODED", "MAX_FRAME",
            "PROTOCOL_VERSION", "Body", "Field", "Group", "Msg", "Numbered", "Op", "Reason", "State", "body", "body_of",
            "gains_body"]

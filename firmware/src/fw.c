@@ -90,7 +90,10 @@ static void send_status(ttt_fw *fw)
     ttt_put_u32(b + TTT_STATUS_STEP, fw->step);
     b[TTT_STATUS_STATE] = fw->state;
     b[TTT_STATUS_INDEX] = s->index;
-    for (d = 0; d < TTT_DRIVES; d++) modes = (uint8_t)(modes | ((fw->cascade.cm[d] & 3) << (2 * d)));
+    for (d = 0; d < TTT_DRIVES; d++) {
+        int mode = fw->cascade.cm[d] & ((1 << TTT_STATUS_MODE_BITS) - 1);
+        modes = (uint8_t)(modes | (mode << (TTT_STATUS_MODE_BITS * d)));
+    }
     b[TTT_STATUS_MODES] = modes;
     for (d = 0; d < TTT_DRIVES; d++) {
         float ma = s->current_a[d] * 1000.0f;
@@ -196,7 +199,7 @@ static int handle(ttt_fw *fw, uint8_t type, const uint8_t *b, size_t n)
             if (!finite((double)v) || !setpoint_in_range(&fw->board, k, v)) return TTT_REJ_VALUE;
             q[k] = (ttt_real)v;
         }
-        ttt_cascade_set_setpoints(&fw->cascade, q, b[TTT_SETPOINTS_FLAGS] & 1);
+        ttt_cascade_set_setpoints(&fw->cascade, q, b[TTT_SETPOINTS_FLAGS] & TTT_SETPOINTS_FLAG_FR_SW);
         fw->last_setpoint_step = fw->step;
         fw->setpoints_ok++;
         return -1;

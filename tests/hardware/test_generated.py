@@ -141,6 +141,9 @@ def _protocol_as_the_pc_speaks_it() -> dict[str, int]:
     at = _where_the_pc_packs(drive_row)
     want |= {"GAINS_BLOCK": at["block"][0], "GAINS_VALUES": at["values_"][0], "GAINS_BLOCK_GLOBAL": global_row.block,
              "BODY_GAINS_DRIVE": len(drive_row.pack()), "BODY_GAINS_GLOBAL": len(global_row.pack())}
+    slow = L.Setpoints(0, (0.0,) * 4, fr_sw=True).pack()
+    want["SETPOINTS_FLAG_FR_SW"] = slow[-1]  # the flags byte ends the body
+    want["STATUS_MODE_BITS"] = 2  # docs/hardware.md: 2 bits per drive
     for cls in L.MESSAGES.values():
         kind = cls.KIND.name
         if cls.KIND in (L.Msg.GAINS, L.Msg.GAINS_READBACK, L.Msg.EMU_TRUTH):

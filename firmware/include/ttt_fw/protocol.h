@@ -75,6 +75,10 @@
 #define TTT_BODY_GAINS_DRIVE 81    /* blocks 0..2 */
 #define TTT_BODY_GAINS_GLOBAL 145  /* block 3 */
 
+/* bits within a field */
+#define TTT_SETPOINTS_FLAG_FR_SW 1  /* the bit of SETPOINTS' FLAGS that selects the slow setpoint filters (fr_sw) */
+#define TTT_STATUS_MODE_BITS 2      /* the bits of STATUS' MODES each drive's mode (TTT_MODE_*) takes, drive 1's lowest */
+
 /* HELLO (0x01): start a session: the firmware answers HANDSHAKE */
 #define TTT_HELLO_PROTOCOL 0  /* the PC's protocol version */
 #define TTT_BODY_HELLO 1
@@ -86,7 +90,7 @@
 /* SETPOINTS (0x04): the setpoints of one control step (running only) */
 #define TTT_SETPOINTS_STEP 0    /* the control step they are meant for */
 #define TTT_SETPOINTS_Q 4       /* drives 1-3 (encoder coordinates), then the servo, rad */
-#define TTT_SETPOINTS_FLAGS 20  /* bit 0: fr_sw, the slow setpoint filters */
+#define TTT_SETPOINTS_FLAGS 20  /* TTT_SETPOINTS_FLAG_* */
 #define TTT_BODY_SETPOINTS 21
 
 /* HEARTBEAT (0x05): the idle link's sign of life: the firmware answers HEARTBEAT_REPLY */
@@ -121,7 +125,7 @@
 #define TTT_STATUS_STEP 0          /* control steps since power-on */
 #define TTT_STATUS_STATE 4         /* the state (State, TTT_STATE_*) */
 #define TTT_STATUS_INDEX 5         /* bit d: drive d's index switch level */
-#define TTT_STATUS_MODES 6         /* 2 bits per drive, drive 1 lowest: its TTT_MODE_* */
+#define TTT_STATUS_MODES 6         /* each drive's TTT_MODE_* in TTT_STATUS_MODE_BITS bits, drive 1 lowest */
 #define TTT_STATUS_COUNTS 7        /* encoder counts */
 #define TTT_STATUS_INDEX_COUNT 19  /* counts latched at the last index edge */
 #define TTT_STATUS_INDEX_EDGES 31  /* index edges seen */

@@ -135,6 +135,7 @@ def protocol_h(bodies: Mapping[protocol.Msg, protocol.Body] = protocol.BODIES) -
             ("BODY_GAINS_DRIVE", p.GAINS_DRIVE.size, f"blocks 0..{last_drive_block}"),
             ("BODY_GAINS_GLOBAL", p.GAINS_GLOBAL.size, f"block {p.GAINS_GLOBAL_BLOCK}")]),
     ]
+    sections.append(("bits within a field", list(p.FIELD_BITS)))
     sections += [(f"{m.name} (0x{m:02X}): {m.doc}", [*_body(m.name, bodies[m]), (f"BODY_{m.name}", bodies[m].size, "")])
                  for m in firmware if m in bodies]
     names = [name for _, rows in sections for name, _, _ in rows]

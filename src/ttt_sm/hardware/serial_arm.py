@@ -49,6 +49,7 @@ from .firmware_link import (
     LinkLost,
     SerialArmError,
 )
+from .link.protocol import STATUS_MODE_BITS
 from .link_truth import LinkTruth
 
 REARM_SETTLE_S = 0.2
@@ -253,7 +254,8 @@ class SerialArm(FirmwareLink):
 
     def enabled(self) -> tuple[bool, bool, bool]:
         m = 0 if self._status is None else self._status.modes
-        return tuple(((m >> (2 * d)) & 3) == layout.MODE_CLOSED for d in range(3))  # type: ignore[return-value]
+        bits, mask = STATUS_MODE_BITS, (1 << STATUS_MODE_BITS) - 1
+        return tuple(((m >> (bits * d)) & mask) == layout.MODE_CLOSED for d in range(3))  # type: ignore[return-value]
 
     def set_enabled(self, drive: int, enabled: bool) -> None:
         d = check_drive(drive) - 1

@@ -16,7 +16,19 @@ from dataclasses import Field, dataclass
 from typing import Any, ClassVar, Self
 
 from ...twin.layout import DRIVES, N_CG, N_CP
-from .protocol import BODIES, FIRST_TO_PC, GAINS_BLOCKS, PROTOCOL_VERSION, Group, Msg, Op, State, body_of, gains_body
+from .protocol import (
+    BODIES,
+    FIRST_TO_PC,
+    GAINS_BLOCKS,
+    PROTOCOL_VERSION,
+    SETPOINTS_FLAG_FR_SW,
+    Group,
+    Msg,
+    Op,
+    State,
+    body_of,
+    gains_body,
+)
 
 STATE_NAMES = tuple(s.name.lower() for s in State)
 
@@ -141,7 +153,7 @@ class GainsRead(Message):
 class Setpoints(Message):
     """Setpoints meant for firmware control step `step`: drives 1-3 (encoder coordinates) and the servo, rad.
 
-    The body's ``FLAGS`` byte holds `fr_sw` in bit 0.
+    The body's ``FLAGS`` byte holds `fr_sw` (:data:`.protocol.SETPOINTS_FLAG_FR_SW`).
     """
 
     KIND: ClassVar[Msg] = Msg.SETPOINTS
@@ -150,12 +162,12 @@ class Setpoints(Message):
     fr_sw: bool = False
 
     def values(self) -> tuple[float | int, ...]:
-        return (self.step, *self.q, 1 if self.fr_sw else 0)
+        return (self.step, *self.q, SETPOINTS_FLAG_FR_SW if self.fr_sw else 0)
 
     @classmethod
     def unpack(cls, body: bytes) -> Self:
         step, a, b, c, d, flags = struct.unpack(cls.FORMAT, body)
-        return cls(step, (a, b, c, d), bool(flags & 1))
+        return cls(step, (a, b, c, d), bool(flags & SETPOINTS_FLAG_FR_SW))
 
     def check(self) -> str | None:
         return None if _finite(self.q) else f"setpoints {self.q} are not all finite"
@@ -212,7 +224,7 @@ class Status(Message):
     step: int
     state: int
     index: int  # bit d: drive d's index switch level
-    modes: int  # 2 bits per drive, drive 1 lowest
+    modes: int  # STATUS_MODE_BITS bits per drive, drive 1 lowest
     counts: tuple[int, int, int]
     index_count: tuple[int, int, int]
     index_edges: tuple[int, int, int]

@@ -189,6 +189,13 @@ def body(*items: Field | Group) -> Body:
     return Body(items)
 
 
+#: Bits within a field, ``(NAME, value, doc)``: the C's ``TTT_<NAME>``.
+FIELD_BITS = (
+    ("SETPOINTS_FLAG_FR_SW", 0x01, "the bit of SETPOINTS' FLAGS that selects the slow setpoint filters (fr_sw)"),
+    ("STATUS_MODE_BITS", 2, "the bits of STATUS' MODES each drive's mode (TTT_MODE_*) takes, drive 1's lowest"),
+)
+SETPOINTS_FLAG_FR_SW, STATUS_MODE_BITS = (value for _, value, _ in FIELD_BITS)
+
 #: A frame's head before its body.
 HEAD = body(Field("TYPE", "B", doc="the message type (TTT_MSG_*)"),
             Field("SEQ", "H", doc="the sequence number, +1 per frame sent (wraps)"))
@@ -220,7 +227,7 @@ BODIES: dict[Msg, Body] = {
     Msg.SETPOINTS: body(
         Field("STEP", "I", doc="the control step they are meant for"),
         Field("Q", "f", DRIVES + 1, doc="drives 1-3 (encoder coordinates), then the servo, rad"),
-        Field("FLAGS", "B", doc="bit 0: fr_sw, the slow setpoint filters")),
+        Field("FLAGS", "B", doc="TTT_SETPOINTS_FLAG_*")),
     Msg.HEARTBEAT: body(Field("TOKEN", "I", doc="echoed in the reply")),
     Msg.DRIVE: body(
         Field("DRIVE", "B", doc=f"0..{DRIVES - 1}"),
@@ -243,7 +250,7 @@ BODIES: dict[Msg, Body] = {
         Field("STEP", "I", doc="control steps since power-on"),
         Field("STATE", "B", doc="the state (State, TTT_STATE_*)"),
         Field("INDEX", "B", doc="bit d: drive d's index switch level"),
-        Field("MODES", "B", doc="2 bits per drive, drive 1 lowest: its TTT_MODE_*"),
+        Field("MODES", "B", doc="each drive's TTT_MODE_* in TTT_STATUS_MODE_BITS bits, drive 1 lowest"),
         Field("COUNTS", "i", DRIVES, doc="encoder counts"),
         Field("INDEX_COUNT", "i", DRIVES, doc="counts latched at the last index edge"),
         Field("INDEX_EDGES", "H", DRIVES, doc="index edges seen"),
@@ -270,7 +277,7 @@ def body_of(kind: Msg, block: int = 0) -> Body:
     return BODIES[kind]
 
 
-__all__ = ["BODIES", "CRC_BYTES", "EMULATOR_ONLY", "FIRST_TO_PC", "GAINS_BLOCKS", "GAINS_DRIVE", "GAINS_GLOBAL",
-           "GAINS_GLOBAL_BLOCK", "HEAD", "HEADER", "HEAD_FORMAT", "MAX_BODY", "MAX_ENCODED", "MAX_FRAME",
-           "PROTOCOL_VERSION", "Body", "Field", "Group", "Msg", "Numbered", "Op", "Reason", "State", "body", "body_of",
-           "gains_body"]
+__all__ = ["BODIES", "CRC_BYTES", "EMULATOR_ONLY", "FIELD_BITS", "FIRST_TO_PC", "GAINS_BLOCKS", "GAINS_DRIVE",
+           "GAINS_GLOBAL", "GAINS_GLOBAL_BLOCK", "HEAD", "HEADER", "HEAD_FORMAT", "MAX_BODY", "MAX_ENCODED",
+           "MAX_FRAME", "PROTOCOL_VERSION", "SETPOINTS_FLAG_FR_SW", "STATUS_MODE_BITS", "Body", "Field", "Group", "Msg",
+           "Numbered", "Op", "Reason", "State", "body", "body_of", "gains_body"]

@@ -36,7 +36,7 @@ lint: setup
 	.venv/bin/ruff check src tests tools
 	.venv/bin/mypy
 
-# Every generated file of the repository: charts/, docs/architecture.md, the firmware's layout.h
+# Every generated file of the repository: charts/, docs/architecture.md, the firmware's layout.h and protocol.h
 # (tools/docs.py, a development tool: not in the installed package).  `make docs CHECK=1` only checks.
 docs: setup
 	$(PY) -m tools.docs $(if $(CHECK),check,export)
@@ -49,7 +49,8 @@ tune: setup
 
 # The firmware's portable C (firmware/), built with the system compiler as the tests
 # load it, both precisions, every warning an error (flags: ttt_sm.hardware.firmware),
-# after checking its generated layout.h is what twin/layout.py's tables make.
+# after checking its generated layout.h and protocol.h are what the tables of twin/layout.py and
+# hardware/link/protocol.py make.
 firmware: setup
 	$(PY) -m ttt_sm.hardware.generate --check
 	$(PY) -m ttt_sm.hardware.firmware out/firmware

@@ -22,12 +22,18 @@ from ttt_sm.hardware import generate
 from ttt_sm.hardware import link as L
 from ttt_sm.hardware.firmware import firmware_root
 from ttt_sm.hardware.link import protocol
+from ttt_sm.params import LIMITS
 from ttt_sm.twin import layout
 
 
 def _defines(text: str) -> dict[str, int]:
     return {name: int(value, 0) for name, value in re.findall(r"^#define TTT_(\w+) (0x[0-9A-F]+|\d+)\b(?![.e])", text,
                                                               re.MULTILINE)}
+
+
+def _names(text: str) -> set[str]:
+    """Every name a C text defines with a value (a number or not)."""
+    return set(re.findall(r"^#define TTT_(\w+) \S", text, re.MULTILINE))
 
 
 def _header(name: str) -> str:
@@ -167,16 +173,18 @@ def test_the_protocol_header_defines_what_the_pc_sends_and_nothing_else():
     want = _protocol_as_the_pc_speaks_it()
     assert _defines(header) == want
     assert want["BODY_HANDSHAKE"] == 70 and want["HANDSHAKE_DRIVE_STRIDE"] == 16 and want["STATUS_SERVO_ADC"] == 43
+    period = re.search(r"^#define TTT_SV_PERIOD_MAX_S (\S+) ", header, re.MULTILINE)
+    assert period and float(period[1]) == LIMITS["servo.period_s"][1]  # what the PC's parameter files may hold
     for r in L.Reason:  # the reasons' docs are the C's comments
         assert re.search(rf"^#define TTT_REJ_{r.name} {r.value} +/\* {re.escape(r.doc)} \*/$", header, re.MULTILINE)
 
 
 def test_link_h_and_fw_h_take_the_protocol_from_the_generated_header():
-    generated = set(_defines(_header("protocol.h")))
+    generated = _names(_header("protocol.h"))
     for name in ("link.h", "fw.h"):
         text = _header(name)
         assert '#include "protocol.h"' in text, name
-        assert not set(_defines(text)) & generated, f"{name} defines a number of protocol.h by hand"
+        assert not _names(text) & generated, f"{name} defines a number of protocol.h by hand"
     for name in ("link.c", "fw.c"):  # bodies are read and written at the generated offsets, never at a literal one
         text = (firmware_root() / "src" / name).read_text()
         assert not re.search(r"(?<![.\w])(?<!uint8_t )(b|body|frame)( \+ \d|\[\d)", text), name

@@ -31,11 +31,10 @@
 /* What the board is: told to the PC in the handshake. */
 /* What GAINS may carry (checked in fw.c, rejected as TTT_REJ_VALUE; docs/hardware.md): no gain or
  * coefficient beyond +-TTT_GAIN_MAX, a control step in [TTT_DT_MIN_S, TTT_DT_MAX_S], a servo PWM
- * period up to TTT_SV_PERIOD_MAX_S. */
+ * period up to TTT_SV_PERIOD_MAX_S (protocol.h: the bound of the PC's parameter files). */
 #define TTT_GAIN_MAX 1.0e6
 #define TTT_DT_MIN_S 1.0e-5
 #define TTT_DT_MAX_S 0.1
-#define TTT_SV_PERIOD_MAX_S 0.1
 
 typedef struct ttt_board {
     double rad_per_count[TTT_DRIVES];

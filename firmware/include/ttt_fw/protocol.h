@@ -79,6 +79,9 @@
 #define TTT_SETPOINTS_FLAG_FR_SW 1  /* the bit of SETPOINTS' FLAGS that selects the slow setpoint filters (fr_sw) */
 #define TTT_STATUS_MODE_BITS 2      /* the bits of STATUS' MODES each drive's mode (TTT_MODE_*) takes, drive 1's lowest */
 
+/* what GAINS may carry, as the PC's parameter files may (ttt_sm.params.LIMITS) */
+#define TTT_SV_PERIOD_MAX_S 0.1  /* the servo's PWM period, s: [servo] period_s */
+
 /* HELLO (0x01): start a session: the firmware answers HANDSHAKE */
 #define TTT_HELLO_PROTOCOL 0  /* the PC's protocol version */
 #define TTT_BODY_HELLO 1

@@ -31,6 +31,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
 from ..files import RecordWriteError, write_atomic
+from ..params import LIMITS
 from ..twin import layout
 from .firmware import firmware_root
 from .link import protocol
@@ -136,6 +137,8 @@ def protocol_h(bodies: Mapping[protocol.Msg, protocol.Body] = protocol.BODIES) -
             ("BODY_GAINS_GLOBAL", p.GAINS_GLOBAL.size, f"block {p.GAINS_GLOBAL_BLOCK}")]),
     ]
     sections.append(("bits within a field", list(p.FIELD_BITS)))
+    sections.append(("what GAINS may carry, as the PC's parameter files may (ttt_sm.params.LIMITS)", [
+        ("SV_PERIOD_MAX_S", repr(float(LIMITS["servo.period_s"][1])), "the servo's PWM period, s: [servo] period_s")]))
     sections += [(f"{m.name} (0x{m:02X}): {m.doc}", [*_body(m.name, bodies[m]), (f"BODY_{m.name}", bodies[m].size, "")])
                  for m in firmware if m in bodies]
     names = [name for _, rows in sections for name, _, _ in rows]

@@ -163,7 +163,7 @@ int ttt_seq_accept(ttt_seq *s, uint16_t seq)
     uint16_t delta = (uint16_t)(seq - s->last);
     if (s->have) {
         if (delta == 0) return TTT_REJ_DUPLICATE;
-        if (delta >= 0x8000u) return TTT_REJ_OUT_OF_ORDER;
+        if (delta >= TTT_SEQ_BEHIND) return TTT_REJ_OUT_OF_ORDER;
         s->lost += (uint32_t)(delta - 1u);
     }
     s->have = 1;

@@ -130,11 +130,19 @@ def _where_the_pc_packs(message: L.Message) -> dict[str, list[int]]:
     return out
 
 
+def _out_of_order(delta: int) -> bool:
+    """Whether the PC's receiver refuses a sequence number `delta` after the last as out of order."""
+    seq = L.SeqTracker()
+    seq.accept(0)
+    return seq.accept(delta) == L.Reason.OUT_OF_ORDER
+
+
 def _protocol_as_the_pc_speaks_it() -> dict[str, int]:
     """What protocol.h must define, found from the PC's messages, their packed bytes and frames."""
     want = {"PROTOCOL_VERSION": L.PROTOCOL_VERSION, "HEADER": L.HEADER, "CRC": L.CRC_BYTES, "MAX_BODY": L.MAX_BODY,
             "MAX_FRAME": L.MAX_FRAME, "MAX_ENCODED": L.MAX_ENCODED, "N_REJ": L.N_REASONS,
             "GAINS_BLOCKS": L.GAINS_BLOCKS}
+    want["SEQ_BEHIND"] = next(d for d in range(1, 0x10000) if _out_of_order(d))
     frame = L.cobs_decode(L.encode_frame(0x11, 0x0011, b"")[:-1])
     want |= {"FRAME_TYPE": frame.index(0x11), "FRAME_SEQ": frame.index(0x11, 1)}
     want |= {f"MSG_{m.name}": m.value for m in L.Msg if m is not L.Msg.EMU_TRUTH}  # the emulator's own: not the C's

@@ -19,13 +19,14 @@
 #define TTT_PROTOCOL_VERSION 2
 
 /* a frame: its head, the body, the CRC */
-#define TTT_FRAME_TYPE 0     /* the message type (TTT_MSG_*) */
-#define TTT_FRAME_SEQ 1      /* the sequence number, +1 per frame sent (wraps) */
-#define TTT_HEADER 3         /* the head's bytes */
-#define TTT_CRC 2            /* CRC-16/CCITT-FALSE, MSB first */
-#define TTT_MAX_BODY 160     /* the longest body a frame may carry */
-#define TTT_MAX_FRAME 165    /* header, body, CRC */
-#define TTT_MAX_ENCODED 166  /* COBS-encoded, without the 0x00: one byte added per 254 */
+#define TTT_FRAME_TYPE 0       /* the message type (TTT_MSG_*) */
+#define TTT_FRAME_SEQ 1        /* the sequence number, +1 per frame sent (wraps) */
+#define TTT_HEADER 3           /* the head's bytes */
+#define TTT_CRC 2              /* CRC-16/CCITT-FALSE, MSB first */
+#define TTT_MAX_BODY 160       /* the longest body a frame may carry */
+#define TTT_MAX_FRAME 165      /* header, body, CRC */
+#define TTT_MAX_ENCODED 166    /* COBS-encoded, without the 0x00: one byte added per 254 */
+#define TTT_SEQ_BEHIND 0x8000  /* a seq this far (mod 2^16) or farther after the last is behind it */
 
 /* Message types: PC -> firmware below 0x80, firmware -> PC from 0x80 (FIRST_TO_PC). */
 #define TTT_MSG_HELLO 0x01            /* start a session: the firmware answers HANDSHAKE */

@@ -206,6 +206,8 @@ CRC_BYTES = 2
 MAX_BODY = 160
 """The longest body a frame may carry (the longest message's is shorter: room to grow)."""
 MAX_FRAME = HEADER + MAX_BODY + CRC_BYTES
+SEQ_BEHIND = 0x8000
+"""A sequence number this many (modulo 2^16) or more after the last is behind it: out of order."""
 MAX_ENCODED = MAX_FRAME + MAX_FRAME // 254 + 1
 """The longest COBS-encoded frame, without its closing 0x00 (COBS adds at most one byte per 254)."""
 
@@ -279,5 +281,5 @@ def body_of(kind: Msg, block: int = 0) -> Body:
 
 __all__ = ["BODIES", "CRC_BYTES", "EMULATOR_ONLY", "FIELD_BITS", "FIRST_TO_PC", "GAINS_BLOCKS", "GAINS_DRIVE",
            "GAINS_GLOBAL", "GAINS_GLOBAL_BLOCK", "HEAD", "HEADER", "HEAD_FORMAT", "MAX_BODY", "MAX_ENCODED",
-           "MAX_FRAME", "PROTOCOL_VERSION", "SETPOINTS_FLAG_FR_SW", "STATUS_MODE_BITS", "Body", "Field", "Group", "Msg",
-           "Numbered", "Op", "Reason", "State", "body", "body_of", "gains_body"]
+           "MAX_FRAME", "PROTOCOL_VERSION", "SEQ_BEHIND", "SETPOINTS_FLAG_FR_SW", "STATUS_MODE_BITS", "Body", "Field",
+           "Group", "Msg", "Numbered", "Op", "Reason", "State", "body", "body_of", "gains_body"]

@@ -103,7 +103,6 @@ def test_an_unwritable_generated_file_is_said_in_one_line_and_nothing_half_writt
     assert sorted(p.name for p in (root / "include" / "ttt_fw").iterdir()) == ["layout.h"]  # no temporary left
 
 
-
 #: The attributes of a message its body's fields are not named after.
 _FIELD_OF = {"fr_sw": "FLAGS"}
 #: The fields a body repeats drive by drive, interleaved (docs/hardware.md: HANDSHAKE, "per drive: ...").
@@ -210,19 +209,19 @@ def test_a_field_added_to_a_message_table_moves_the_offsets_after_it_and_the_len
     items[group] = replace(old_group, fields=(*old_group.fields, protocol.Field("SPARE", "f")))  # 4 bytes a drive
     grown = protocol.Body(tuple(items))
     after = _defines(generate.protocol_h({**protocol.BODIES, L.Msg.HANDSHAKE: grown}))
-    drives = 4 * L.DRIVES
+    spare = 4 * L.DRIVES  # SPARE's bytes: one f32 a drive
     assert after["HANDSHAKE_DRIVE_STRIDE"] == before["HANDSHAKE_DRIVE_STRIDE"] + 4
     assert after["HANDSHAKE_SPARE"] == before["HANDSHAKE_LIMIT_MAX_RAD"] + 4
-    assert after["HANDSHAKE_NEW"] == before["HANDSHAKE_SERVO_MIN_RAD"] + drives
-    assert after["HANDSHAKE_SERVO_MIN_RAD"] == before["HANDSHAKE_SERVO_MIN_RAD"] + drives + 2
-    assert after["HANDSHAKE_SERVO_SAFE_RAD"] == before["HANDSHAKE_SERVO_SAFE_RAD"] + drives + 2
-    assert after["BODY_HANDSHAKE"] == before["BODY_HANDSHAKE"] + drives + 2 == struct.calcsize(grown.format)
+    assert after["HANDSHAKE_NEW"] == before["HANDSHAKE_SERVO_MIN_RAD"] + spare
+    assert after["HANDSHAKE_SERVO_MIN_RAD"] == before["HANDSHAKE_SERVO_MIN_RAD"] + spare + 2
+    assert after["HANDSHAKE_SERVO_SAFE_RAD"] == before["HANDSHAKE_SERVO_SAFE_RAD"] + spare + 2
+    assert after["BODY_HANDSHAKE"] == before["BODY_HANDSHAKE"] + spare + 2 == struct.calcsize(grown.format)
     unmoved = ("HANDSHAKE_CONTROL_PERIOD_US", "HANDSHAKE_RAD_PER_COUNT", "HANDSHAKE_LIMIT_MAX_RAD", "BODY_STATUS")
     assert all(after[k] == before[k] for k in unmoved)
 
 
 def test_a_protocol_name_defined_twice_is_refused():
-    clash = protocol.body(protocol.Field("RAD_PER_COUNT", "d"))  # HELLO_RAD_PER_COUNT: fine; as HANDSHAKE's: twice
-    twice = protocol.Body((*protocol.BODIES[L.Msg.HANDSHAKE].items, *clash.items))
+    second = protocol.Field("RAD_PER_COUNT", "d")  # a field of the name a HANDSHAKE field has
+    twice = protocol.Body((*protocol.BODIES[L.Msg.HANDSHAKE].items, second))
     with pytest.raises(ValueError, match="TTT_HANDSHAKE_RAD_PER_COUNT"):
         generate.protocol_h({**protocol.BODIES, L.Msg.HANDSHAKE: twice})

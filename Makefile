@@ -36,7 +36,8 @@ lint: setup
 	.venv/bin/ruff check src tests tools
 	.venv/bin/mypy
 
-# Every generated file of the repository: charts/, docs/architecture.md, the firmware's layout.h, structs.h
+# Every generated file of the repository: charts/, docs/architecture.md, the firmware's layout.h, structs.h,
+# protocol.h and the reference board's arm_board.h
 # (tools/docs.py, a development tool: not in the installed package).  `make docs CHECK=1` only checks.
 docs: setup
 	$(PY) -m tools.docs $(if $(CHECK),check,export)
@@ -50,7 +51,7 @@ tune: setup
 # The firmware's portable C (firmware/), built with the system compiler as the tests
 # load it, both precisions, every warning an error (flags: ttt_sm.hardware.firmware),
 # after checking its generated headers are what their tables make (layout.h: twin/layout.py,
-# structs.h: hardware/structs.py).
+# structs.h: hardware/structs.py, protocol.h: hardware/link/protocol.py, arm_board.h: data/arm.toml).
 firmware: setup
 	$(PY) -m ttt_sm.hardware.generate --check
 	$(PY) -m ttt_sm.hardware.firmware out/firmware

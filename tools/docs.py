@@ -2,8 +2,8 @@
 
 ``export`` writes the chart diagrams in ``charts/`` (as ``ttt-sm charts
 export`` does), ``docs/architecture.md`` with its pictures, and the firmware's
-generated headers (``layout.h``, ``structs.h``); ``check`` lists the files that are stale and exits
-with status 1 if there are any.  Run it from the repository's root with the
+generated headers (``layout.h``, ``structs.h``, ``protocol.h``, ``arm_board.h``); ``check`` lists the
+files that are stale and exits with status 1 if there are any.  Run it from the repository's root with the
 repository's Python (``.venv/bin/python -m tools.docs check``) or pass
 ``--root``.  A development tool: the installed package does not carry it (the
 wheel has no repository to write into).

@@ -27,24 +27,25 @@ static void reject(ttt_fw *fw, int reason)
 
 static void send_handshake(ttt_fw *fw)
 {
-    uint8_t b[70];
+    uint8_t b[TTT_BODY_HANDSHAKE];
     const ttt_board *bd = &fw->board;
     int d;
-    b[0] = TTT_PROTOCOL_VERSION;
-    b[1] = TTT_FW_VERSION_MAJOR;
-    b[2] = TTT_FW_VERSION_MINOR;
-    b[3] = TTT_FW_VERSION_PATCH;
-    b[4] = TTT_DRIVES;
-    b[5] = (uint8_t)sizeof(ttt_real);
-    ttt_put_u32(b + 6, bd->control_period_us);
+    b[TTT_HANDSHAKE_PROTOCOL] = TTT_PROTOCOL_VERSION;
+    b[TTT_HANDSHAKE_FIRMWARE] = TTT_FW_VERSION_MAJOR;
+    b[TTT_HANDSHAKE_FIRMWARE + 1] = TTT_FW_VERSION_MINOR;
+    b[TTT_HANDSHAKE_FIRMWARE + 2] = TTT_FW_VERSION_PATCH;
+    b[TTT_HANDSHAKE_DRIVES] = TTT_DRIVES;
+    b[TTT_HANDSHAKE_REAL_SIZE] = (uint8_t)sizeof(ttt_real);
+    ttt_put_u32(b + TTT_HANDSHAKE_CONTROL_PERIOD_US, bd->control_period_us);
     for (d = 0; d < TTT_DRIVES; d++) {
-        ttt_put_f64(b + 10 + 16 * d, bd->rad_per_count[d]);
-        ttt_put_f32(b + 18 + 16 * d, bd->limit_min_rad[d]);
-        ttt_put_f32(b + 22 + 16 * d, bd->limit_max_rad[d]);
+        uint8_t *drive = b + TTT_HANDSHAKE_DRIVE_STRIDE * d;
+        ttt_put_f64(drive + TTT_HANDSHAKE_RAD_PER_COUNT, bd->rad_per_count[d]);
+        ttt_put_f32(drive + TTT_HANDSHAKE_LIMIT_MIN_RAD, bd->limit_min_rad[d]);
+        ttt_put_f32(drive + TTT_HANDSHAKE_LIMIT_MAX_RAD, bd->limit_max_rad[d]);
     }
-    ttt_put_f32(b + 58, bd->servo_min_rad);
-    ttt_put_f32(b + 62, bd->servo_max_rad);
-    ttt_put_f32(b + 66, bd->servo_safe_rad);
+    ttt_put_f32(b + TTT_HANDSHAKE_SERVO_MIN_RAD, bd->servo_min_rad);
+    ttt_put_f32(b + TTT_HANDSHAKE_SERVO_MAX_RAD, bd->servo_max_rad);
+    ttt_put_f32(b + TTT_HANDSHAKE_SERVO_SAFE_RAD, bd->servo_safe_rad);
     send(fw, TTT_MSG_HANDSHAKE, b, sizeof b);
 }
 
@@ -60,46 +61,49 @@ static ttt_real *gains_block(ttt_fw *fw, uint8_t block, int *count)
 
 static void send_gains(ttt_fw *fw, uint8_t block)
 {
-    uint8_t b[1 + 8 * TTT_N_CG];
+    uint8_t b[TTT_BODY_GAINS_GLOBAL];
     int count, k;
     const ttt_real *v = gains_block(fw, block, &count);
-    b[0] = block;
-    for (k = 0; k < count; k++) ttt_put_f64(b + 1 + 8 * k, (double)v[k]);
-    send(fw, TTT_MSG_GAINS_READBACK, b, 1 + 8 * (size_t)count);
+    b[TTT_GAINS_BLOCK] = block;
+    for (k = 0; k < count; k++) ttt_put_f64(b + TTT_GAINS_VALUES + 8 * k, (double)v[k]);
+    send(fw, TTT_MSG_GAINS_READBACK, b, TTT_GAINS_VALUES + 8 * (size_t)count);
 }
 
 static void send_heartbeat_reply(ttt_fw *fw, uint32_t token)
 {
-    uint8_t b[16 + 4 * TTT_N_REJ];
+    uint8_t b[TTT_BODY_HEARTBEAT_REPLY];
     int r;
-    ttt_put_u32(b, token);
-    ttt_put_u32(b + 4, fw->step);
-    ttt_put_u32(b + 8, fw->frames_ok);
-    ttt_put_u32(b + 12, fw->rx_seq.lost);
-    for (r = 0; r < TTT_N_REJ; r++) ttt_put_u32(b + 16 + 4 * r, fw->rejections[r]);
+    ttt_put_u32(b + TTT_HEARTBEAT_REPLY_TOKEN, token);
+    ttt_put_u32(b + TTT_HEARTBEAT_REPLY_STEP, fw->step);
+    ttt_put_u32(b + TTT_HEARTBEAT_REPLY_FRAMES_OK, fw->frames_ok);
+    ttt_put_u32(b + TTT_HEARTBEAT_REPLY_LOST, fw->rx_seq.lost);
+    for (r = 0; r < TTT_N_REJ; r++) ttt_put_u32(b + TTT_HEARTBEAT_REPLY_REJECTIONS + 4 * r, fw->rejections[r]);
     send(fw, TTT_MSG_HEARTBEAT_REPLY, b, sizeof b);
 }
 
 static void send_status(ttt_fw *fw)
 {
-    uint8_t b[45];
+    uint8_t b[TTT_BODY_STATUS];
     const ttt_sensors *s = &fw->sensors;
     int d;
     uint8_t modes = 0;
-    ttt_put_u32(b, fw->step);
-    b[4] = fw->state;
-    b[5] = s->index;
-    for (d = 0; d < TTT_DRIVES; d++) modes = (uint8_t)(modes | ((fw->cascade.cm[d] & 3) << (2 * d)));
-    b[6] = modes;
+    ttt_put_u32(b + TTT_STATUS_STEP, fw->step);
+    b[TTT_STATUS_STATE] = fw->state;
+    b[TTT_STATUS_INDEX] = s->index;
+    for (d = 0; d < TTT_DRIVES; d++) {
+        int mode = fw->cascade.cm[d] & ((1 << TTT_STATUS_MODE_BITS) - 1);
+        modes = (uint8_t)(modes | (mode << (TTT_STATUS_MODE_BITS * d)));
+    }
+    b[TTT_STATUS_MODES] = modes;
     for (d = 0; d < TTT_DRIVES; d++) {
         float ma = s->current_a[d] * 1000.0f;
         int32_t i = !finite((double)ma) ? 0 : ma > 32767.0f ? 32767 : ma < -32768.0f ? -32768 : (int32_t)ma;
-        ttt_put_u32(b + 7 + 4 * d, (uint32_t)s->counts[d]);
-        ttt_put_u32(b + 19 + 4 * d, (uint32_t)s->index_count[d]);
-        ttt_put_u16(b + 31 + 2 * d, s->index_edges[d]);
-        ttt_put_u16(b + 37 + 2 * d, (uint16_t)(int16_t)i);
+        ttt_put_u32(b + TTT_STATUS_COUNTS + 4 * d, (uint32_t)s->counts[d]);
+        ttt_put_u32(b + TTT_STATUS_INDEX_COUNT + 4 * d, (uint32_t)s->index_count[d]);
+        ttt_put_u16(b + TTT_STATUS_INDEX_EDGES + 2 * d, s->index_edges[d]);
+        ttt_put_u16(b + TTT_STATUS_CURRENT_MA + 2 * d, (uint16_t)(int16_t)i);
     }
-    ttt_put_u16(b + 43, s->servo_adc); /* raw counts: the PC holds the calibration (docs/hardware.md) */
+    ttt_put_u16(b + TTT_STATUS_SERVO_ADC, s->servo_adc); /* raw counts: the PC calibrates (docs/hardware.md) */
     send(fw, TTT_MSG_STATUS, b, sizeof b);
 }
 
@@ -165,51 +169,53 @@ static int handle(ttt_fw *fw, uint8_t type, const uint8_t *b, size_t n)
         send_handshake(fw);
         return -1;
     case TTT_MSG_GAINS: {
+        uint8_t block = b[TTT_GAINS_BLOCK];
         ttt_real *dst;
         double v[TTT_N_CG];
-        if (b[0] >= TTT_GAINS_BLOCKS) return TTT_REJ_VALUE;
+        if (block >= TTT_GAINS_BLOCKS) return TTT_REJ_VALUE;
         if (fw->state == TTT_STATE_RUNNING) return TTT_REJ_REFUSED;
-        dst = gains_block(fw, b[0], &count);
+        dst = gains_block(fw, block, &count);
         for (k = 0; k < count; k++) {
-            v[k] = ttt_get_f64(b + 1 + 8 * k);
+            v[k] = ttt_get_f64(b + TTT_GAINS_VALUES + 8 * k);
             if (!finite(v[k]) || v[k] > TTT_GAIN_MAX || v[k] < -TTT_GAIN_MAX) return TTT_REJ_VALUE;
         }
-        if (!gains_in_range(b[0], v)) return TTT_REJ_VALUE;
+        if (!gains_in_range(block, v)) return TTT_REJ_VALUE;
         for (k = 0; k < count; k++) dst[k] = (ttt_real)v[k];
-        fw->gains_loaded = (uint8_t)(fw->gains_loaded | (1u << b[0]));
-        send_gains(fw, b[0]);
+        fw->gains_loaded = (uint8_t)(fw->gains_loaded | (1u << block));
+        send_gains(fw, block);
         return -1;
     }
     case TTT_MSG_GAINS_READ:
-        if (b[0] >= TTT_GAINS_BLOCKS) return TTT_REJ_VALUE;
-        send_gains(fw, b[0]);
+        if (b[TTT_GAINS_READ_BLOCK] >= TTT_GAINS_BLOCKS) return TTT_REJ_VALUE;
+        send_gains(fw, b[TTT_GAINS_READ_BLOCK]);
         return -1;
     case TTT_MSG_SETPOINTS: {
-        uint32_t at = ttt_get_u32(b);
+        uint32_t at = ttt_get_u32(b + TTT_SETPOINTS_STEP);
         ttt_real q[4];
         if (fw->state != TTT_STATE_RUNNING) return TTT_REJ_REFUSED;
         if ((uint32_t)(fw->step - at) < 0x80000000u && fw->step - at > fw->board.late_steps) return TTT_REJ_LATE;
         for (k = 0; k < 4; k++) {
-            float v = ttt_get_f32(b + 4 + 4 * k);
+            float v = ttt_get_f32(b + TTT_SETPOINTS_Q + 4 * k);
             if (!finite((double)v) || !setpoint_in_range(&fw->board, k, v)) return TTT_REJ_VALUE;
             q[k] = (ttt_real)v;
         }
-        ttt_cascade_set_setpoints(&fw->cascade, q, b[20] & 1);
+        ttt_cascade_set_setpoints(&fw->cascade, q, b[TTT_SETPOINTS_FLAGS] & TTT_SETPOINTS_FLAG_FR_SW);
         fw->last_setpoint_step = fw->step;
         fw->setpoints_ok++;
         return -1;
     }
     case TTT_MSG_HEARTBEAT:
-        send_heartbeat_reply(fw, ttt_get_u32(b));
+        send_heartbeat_reply(fw, ttt_get_u32(b + TTT_HEARTBEAT_TOKEN));
         return -1;
     case TTT_MSG_DRIVE: {
-        double v = ttt_get_f64(b + 2);
+        double v = ttt_get_f64(b + TTT_DRIVE_VALUE);
+        uint8_t op = b[TTT_DRIVE_OP];
         ttt_real q;
-        d = b[0];
-        if (d >= TTT_DRIVES || b[1] > TTT_OP_OFFSET || !finite(v)) return TTT_REJ_VALUE;
+        d = b[TTT_DRIVE_DRIVE];
+        if (d >= TTT_DRIVES || op > TTT_OP_OFFSET || !finite(v)) return TTT_REJ_VALUE;
         if (fw->state != TTT_STATE_RUNNING) return TTT_REJ_REFUSED;
         q = ttt_cascade_angle(&fw->cascade, d, fw->sensors.counts[d]);
-        switch (b[1]) {
+        switch (op) {
         case TTT_OP_OFF: ttt_cascade_set_mode(&fw->cascade, d, TTT_MODE_OFF, q); break;
         case TTT_OP_CLOSED: ttt_cascade_set_mode(&fw->cascade, d, TTT_MODE_CLOSED, q); break;
         case TTT_OP_OPEN: ttt_cascade_set_open_duty(&fw->cascade, d, (ttt_real)v); break;
@@ -267,7 +273,7 @@ void ttt_fw_rx(ttt_fw *fw, const uint8_t *data, size_t n)
             continue;
         }
         if (got != TTT_RX_FRAME) continue;
-        if (fw->rx.type >= 0x80) { /* a firmware -> PC type: not for us, its number not taken */
+        if (fw->rx.type >= TTT_FIRST_TO_PC) { /* a firmware -> PC type: not for us, its number not taken */
             reject(fw, TTT_REJ_UNKNOWN_TYPE);
             continue;
         }

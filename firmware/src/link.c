@@ -59,17 +59,17 @@ int ttt_cobs_decode(const uint8_t *in, size_t n, uint8_t *out)
 int ttt_body_length(uint8_t type)
 {
     switch (type) {
-    case TTT_MSG_HELLO: return 1;
-    case TTT_MSG_GAINS: return -2; /* variable: see ttt_gains_length */
-    case TTT_MSG_GAINS_READ: return 1;
-    case TTT_MSG_SETPOINTS: return 21;
-    case TTT_MSG_HEARTBEAT: return 4;
-    case TTT_MSG_DRIVE: return 10;
-    case TTT_MSG_START: return 0;
-    case TTT_MSG_HANDSHAKE: return 70;
+    case TTT_MSG_HELLO: return TTT_BODY_HELLO;
+    case TTT_MSG_GAINS: return -2; /* variable: see gains_length */
+    case TTT_MSG_GAINS_READ: return TTT_BODY_GAINS_READ;
+    case TTT_MSG_SETPOINTS: return TTT_BODY_SETPOINTS;
+    case TTT_MSG_HEARTBEAT: return TTT_BODY_HEARTBEAT;
+    case TTT_MSG_DRIVE: return TTT_BODY_DRIVE;
+    case TTT_MSG_START: return TTT_BODY_START;
+    case TTT_MSG_HANDSHAKE: return TTT_BODY_HANDSHAKE;
     case TTT_MSG_GAINS_READBACK: return -2;
-    case TTT_MSG_STATUS: return 45;
-    case TTT_MSG_HEARTBEAT_REPLY: return 16 + 4 * TTT_N_REJ;
+    case TTT_MSG_STATUS: return TTT_BODY_STATUS;
+    case TTT_MSG_HEARTBEAT_REPLY: return TTT_BODY_HEARTBEAT_REPLY;
     default: return -1;
     }
 }
@@ -80,8 +80,8 @@ size_t ttt_frame_encode(uint8_t type, uint16_t seq, const uint8_t *body, size_t 
     size_t i, len;
     uint16_t crc;
     if (n > TTT_MAX_BODY) return 0;
-    frame[0] = type;
-    ttt_put_u16(frame + 1, seq);
+    frame[TTT_FRAME_TYPE] = type;
+    ttt_put_u16(frame + TTT_FRAME_SEQ, seq);
     for (i = 0; i < n; i++) frame[TTT_HEADER + i] = body[i];
     crc = ttt_crc16(frame, TTT_HEADER + n);
     frame[TTT_HEADER + n] = (uint8_t)(crc >> 8);
@@ -102,11 +102,12 @@ void ttt_rx_init(ttt_rx *rx)
     rx->reason = 0;
 }
 
-/* The body length a GAINS or GAINS_READBACK body must have for its block byte. */
+/* The body length a GAINS or GAINS_READBACK body must have for its block byte (a body without
+ * one is cut short: shorter than either). */
 static int gains_length(const uint8_t *body, size_t n)
 {
-    if (n < 1) return 1;
-    return body[0] == 3 ? 1 + 18 * 8 : 1 + 10 * 8;
+    if (n < TTT_GAINS_VALUES) return TTT_BODY_GAINS_DRIVE;
+    return body[TTT_GAINS_BLOCK] == TTT_GAINS_BLOCK_GLOBAL ? TTT_BODY_GAINS_GLOBAL : TTT_BODY_GAINS_DRIVE;
 }
 
 static int judge(ttt_rx *rx)
@@ -119,8 +120,8 @@ static int judge(ttt_rx *rx)
     if (n < TTT_HEADER + TTT_CRC) return TTT_REJ_SHORT;
     crc = (uint16_t)((rx->frame[n - 2] << 8) | rx->frame[n - 1]);
     if (crc != ttt_crc16(rx->frame, (size_t)n - TTT_CRC)) return TTT_REJ_CRC;
-    rx->type = rx->frame[0];
-    rx->seq = ttt_get_u16(rx->frame + 1);
+    rx->type = rx->frame[TTT_FRAME_TYPE];
+    rx->seq = ttt_get_u16(rx->frame + TTT_FRAME_SEQ);
     rx->body = rx->frame + TTT_HEADER;
     rx->body_len = (size_t)n - TTT_HEADER - TTT_CRC;
     expected = ttt_body_length(rx->type);
@@ -162,7 +163,7 @@ int ttt_seq_accept(ttt_seq *s, uint16_t seq)
     uint16_t delta = (uint16_t)(seq - s->last);
     if (s->have) {
         if (delta == 0) return TTT_REJ_DUPLICATE;
-        if (delta >= 0x8000u) return TTT_REJ_OUT_OF_ORDER;
+        if (delta >= TTT_SEQ_BEHIND) return TTT_REJ_OUT_OF_ORDER;
         s->lost += (uint32_t)(delta - 1u);
     }
     s->have = 1;

@@ -385,7 +385,8 @@ Where the thesis' parts live (docs/thesis_map.md maps every figure and
 equation). The cascade loop spans several modules on purpose: one
 definition of each formula (`ttt_sm.twin._cascade` for the controller step and
 the setpoint filter, `ttt_sm.twin._plant` for gravity, `ttt_sm.params.values` for the
-servo), one table of each memory layout (`ttt_sm.twin.layout`), the design of
+servo), one table of each memory layout (`ttt_sm.twin.layout`) and of the
+serial link's protocol (`ttt_sm.hardware.link.protocol`), the design of
 the gains apart from the step that uses them (`ttt_sm.twin.tuning`,
 `ttt_sm.twin.gains`), and the loop that fuses controller and plant
 (`ttt_sm.twin._kernel`).

@@ -9,7 +9,8 @@
  * downloaded), RUNNING after START (the cascade follows the setpoints),
  * SAFE_STOP when setpoints stopped arriving for board.watchdog_steps
  * control steps (each powered drive holds where it is, the pen goes to
- * board.servo_safe_rad) until the next START.
+ * board.servo_safe_rad) until the next START.  Their numbers (TTT_STATE_*),
+ * the DRIVE operations (TTT_OP_*) and the gains blocks are in protocol.h.
  */
 #ifndef TTT_FW_FW_H
 #define TTT_FW_FW_H
@@ -19,32 +20,21 @@
 
 #include "cascade.h"
 #include "link.h"
+#include "protocol.h"
 #include "structs.h" /* ttt_board, ttt_sensors (and ttt_cascade), generated */
 
 #define TTT_FW_VERSION_MAJOR 0
 #define TTT_FW_VERSION_MINOR 2
 #define TTT_FW_VERSION_PATCH 0
 
-#define TTT_STATE_IDLE 0
-#define TTT_STATE_RUNNING 1
-#define TTT_STATE_SAFE_STOP 2
-
-/* DRIVE message operations */
-#define TTT_OP_OFF 0       /* bridge off */
-#define TTT_OP_CLOSED 1    /* cascade on, holding where the drive is */
-#define TTT_OP_OPEN 2      /* open loop at duty = value */
-#define TTT_OP_OFFSET 3    /* encoder offset estimate = value (rad) */
-
-#define TTT_GAINS_BLOCKS 4 /* blocks 0..2: cp of drive 1..3 (10 values); block 3: cg (18 values) */
 #define TTT_TX_CAP 1024
 
 /* What GAINS may carry (checked in fw.c, rejected as TTT_REJ_VALUE; docs/hardware.md): no gain or
  * coefficient beyond +-TTT_GAIN_MAX, a control step in [TTT_DT_MIN_S, TTT_DT_MAX_S], a servo PWM
- * period up to TTT_SV_PERIOD_MAX_S. */
+ * period up to TTT_SV_PERIOD_MAX_S (protocol.h: the bound of the PC's parameter files). */
 #define TTT_GAIN_MAX 1.0e6
 #define TTT_DT_MIN_S 1.0e-5
 #define TTT_DT_MAX_S 0.1
-#define TTT_SV_PERIOD_MAX_S 0.1
 
 /* The firmware's state.  Written here by hand, unlike ttt_board and ttt_sensors
  * (structs.h, generated with the PC's ctypes Structures from one table): the PC

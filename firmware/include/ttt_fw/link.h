@@ -6,6 +6,11 @@
  * Everything here is pure: no I/O, no clock, no heap.  The byte stream is
  * fed one byte at a time to a ttt_rx; it answers with a frame or with the
  * reason the bytes were rejected.
+ *
+ * The protocol's numbers (the version, the framing's sizes, the message
+ * types TTT_MSG_*, the rejection reasons TTT_REJ_*) and each body's length
+ * and field offsets are in protocol.h, generated from the PC's tables
+ * (src/ttt_sm/hardware/link/protocol.py).
  */
 #ifndef TTT_FW_LINK_H
 #define TTT_FW_LINK_H
@@ -13,41 +18,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define TTT_PROTOCOL_VERSION 2
-
-#define TTT_HEADER 3                              /* type, seq (u16 LE) */
-#define TTT_CRC 2                                 /* CRC-16/CCITT-FALSE, MSB first */
-#define TTT_MAX_BODY 160
-#define TTT_MAX_FRAME (TTT_HEADER + TTT_MAX_BODY + TTT_CRC)
-#define TTT_MAX_ENCODED (TTT_MAX_FRAME + TTT_MAX_FRAME / 254 + 1) /* COBS overhead, without the 0x00 */
-
-/* message types: PC -> firmware below 0x80, firmware -> PC from 0x80 */
-#define TTT_MSG_HELLO 0x01
-#define TTT_MSG_GAINS 0x02
-#define TTT_MSG_GAINS_READ 0x03
-#define TTT_MSG_SETPOINTS 0x04
-#define TTT_MSG_HEARTBEAT 0x05
-#define TTT_MSG_DRIVE 0x06
-#define TTT_MSG_START 0x07
-#define TTT_MSG_HANDSHAKE 0x81
-#define TTT_MSG_GAINS_READBACK 0x82
-#define TTT_MSG_STATUS 0x85
-#define TTT_MSG_HEARTBEAT_REPLY 0x86
-
-/* rejection reasons (the same numbers on both sides of the link) */
-#define TTT_REJ_COBS 0          /* not valid COBS */
-#define TTT_REJ_CRC 1           /* CRC mismatch */
-#define TTT_REJ_SHORT 2         /* fewer bytes than a header and a CRC */
-#define TTT_REJ_OVERLONG 3      /* no 0x00 within the longest frame */
-#define TTT_REJ_UNKNOWN_TYPE 4  /* no such message type */
-#define TTT_REJ_PARTIAL 5       /* body shorter than its type's: a frame cut short */
-#define TTT_REJ_LENGTH 6        /* body longer than its type's */
-#define TTT_REJ_DUPLICATE 7     /* sequence number already seen */
-#define TTT_REJ_OUT_OF_ORDER 8  /* sequence number behind the last one */
-#define TTT_REJ_LATE 9          /* setpoints for a step already past */
-#define TTT_REJ_REFUSED 10      /* valid, but not in this state (setpoints before START, gains while running) */
-#define TTT_REJ_VALUE 11        /* a field out of range (drive, block, op, non-finite, a setpoint, gain or period beyond its range) */
-#define TTT_N_REJ 12
+#include "protocol.h"
 
 /* CRC-16/CCITT-FALSE: polynomial 0x1021, init 0xFFFF, no reflection, no final xor ("123456789" -> 0x29B1). */
 uint16_t ttt_crc16(const uint8_t *data, size_t n);

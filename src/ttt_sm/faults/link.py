@@ -331,8 +331,8 @@ def run_link_cell(params: ArmParams, fault: str, seed: int = 0, gains: Gains | N
                     arm.rearm()
                     pc.run(WARMUP_S)
                 # the machine held an end up before the onset: the firmware stopped, or the PC lost the link
-                lost_before = fw.state != 1 or not arm.link_ok or bool(arm.losses) or any(
-                    state == 2 for _, state, _ in emu.state_changes)
+                lost_before = fw.state != L.State.RUNNING or not arm.link_ok or bool(arm.losses) or any(
+                    state == L.State.SAFE_STOP for _, state, _ in emu.state_changes)
                 pc.not_ok_at = None
                 fw_rej, pc_rej = dict(fw.rejections()), dict(arm.rx.rejections)
                 late_outside = fw_rej[L.Reason.LATE] - late0
@@ -345,7 +345,7 @@ def run_link_cell(params: ArmParams, fault: str, seed: int = 0, gains: Gains | N
                 pc.run(FAULT_S, losing)
                 tap.clear()
                 pc.run(AFTER_S, losing)
-                stops = [(step, at) for step, state, at in emu.state_changes[changes:] if state == 2]
+                stops = [(step, at) for step, state, at in emu.state_changes[changes:] if state == L.State.SAFE_STOP]
                 fw_after = dict(fw.rejections())
                 pc_after = {int(r): n for r, n in arm.rx.rejections.items()}
                 counts = tap.counts
@@ -362,7 +362,7 @@ def run_link_cell(params: ArmParams, fault: str, seed: int = 0, gains: Gains | N
                 taken = fw.setpoints_ok
                 pc.run(AFTER_S)
                 late_outside += fw.rejections()[L.Reason.LATE] - late_rearm
-                recovered = arm.link_ok and fw.state == 1 and fw.setpoints_ok > taken
+                recovered = arm.link_ok and fw.state == L.State.RUNNING and fw.setpoints_ok > taken
                 end_text = "" if recovered else (f"at the end: link_ok={arm.link_ok}, firmware state {fw.state}, "
                                                  f"{fw.setpoints_ok - taken} setpoints taken; {arm.link_fault or ''}")
                 stall_ms, behind_ms = pc.max_stall_s * 1e3, emu.max_behind_steps * params.control.dt * 1e3

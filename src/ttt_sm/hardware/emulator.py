@@ -295,7 +295,7 @@ class ArmEmulator:
                     self._gate = fw.setpoints_ok
                     self._until = fw.last_setpoint_step + fw.board.status_every
                 with self._lock:
-                    while fw.state == 1 and fw.steps < self._until:
+                    while fw.state == L.State.RUNNING and fw.steps < self._until:
                         self.bench.step()
                 self._note_state()
                 self._send(fd)
@@ -322,7 +322,7 @@ class ArmEmulator:
     def _deliver(self, data: bytes) -> None:
         if not data:
             return
-        if self.pace == "gated" and self.firmware.state != 1:
+        if self.pace == "gated" and self.firmware.state != L.State.RUNNING:
             self.bench.sense()  # no control step runs before START here: the readings a board would have
         fw = self.firmware
         ok = fw.frames_ok

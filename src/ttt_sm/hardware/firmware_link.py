@@ -198,8 +198,8 @@ class FirmwareLink(AbstractContextManager["FirmwareLink"]):
                 if isinstance(m, L.Status):
                     self.status_seen_at = self.last_frame_at
                     if self._status is None or m.step > self._status.step or m.state != self._status.state:
-                        if m.state != 1 and self.stop_seen_at is None and self._status is not None \
-                                and self._status.state == 1:
+                        if m.state != L.State.RUNNING and self.stop_seen_at is None and self._status is not None \
+                                and self._status.state == L.State.RUNNING:
                             self.stop_seen_at = self.last_frame_at
                         self._status = m
                         self.status_at, self.status_step = self.last_frame_at, m.step
@@ -224,7 +224,7 @@ class FirmwareLink(AbstractContextManager["FirmwareLink"]):
                     del self._replies[i]
                     return m
             status = self._status
-            if kind is L.Status and status is not None and (not after_start or status.state == 1):
+            if kind is L.Status and status is not None and (not after_start or status.state == L.State.RUNNING):
                 return status  # type: ignore[return-value]  # kind is Status
             if time.monotonic() > give_up:
                 raise LinkLost(f"no {kind.__name__} from the firmware within {timeout_s * 1000:.0f} ms "
@@ -307,7 +307,7 @@ class FirmwareLink(AbstractContextManager["FirmwareLink"]):
         give_up = checked + timeout
         while True:
             status = self._status
-            if status is not None and (status.state != 1 or status.step >= target):
+            if status is not None and (status.state != L.State.RUNNING or status.step >= target):
                 return  # a stopped firmware: link_ok says so
             self._poll(min(0.005, timeout))
             now = time.monotonic()
@@ -347,7 +347,7 @@ class FirmwareLink(AbstractContextManager["FirmwareLink"]):
         that failed) or from the firmware's own safe stop, until :meth:`rearm`.
         """
         s = self._status
-        return self.lost is None and (s is None or s.state == 1)
+        return self.lost is None and (s is None or s.state == L.State.RUNNING)
 
     @property
     def link_fault(self) -> str | None:
@@ -355,7 +355,7 @@ class FirmwareLink(AbstractContextManager["FirmwareLink"]):
         if self.lost is not None:
             return self.lost.reason
         s = self._status
-        if s is not None and s.state != 1:
+        if s is not None and s.state != L.State.RUNNING:
             return (f"the firmware stopped the drives ({s.state_name} at step {s.step}: no setpoints reached"
                     " it for 50 ms)")
         return None

@@ -28,6 +28,7 @@ from ..twin.cascade import CascadeController
 from ..twin.gains import Gains, check_drive
 from . import structs
 from .firmware import FirmwareError, Precision
+from .link.protocol import Reason
 
 _REAL = {"float": ctypes.c_float, "double": ctypes.c_double}
 _NUMPY = {"float": np.float32, "double": np.float64}
@@ -274,7 +275,7 @@ class NativeFirmware:
 
     def rejections(self) -> dict[int, int]:
         """The firmware's rejection counters, by reason number (``TTT_REJ_*``)."""
-        return {r: int(self.lib.lib.ttt_fw_rejections(self.ptr, r)) for r in range(12)}
+        return {r: int(self.lib.lib.ttt_fw_rejections(self.ptr, r)) for r in range(len(Reason))}
 
 
 __all__ = ["FirmwareLibrary", "NativeCascade", "NativeFirmware", "Board", "SensorsIn", "board_for"]

@@ -49,6 +49,7 @@ from .firmware_link import (
     LinkLost,
     SerialArmError,
 )
+from .link.protocol import STATUS_MODE_BITS
 from .link_truth import LinkTruth
 
 REARM_SETTLE_S = 0.2
@@ -153,7 +154,8 @@ class SerialArm(FirmwareLink):
                 for d in range(3):  # the PC's offsets are the ones: any sent while the link was down were lost
                     self._send(L.Drive(d, L.Op.OFFSET, self._offsets[d]))
                 give_up = sent + timeout_s
-                while not (self._status is not None and self._status.state == 1 and self.status_seen_at >= sent):
+                while not (self._status is not None and self._status.state == L.State.RUNNING
+                           and self.status_seen_at >= sent):
                     if time.monotonic() > give_up:
                         return False
                     self._poll(0.005)
@@ -252,7 +254,8 @@ class SerialArm(FirmwareLink):
 
     def enabled(self) -> tuple[bool, bool, bool]:
         m = 0 if self._status is None else self._status.modes
-        return tuple(((m >> (2 * d)) & 3) == layout.MODE_CLOSED for d in range(3))  # type: ignore[return-value]
+        bits, mask = STATUS_MODE_BITS, (1 << STATUS_MODE_BITS) - 1
+        return tuple(((m >> (bits * d)) & mask) == layout.MODE_CLOSED for d in range(3))  # type: ignore[return-value]
 
     def set_enabled(self, drive: int, enabled: bool) -> None:
         d = check_drive(drive) - 1

@@ -28,8 +28,8 @@ from typing import Any
 
 from ..twin import layout
 
-#: The arm's drives: 1-3 in the thesis, indexed 0-2 in C.
-DRIVES = 3
+#: The arm's drives: 1-3 in the thesis, indexed 0-2 in C (the controller's blocks' count).
+DRIVES = layout.DRIVES
 
 #: The ctypes type of each C type a table may use; ``ttt_real`` (real.h) is the build's, given when the
 #: Structure is built.

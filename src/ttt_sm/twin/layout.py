@@ -138,6 +138,9 @@ def forget_stale_compilations(module_file: str, *depends_on: str | Path) -> None
 
 # ==== the controller (_cascade.py; firmware/src/cascade.c) ==========================================
 
+#: The arm's DC drives: the rows of every per-drive block, and the drives the serial link speaks of.
+DRIVES = 3
+
 #: The servo's calibration, five numbers in the order of ``params.servo_duty``'s arguments after the
 #: angle (``params.Servo.calibration``): the controller's ``cg`` and the plant's ``pg`` hold it alike.
 SERVO_CALIBRATION = (
@@ -186,8 +189,8 @@ CGS = block("CGS", "global state cgs[CGS_*]", [
     ("SV_DUTY_OF", "... computed for this setpoint (NaN: not yet), so that it is computed once per setpoint"),
 ])
 ACT = block("ACT", "outputs act[ACT_*]: what the plant (the H-bridges, the servo) receives", [
-    ("DUTY", "3 values: PWM duty applied to each H-bridge now (-1..1)", 3),
-    ("BRIDGE", "3 values: 1.0 while the bridge is on, 0.0 while off (the motor coasts)", 3),
+    ("DUTY", "3 values: PWM duty applied to each H-bridge now (-1..1)", DRIVES),
+    ("BRIDGE", "3 values: 1.0 while the bridge is on, 0.0 while off (the motor coasts)", DRIVES),
     ("SV_DUTY", "servo PWM duty (0..1)"),
 ])
 MODE = block("MODE", "modes cm[d] (integers)", [
@@ -196,8 +199,8 @@ MODE = block("MODE", "modes cm[d] (integers)", [
     ("OPEN", "fixed duty (tests, experiments); duty 0 shorts the motor (brakes)"),
 ], counted=False)
 CR = block("CR", "the twin's one float buffer cf[CR_*, :WIDTH]: each block a row or three", [
-    ("CP", "3 rows: cp", 3),
-    ("CS", "3 rows: cs", 3),
+    ("CP", "3 rows: cp", DRIVES),
+    ("CS", "3 rows: cs", DRIVES),
     ("CG", "cg"),
     ("CGS", "cgs"),
     ("ACT", "act"),

@@ -8,6 +8,10 @@ The same specification as the firmware's ``firmware/src/link.c`` and
 COBS-encoded and closed by a 0x00 byte.  Bodies are little-endian.  One
 module an idea, as the camera's link (:mod:`ttt_sm.smartcam`) is cut:
 
+- :mod:`.protocol` -- the protocol's numbers and body layouts, written
+  once: :class:`Msg`, :class:`Reason`, :class:`State`, :class:`Op`, the
+  framing's sizes and every body's fields, from which the messages' formats
+  and the firmware's ``protocol.h`` are made;
 - :mod:`.rejections` -- :class:`Reason` (the firmware's ``TTT_REJ_*``) and
   :class:`Rejection`;
 - :mod:`.messages` -- :class:`Msg`, the :class:`Message` types and their
@@ -61,6 +65,7 @@ from .messages import (
     Op,
     Setpoints,
     Start,
+    State,
     Status,
     body_length,
     kind_name,
@@ -72,5 +77,5 @@ __all__ = [
     "N_CP", "N_REASONS", "PROTOCOL_VERSION", "STATE_NAMES", "TO_FIRMWARE", "TO_PC", "Drive", "EmuTruth", "Frame",
     "FrameDecoder", "Gains", "GainsRead", "GainsReadback", "Handshake", "Heartbeat", "HeartbeatReply", "Hello",
     "Message", "Msg", "Op", "Reason", "Receiver", "Rejection", "SeqTracker", "Sender", "Setpoints", "Start",
-    "Status", "body_length", "cobs_decode", "cobs_encode", "crc16", "encode_frame", "kind_name",
+    "State", "Status", "body_length", "cobs_decode", "cobs_encode", "crc16", "encode_frame", "kind_name",
 ]

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 from .framing import FrameDecoder, encode_frame
 from .messages import MESSAGES, TO_PC, Message, Msg, kind_name
+from .protocol import SEQ_BEHIND
 from .rejections import Reason, Rejection
 
 log = logging.getLogger("ttt_sm.link")
@@ -38,7 +39,7 @@ class SeqTracker:
             delta = (seq - self.last) & 0xFFFF
             if delta == 0:
                 return Reason.DUPLICATE
-            if delta >= 0x8000:
+            if delta >= SEQ_BEHIND:
                 return Reason.OUT_OF_ORDER
             self.lost += delta - 1
         self.last = seq

@@ -18,14 +18,8 @@ from dataclasses import dataclass
 
 from ...ptylink.crc import crc16
 from .messages import body_length, kind_name
+from .protocol import CRC_BYTES, HEAD_FORMAT, HEADER, MAX_BODY, MAX_ENCODED, MAX_FRAME
 from .rejections import Reason, Rejection
-
-HEADER = 3
-CRC_BYTES = 2
-MAX_BODY = 160
-MAX_FRAME = HEADER + MAX_BODY + CRC_BYTES
-MAX_ENCODED = MAX_FRAME + MAX_FRAME // 254 + 1
-"""The longest COBS-encoded frame, without its closing 0x00."""
 
 
 def cobs_encode(data: bytes) -> bytes:
@@ -72,8 +66,8 @@ def encode_frame(kind: int, seq: int, body: bytes) -> bytes:
     """A whole wire frame: COBS of type, seq, body and CRC, then 0x00."""
     if len(body) > MAX_BODY:
         raise ValueError(f"a body of {len(body)} bytes is longer than {MAX_BODY}")
-    frame = struct.pack("<BH", kind, seq & 0xFFFF) + body
-    return cobs_encode(frame + crc16(frame).to_bytes(2, "big")) + b"\x00"
+    frame = struct.pack(HEAD_FORMAT, kind, seq & 0xFFFF) + body
+    return cobs_encode(frame + crc16(frame).to_bytes(CRC_BYTES, "big")) + b"\x00"
 
 
 @dataclass(frozen=True)
@@ -119,10 +113,10 @@ class FrameDecoder:
             return Rejection(Reason.COBS, f"{e} ({encoded[:16].hex(' ')})", size)
         if len(frame) < HEADER + CRC_BYTES:
             return Rejection(Reason.SHORT, f"{len(frame)} bytes, a frame has at least {HEADER + CRC_BYTES}", size)
-        got, want = int.from_bytes(frame[-2:], "big"), crc16(frame[:-2])
+        got, want = int.from_bytes(frame[-CRC_BYTES:], "big"), crc16(frame[:-CRC_BYTES])
         if got != want:
             return Rejection(Reason.CRC, f"CRC {got:04x}, computed {want:04x}, type 0x{frame[0]:02x}", size)
-        kind, seq = struct.unpack_from("<BH", frame)
+        kind, seq = struct.unpack_from(HEAD_FORMAT, frame)
         body = frame[HEADER:-CRC_BYTES]
         expected = body_length(kind, body)
         if expected is None:

@@ -11,34 +11,26 @@ from __future__ import annotations
 
 import math
 import struct
-from dataclasses import Field, dataclass, fields
-from enum import IntEnum
+from collections.abc import Iterator
+from dataclasses import Field, dataclass
 from typing import Any, ClassVar, Self
 
-from .rejections import N_REASONS
+from ...twin.layout import DRIVES, N_CG, N_CP
+from .protocol import (
+    BODIES,
+    FIRST_TO_PC,
+    GAINS_BLOCKS,
+    PROTOCOL_VERSION,
+    SETPOINTS_FLAG_FR_SW,
+    Group,
+    Msg,
+    Op,
+    State,
+    body_of,
+    gains_body,
+)
 
-PROTOCOL_VERSION = 2
-DRIVES = 3
-N_CP = 10
-N_CG = 18
-GAINS_BLOCKS = 4  # 0..2: a drive's parameter row (N_CP values); 3: the global row (N_CG values)
-
-
-class Msg(IntEnum):
-    """Message types: PC -> firmware below 0x80, firmware -> PC from 0x80."""
-
-    HELLO = 0x01
-    GAINS = 0x02
-    GAINS_READ = 0x03
-    SETPOINTS = 0x04
-    HEARTBEAT = 0x05
-    DRIVE = 0x06
-    START = 0x07
-    HANDSHAKE = 0x81
-    GAINS_READBACK = 0x82
-    STATUS = 0x85
-    HEARTBEAT_REPLY = 0x86
-    EMU_TRUTH = 0xE0  # the emulator's, never a board's: the plant's true angles (simulation only)
+STATE_NAMES = tuple(s.name.lower() for s in State)
 
 
 def kind_name(kind: int) -> str:
@@ -52,26 +44,52 @@ def kind_name(kind: int) -> str:
 class Message:
     """A message's fields; :meth:`pack` gives its body, :meth:`unpack` reads one (bodies are little-endian).
 
-    A message whose fields are its body's values one for one, in order,
-    needs no more than its fields and :attr:`FORMAT`; one that groups
-    values into tuples says how in :meth:`values` and :meth:`unpack`.
+    Its body's table (:data:`.protocol.BODIES`) says what it holds: each
+    field of the table is the attribute of its name in lower case, in
+    order, a tuple where the field counts several values or repeats per
+    drive; :attr:`FORMAT` is the table's ``struct`` format, set when the
+    class is made.  A message whose attributes are not its body's fields
+    says how they map in :meth:`values` and :meth:`unpack`.
     """
 
     KIND: ClassVar[Msg]
     FORMAT: ClassVar[str]
     __dataclass_fields__: ClassVar[dict[str, Field[Any]]]  # every message is a dataclass
 
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls.FORMAT = body_of(cls.KIND).format
+
     def values(self) -> tuple[float | int, ...]:
-        """The body's values in :attr:`FORMAT`'s order: by default the fields, as declared."""
-        return tuple(getattr(self, f.name) for f in fields(self))
+        """The body's values in :attr:`FORMAT`'s order: a group's fields interleaved, repeat by repeat."""
+        out: list[float | int] = []
+        for item in BODIES[self.KIND].items:
+            if isinstance(item, Group):
+                columns = [getattr(self, f.name.lower()) for f in item.fields]
+                out += [v for i in range(item.count) for v in (c[i] for c in columns)]
+            elif item.count == 1:
+                out.append(getattr(self, item.name.lower()))
+            else:
+                out += getattr(self, item.name.lower())
+        return tuple(out)
 
     def pack(self) -> bytes:
         return struct.pack(self.FORMAT, *self.values())
 
     @classmethod
     def unpack(cls, body: bytes) -> Self:
-        """The message in `body` (of :attr:`FORMAT`'s length): by default its values as the fields."""
-        return cls(*struct.unpack(cls.FORMAT, body))
+        """The message in `body` (of :attr:`FORMAT`'s length): its values as the fields, grouped as :meth:`values`."""
+        values: Iterator[Any] = iter(struct.unpack(cls.FORMAT, body))
+        args: list[Any] = []
+        for item in BODIES[cls.KIND].items:
+            if isinstance(item, Group):
+                rows = [[next(values) for _ in item.fields] for _ in range(item.count)]
+                args += [tuple(column) for column in zip(*rows, strict=True)]
+            elif item.count == 1:
+                args.append(next(values))
+            else:
+                args.append(tuple(next(values) for _ in range(item.count)))
+        return cls(*args)
 
     def check(self) -> str | None:
         """What is out of range in the fields (a :data:`Reason.VALUE` rejection), None if nothing."""
@@ -85,26 +103,30 @@ def _finite(values: tuple[float, ...] | list[float]) -> bool:
 @dataclass(frozen=True)
 class Hello(Message):
     KIND: ClassVar[Msg] = Msg.HELLO
-    FORMAT: ClassVar[str] = "<B"
     protocol: int = PROTOCOL_VERSION
 
 
 @dataclass(frozen=True)
 class Gains(Message):
-    """One block of the controller's parameters: 0..2 a drive's row (10 values), 3 the global row (18)."""
+    """One block of the controller's parameters: 0..2 a drive's row (N_CP values), 3 the global row (N_CG).
+
+    Its :attr:`FORMAT` is the drive row's; a body's length is its values', whatever their number (a
+    wrong one is the receiver's to judge).
+    """
 
     KIND: ClassVar[Msg] = Msg.GAINS
-    FORMAT: ClassVar[str] = "<B"
     block: int
     values_: tuple[float, ...]
 
+    def values(self) -> tuple[float | int, ...]:
+        return (self.block, *self.values_)
+
     def pack(self) -> bytes:
-        return struct.pack(f"<B{len(self.values_)}d", self.block, *self.values_)
+        return struct.pack(gains_body(len(self.values_)).format, *self.values())
 
     @classmethod
-    def unpack(cls, body: bytes) -> Gains:
-        n = (len(body) - 1) // 8
-        block, *vals = struct.unpack(f"<B{n}d", body)
+    def unpack(cls, body: bytes) -> Self:
+        block, *vals = struct.unpack(gains_body((len(body) - 1) // 8).format, body)
         return cls(block, tuple(vals))
 
     def check(self) -> str | None:
@@ -121,7 +143,6 @@ class GainsReadback(Gains):
 @dataclass(frozen=True)
 class GainsRead(Message):
     KIND: ClassVar[Msg] = Msg.GAINS_READ
-    FORMAT: ClassVar[str] = "<B"
     block: int
 
     def check(self) -> str | None:
@@ -130,21 +151,23 @@ class GainsRead(Message):
 
 @dataclass(frozen=True)
 class Setpoints(Message):
-    """Setpoints meant for firmware control step `step`: drives 1-3 (encoder coordinates) and the servo, rad."""
+    """Setpoints meant for firmware control step `step`: drives 1-3 (encoder coordinates) and the servo, rad.
+
+    The body's ``FLAGS`` byte holds `fr_sw` (:data:`.protocol.SETPOINTS_FLAG_FR_SW`).
+    """
 
     KIND: ClassVar[Msg] = Msg.SETPOINTS
-    FORMAT: ClassVar[str] = "<I4fB"
     step: int
     q: tuple[float, float, float, float]
     fr_sw: bool = False
 
     def values(self) -> tuple[float | int, ...]:
-        return (self.step, *self.q, 1 if self.fr_sw else 0)
+        return (self.step, *self.q, SETPOINTS_FLAG_FR_SW if self.fr_sw else 0)
 
     @classmethod
-    def unpack(cls, body: bytes) -> Setpoints:
+    def unpack(cls, body: bytes) -> Self:
         step, a, b, c, d, flags = struct.unpack(cls.FORMAT, body)
-        return cls(step, (a, b, c, d), bool(flags & 1))
+        return cls(step, (a, b, c, d), bool(flags & SETPOINTS_FLAG_FR_SW))
 
     def check(self) -> str | None:
         return None if _finite(self.q) else f"setpoints {self.q} are not all finite"
@@ -153,23 +176,12 @@ class Setpoints(Message):
 @dataclass(frozen=True)
 class Heartbeat(Message):
     KIND: ClassVar[Msg] = Msg.HEARTBEAT
-    FORMAT: ClassVar[str] = "<I"
     token: int
-
-
-class Op(IntEnum):
-    """What a :class:`Drive` message does to drive `drive`."""
-
-    OFF = 0  # bridge off
-    CLOSED = 1  # cascade on, holding where the drive is
-    OPEN = 2  # open loop at duty = value
-    OFFSET = 3  # encoder offset estimate = value (rad)
 
 
 @dataclass(frozen=True)
 class Drive(Message):
     KIND: ClassVar[Msg] = Msg.DRIVE
-    FORMAT: ClassVar[str] = "<BBd"
     drive: int  # 0..2
     op: int
     value: float = 0.0
@@ -183,7 +195,6 @@ class Drive(Message):
 @dataclass(frozen=True)
 class Start(Message):
     KIND: ClassVar[Msg] = Msg.START
-    FORMAT: ClassVar[str] = "<"
 
 
 @dataclass(frozen=True)
@@ -191,7 +202,6 @@ class Handshake(Message):
     """What the firmware is: versions, drives, its number type, control period, encoders and limits."""
 
     KIND: ClassVar[Msg] = Msg.HANDSHAKE
-    FORMAT: ClassVar[str] = "<BBBBBBI" + "dff" * DRIVES + "fff"
     protocol: int
     firmware: tuple[int, int, int]
     drives: int
@@ -204,22 +214,6 @@ class Handshake(Message):
     servo_max_rad: float
     servo_safe_rad: float
 
-    def values(self) -> tuple[float | int, ...]:
-        per_drive = [v for d in range(DRIVES)
-                     for v in (self.rad_per_count[d], self.limit_min_rad[d], self.limit_max_rad[d])]
-        return (self.protocol, *self.firmware, self.drives, self.real_size, self.control_period_us, *per_drive,
-                self.servo_min_rad, self.servo_max_rad, self.servo_safe_rad)
-
-    @classmethod
-    def unpack(cls, body: bytes) -> Handshake:
-        v = struct.unpack(cls.FORMAT, body)
-        drives = v[7:7 + 3 * DRIVES]
-        return cls(v[0], (v[1], v[2], v[3]), v[4], v[5], v[6], tuple(drives[0::3]), tuple(drives[1::3]),
-                   tuple(drives[2::3]), *v[7 + 3 * DRIVES:])
-
-
-STATE_NAMES = ("idle", "running", "safe_stop")
-
 
 @dataclass(frozen=True)
 class Status(Message):
@@ -227,25 +221,15 @@ class Status(Message):
     ADC counts: the PC converts it with the ``[servo]`` calibration)."""
 
     KIND: ClassVar[Msg] = Msg.STATUS
-    FORMAT: ClassVar[str] = "<IBBB3i3i3H3hH"
     step: int
     state: int
     index: int  # bit d: drive d's index switch level
-    modes: int  # 2 bits per drive, drive 1 lowest
+    modes: int  # STATUS_MODE_BITS bits per drive, drive 1 lowest
     counts: tuple[int, int, int]
     index_count: tuple[int, int, int]
     index_edges: tuple[int, int, int]
     current_ma: tuple[int, int, int]
     servo_adc: int
-
-    def values(self) -> tuple[int, ...]:
-        return (self.step, self.state, self.index, self.modes, *self.counts, *self.index_count,
-                *self.index_edges, *self.current_ma, self.servo_adc)
-
-    @classmethod
-    def unpack(cls, body: bytes) -> Status:
-        v = struct.unpack(cls.FORMAT, body)
-        return cls(v[0], v[1], v[2], v[3], v[4:7], v[7:10], v[10:13], v[13:16], v[16])
 
     @property
     def state_name(self) -> str:
@@ -257,20 +241,11 @@ class HeartbeatReply(Message):
     """The firmware's answer to a :class:`Heartbeat`: the token, its step and its link counters."""
 
     KIND: ClassVar[Msg] = Msg.HEARTBEAT_REPLY
-    FORMAT: ClassVar[str] = f"<4I{N_REASONS}I"
     token: int
     step: int
     frames_ok: int
     lost: int
     rejections: tuple[int, ...]
-
-    def values(self) -> tuple[int, ...]:
-        return (self.token, self.step, self.frames_ok, self.lost, *self.rejections)
-
-    @classmethod
-    def unpack(cls, body: bytes) -> HeartbeatReply:
-        v = struct.unpack(cls.FORMAT, body)
-        return cls(v[0], v[1], v[2], v[3], tuple(v[4:]))
 
 
 @dataclass(frozen=True)
@@ -286,19 +261,10 @@ class EmuTruth(Message):
     """
 
     KIND: ClassVar[Msg] = Msg.EMU_TRUTH
-    FORMAT: ClassVar[str] = "<IB4d3d"
     step: int
     flags: int
     q: tuple[float, float, float, float]
     offsets: tuple[float, float, float]
-
-    def values(self) -> tuple[float | int, ...]:
-        return (self.step, self.flags, *self.q, *self.offsets)
-
-    @classmethod
-    def unpack(cls, body: bytes) -> EmuTruth:
-        v = struct.unpack(cls.FORMAT, body)
-        return cls(v[0], v[1], (v[2], v[3], v[4], v[5]), (v[6], v[7], v[8]))
 
     @property
     def gated(self) -> bool:
@@ -311,20 +277,18 @@ class EmuTruth(Message):
 MESSAGES: dict[int, type[Message]] = {m.KIND: m for m in (
     Hello, Gains, GainsRead, Setpoints, Heartbeat, Drive, Start, Handshake, GainsReadback, Status, HeartbeatReply,
     EmuTruth)}
-_FIXED_LENGTH = {kind: struct.calcsize(m.FORMAT) for kind, m in MESSAGES.items()
-                 if kind not in (Msg.GAINS, Msg.GAINS_READBACK)}
-TO_FIRMWARE = frozenset(k for k in MESSAGES if k < 0x80)
-TO_PC = frozenset(k for k in MESSAGES if k >= 0x80)
+TO_FIRMWARE = frozenset(k for k in MESSAGES if k < FIRST_TO_PC)
+TO_PC = frozenset(k for k in MESSAGES if k >= FIRST_TO_PC)
 
 
 def body_length(kind: int, body: bytes) -> int | None:
     """The body length a frame of type `kind` must have (GAINS: by its block byte), None if no such type."""
-    if kind in (Msg.GAINS, Msg.GAINS_READBACK):
-        return 1 + 8 * (N_CG if body[:1] == b"\x03" else N_CP)
-    return _FIXED_LENGTH.get(kind)
+    if kind not in MESSAGES:
+        return None
+    return body_of(Msg(kind), body[0] if body else 0).size
 
 
 __all__ = ["DRIVES", "GAINS_BLOCKS", "MESSAGES", "N_CG", "N_CP", "PROTOCOL_VERSION", "STATE_NAMES", "TO_FIRMWARE",
            "TO_PC", "Drive", "EmuTruth", "Gains", "GainsRead", "GainsReadback", "Handshake", "Heartbeat",
-           "HeartbeatReply", "Hello", "Message", "Msg", "Op", "Setpoints", "Start", "Status", "body_length",
+           "HeartbeatReply", "Hello", "Message", "Msg", "Op", "Setpoints", "Start", "State", "Status", "body_length",
            "kind_name"]

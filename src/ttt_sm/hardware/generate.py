@@ -58,20 +58,23 @@ def generated(root: Path | None = None) -> dict[Path, Callable[[], str]]:
     return {root / rel: make for rel, make, _ in FILES}
 
 
+def _stale_texts(root: Path | None) -> dict[Path, str]:
+    """Each generated file that is missing or differs from what its tables make now, with that text."""
+    texts = {path: make() for path, make in generated(root).items()}
+    return {path: text for path, text in texts.items()
+            if not path.is_file() or path.read_text(encoding="utf-8") != text}
+
+
 def stale(root: Path | None = None) -> list[Path]:
     """The generated files that are missing or differ from what their tables make now."""
-    out = []
-    for path, make in generated(root).items():
-        if not path.is_file() or path.read_text(encoding="utf-8") != make():
-            out.append(path)
-    return out
+    return list(_stale_texts(root))
 
 
 def write(root: Path | None = None) -> list[Path]:
-    """Write every generated file that is stale; return those written."""
+    """Write every generated file that is stale (each made once); return those written."""
     written = []
-    for path in stale(root):
-        write_atomic(path, generated(root)[path]())  # the whole file or the one that was there
+    for path, text in _stale_texts(root).items():
+        write_atomic(path, text)  # the whole file or the one that was there
         written.append(path)
     return written
 

@@ -36,15 +36,21 @@ def _c_title(title: str) -> str:
 Row = tuple[str, int | str, str]
 
 
+def _c_comment(name: str, doc: str) -> str:
+    """`doc` as a C comment (empty if `doc` is); a doc that would end the comment early is refused."""
+    if "*/" in doc:
+        raise ValueError(f"{name}: a doc may not close a C comment: {doc!r}")
+    return f"/* {doc} */" if doc else ""
+
+
 def _defines(rows: Sequence[Row]) -> list[str]:
-    """``#define TTT_<name> <value>`` lines, their ``/* doc */`` comments aligned; a doc may not close a comment."""
+    """``#define TTT_<name> <value>`` lines, their :func:`_c_comment` comments aligned."""
     width = max((len(f"#define {C_PREFIX}{name} {value}") for name, value, _ in rows), default=0)
     lines = []
     for name, value, doc in rows:
         define = f"#define {C_PREFIX}{name} {value}"
-        if "*/" in doc:
-            raise ValueError(f"{C_PREFIX}{name}: a doc may not close a C comment: {doc!r}")
-        lines.append(f"{define:<{width}}  /* {doc} */" if doc else define)
+        comment = _c_comment(f"{C_PREFIX}{name}", doc)
+        lines.append(f"{define:<{width}}  {comment}" if comment else define)
     return lines
 
 
@@ -123,10 +129,11 @@ def protocol_h(bodies: Mapping[protocol.Msg, protocol.Body] = protocol.BODIES) -
             ("GAINS_BLOCKS", p.GAINS_BLOCKS, ""),
             ("BODY_GAINS_DRIVE", p.GAINS_DRIVE.size, f"blocks 0..{last_drive_block}"),
             ("BODY_GAINS_GLOBAL", p.GAINS_GLOBAL.size, f"block {p.GAINS_GLOBAL_BLOCK}")]),
+        ("bits within a field", list(p.FIELD_BITS)),
+        ("what GAINS may carry, as the PC's parameter files may (ttt_sm.params.LIMITS)", [
+            ("SV_PERIOD_MAX_S", repr(float(LIMITS["servo.period_s"][1])),
+             "the servo's PWM period, s: [servo] period_s")]),
     ]
-    sections.append(("bits within a field", list(p.FIELD_BITS)))
-    sections.append(("what GAINS may carry, as the PC's parameter files may (ttt_sm.params.LIMITS)", [
-        ("SV_PERIOD_MAX_S", repr(float(LIMITS["servo.period_s"][1])), "the servo's PWM period, s: [servo] period_s")]))
     sections += [(f"{m.name} (0x{m:02X}): {m.doc}", [*_body(m.name, bodies[m]), (f"BODY_{m.name}", bodies[m].size, "")])
                  for m in firmware if m in bodies]
     names = [name for _, rows in sections for name, _, _ in rows]
@@ -137,13 +144,6 @@ def protocol_h(bodies: Mapping[protocol.Msg, protocol.Body] = protocol.BODIES) -
         lines += ["", f"/* {title} */", *_defines(rows)]
     lines += ["", "#endif", ""]
     return "\n".join(lines)
-
-
-def _c_comment(name: str, doc: str) -> str:
-    """`doc` as a C comment (empty if `doc` is); a doc that would end the comment early is refused."""
-    if "*/" in doc:
-        raise ValueError(f"{name}: a doc may not close a C comment: {doc!r}")
-    return f"/* {doc} */" if doc else ""
 
 
 def _declaration(f: structs.CField) -> str:

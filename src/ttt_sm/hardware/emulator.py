@@ -348,7 +348,8 @@ class ArmEmulator:
         if data and self.truth:  # before the firmware's frames: the PC has it when it reads their status
             ps, pgs, ints, rpc = self.plant.ps, self.plant.pgs, self.plant.ints, self._rpc
             q, c0 = layout.PS_Q, layout.PI_C0
-            frame = self._truth_tx.frame(L.EmuTruth(self.firmware.steps, int(self.pace == "gated"), (
+            flags = L.EMU_TRUTH_FLAG_GATED if self.pace == "gated" else 0
+            frame = self._truth_tx.frame(L.EmuTruth(self.firmware.steps, flags, (
                 float(ps[0, q]), float(ps[1, q]), float(ps[2, q]), float(pgs[layout.PGS_SV_Q])),
                 ((ints[0, c0] + 0.5) * rpc[0], (ints[1, c0] + 0.5) * rpc[1],
                  (ints[2, c0] + 0.5) * rpc[2])))  # (live: a jumped encoder moves its offset)

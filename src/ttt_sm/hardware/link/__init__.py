@@ -43,6 +43,7 @@ from .framing import (
 )
 from .messages import (
     DRIVES,
+    EMU_TRUTH_FLAG_GATED,
     GAINS_BLOCKS,
     MESSAGES,
     N_CG,
@@ -73,9 +74,10 @@ from .messages import (
 from .rejections import N_REASONS, Reason, Rejection
 
 __all__ = [
-    "CRC_BYTES", "DRIVES", "GAINS_BLOCKS", "HEADER", "MAX_BODY", "MAX_ENCODED", "MAX_FRAME", "MESSAGES", "N_CG",
-    "N_CP", "N_REASONS", "PROTOCOL_VERSION", "STATE_NAMES", "TO_FIRMWARE", "TO_PC", "Drive", "EmuTruth", "Frame",
-    "FrameDecoder", "Gains", "GainsRead", "GainsReadback", "Handshake", "Heartbeat", "HeartbeatReply", "Hello",
-    "Message", "Msg", "Op", "Reason", "Receiver", "Rejection", "SeqTracker", "Sender", "Setpoints", "Start",
-    "State", "Status", "body_length", "cobs_decode", "cobs_encode", "crc16", "encode_frame", "kind_name",
+    "CRC_BYTES", "DRIVES", "EMU_TRUTH_FLAG_GATED", "GAINS_BLOCKS", "HEADER", "MAX_BODY", "MAX_ENCODED", "MAX_FRAME",
+    "MESSAGES", "N_CG", "N_CP", "N_REASONS", "PROTOCOL_VERSION", "STATE_NAMES", "TO_FIRMWARE", "TO_PC", "Drive",
+    "EmuTruth", "Frame", "FrameDecoder", "Gains", "GainsRead", "GainsReadback", "Handshake", "Heartbeat",
+    "HeartbeatReply", "Hello", "Message", "Msg", "Op", "Reason", "Receiver", "Rejection", "SeqTracker", "Sender",
+    "Setpoints", "Start", "State", "Status", "body_length", "cobs_decode", "cobs_encode", "crc16", "encode_frame",
+    "kind_name",
 ]

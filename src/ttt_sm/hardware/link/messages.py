@@ -31,6 +31,8 @@ from .protocol import (
 )
 
 STATE_NAMES = tuple(s.name.lower() for s in State)
+#: The bit of EMU_TRUTH's `flags` that says the emulator is gated (the emulator's own: not in protocol.h).
+EMU_TRUTH_FLAG_GATED = 0x01
 
 
 def kind_name(kind: int) -> str:
@@ -268,7 +270,7 @@ class EmuTruth(Message):
 
     @property
     def gated(self) -> bool:
-        return bool(self.flags & 1)
+        return bool(self.flags & EMU_TRUTH_FLAG_GATED)
 
     def check(self) -> str | None:
         return None if _finite(self.q + self.offsets) else f"non-finite angles {self.q} {self.offsets}"
@@ -288,7 +290,7 @@ def body_length(kind: int, body: bytes) -> int | None:
     return body_of(Msg(kind), body[0] if body else 0).size
 
 
-__all__ = ["DRIVES", "GAINS_BLOCKS", "MESSAGES", "N_CG", "N_CP", "PROTOCOL_VERSION", "STATE_NAMES", "TO_FIRMWARE",
-           "TO_PC", "Drive", "EmuTruth", "Gains", "GainsRead", "GainsReadback", "Handshake", "Heartbeat",
-           "HeartbeatReply", "Hello", "Message", "Msg", "Op", "Setpoints", "Start", "State", "Status", "body_length",
-           "kind_name"]
+__all__ = ["DRIVES", "EMU_TRUTH_FLAG_GATED", "GAINS_BLOCKS", "MESSAGES", "N_CG", "N_CP", "PROTOCOL_VERSION",
+           "STATE_NAMES", "TO_FIRMWARE", "TO_PC", "Drive", "EmuTruth", "Gains", "GainsRead", "GainsReadback",
+           "Handshake", "Heartbeat", "HeartbeatReply", "Hello", "Message", "Msg", "Op", "Setpoints", "Start", "State",
+           "Status", "body_length", "kind_name"]

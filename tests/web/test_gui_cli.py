@@ -28,13 +28,8 @@ def test_gui_serves_the_printed_address_and_ctrl_c_saves_the_trace(tmp_path: Pat
                 url = found.group(1)
                 break
         assert url is not None, "no address printed"
-        for _ in range(600):  # the server starts after the robot is built
-            try:
-                page = urllib.request.urlopen(url, timeout=5).read().decode()
-                break
-            except OSError:
-                import time
-                time.sleep(0.1)
+        # opened at once, as a person or .ci/run does: the port listens from the moment it is printed
+        page = urllib.request.urlopen(url, timeout=60).read().decode()
         assert 'data-role="sim-time"' in page
         index = urllib.request.urlopen(url.replace("/charts", "/"), timeout=5).read().decode()  # the token too
         assert 'href="/charts"' in index
@@ -52,3 +47,24 @@ def test_gui_serves_the_printed_address_and_ctrl_c_saves_the_trace(tmp_path: Pat
                                           ("0.0.0.0", True), ("192.168.1.5", True), ("robot.lab", True)])
 def test_every_host_but_loopback_is_said_to_reach_beyond_this_machine(host: str, beyond: bool) -> None:
     assert beyond_this_machine(host) is beyond
+
+
+def test_the_printed_port_takes_connections_before_the_server_runs(tmp_path: Path, monkeypatch, capsys) -> None:
+    # .ci/run once fetched the printed address in the moment before uvicorn listened: connection refused
+    import socket
+
+    import uvicorn
+
+    from ttt_sm.cli import main
+
+    taken = []
+
+    def run(self: uvicorn.Server, sockets: list[socket.socket]) -> None:  # the server never starts
+        port = sockets[0].getsockname()[1]
+        assert f"127.0.0.1:{port}/charts?token=" in capsys.readouterr().out  # the address is out already
+        with socket.create_connection(("127.0.0.1", port), timeout=5):
+            taken.append(port)
+
+    monkeypatch.setattr(uvicorn.Server, "run", run)
+    assert main(["gui", "--port", "0", "--paused", "--trace", str(tmp_path / "trace.jsonl")]) == 0
+    assert len(taken) == 1

@@ -122,6 +122,9 @@ def cmd_gui(args: argparse.Namespace) -> int:
         sock = socket.socket(socket.AF_INET6 if ":" in args.host else socket.AF_INET, socket.SOCK_STREAM)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         sock.bind((args.host, args.port))
+        # listening before the address is printed: a page or script that opens it while the robot is built
+        # and uvicorn starts waits in the backlog instead of being refused (uvicorn's own backlog)
+        sock.listen(2048)
     except OSError as exc:
         raise CliError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
     port = sock.getsockname()[1]

@@ -27,7 +27,8 @@ def test_wall_clock_paces_and_counts_lateness():
     for k in range(50):
         c.wait_period(k)
     elapsed = time.perf_counter() - t0
-    assert elapsed >= 49 * 0.002  # it did wait for period 49
+    # it did wait for period 49: the clock skips a sleep shorter than its slack, so it may return that much early
+    assert elapsed >= 49 * 0.002 - c.slack_s
     st = c.stats()
     assert st.periods == 50
     assert st.lateness_p99_us >= st.lateness_p50_us >= 0
